@@ -1,0 +1,185 @@
+"""Contact modes and their enumeration under the utility conditions (Sections 3.1, 3.2, 4.7).
+
+A contact mode assigns one interaction to every contact: ``R`` (rolling),
+``S`` (sliding) or ``B`` (breaking).  It is written as one letter per contact
+in order (``"RBS"``) and named as in the paper (``"R1S3"``, ``"3S"``).
+
+With a given control-mode partition of ``n_e`` effort-controlled joints, the
+utility conditions (29)-(32) require ``2 n_R + n_S = 3 + n_e`` applicable
+kinematic constraints; :func:`enumerate_modes` lists exactly those modes, in
+the paper's order (``n_R`` ascending, then the rolling set, then the sliding
+set, lexicographically), so that for three contacts 3S=1, R1S2=2, R1S3=3,
+R2S1=4, R2S3=5, R3S1=6, R3S2=7 (Fig. 6's numbering).  Their number is eq. (49).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from itertools import combinations
+from math import comb
+
+import numpy as np
+
+from .errors import ModeError
+
+__all__ = [
+    "ContactMode",
+    "mode_from_letters",
+    "enumerate_modes",
+    "count_modes",
+    "mode_index_array",
+]
+
+
+@dataclass(frozen=True, slots=True)
+class ContactMode:
+    """One contact mode.
+
+    Attributes
+    ----------
+    letters : str
+        One of ``R``, ``S``, ``B`` per contact, in contact order (0-based index i
+        is contact ``i + 1`` of the paper).
+    """
+
+    letters: str
+
+    def __post_init__(self):
+        if not self.letters or set(self.letters) - set("RSB"):
+            raise ModeError(f"mode: expected letters R, S or B (one per contact); got {self.letters!r}")
+
+    @property
+    def n_contacts(self) -> int:
+        return len(self.letters)
+
+    @property
+    def rolling(self) -> tuple[int, ...]:
+        """0-based indices of rolling contacts."""
+        return tuple(i for i, c in enumerate(self.letters) if c == "R")
+
+    @property
+    def sliding(self) -> tuple[int, ...]:
+        """0-based indices of sliding contacts."""
+        return tuple(i for i, c in enumerate(self.letters) if c == "S")
+
+    @property
+    def breaking(self) -> tuple[int, ...]:
+        """0-based indices of breaking contacts."""
+        return tuple(i for i, c in enumerate(self.letters) if c == "B")
+
+    @property
+    def n_constraints(self) -> int:
+        """Number of applicable kinematic constraints ``2 n_R + n_S`` (eq. 13)."""
+        return 2 * len(self.rolling) + len(self.sliding)
+
+    @property
+    def kind(self) -> str:
+        """Type of the mode by counts, as in Section 4: ``3S``, ``RS``, ``2R``, ``R2S``, ``4S``."""
+        nr, ns = len(self.rolling), len(self.sliding)
+        part = lambda k, c: "" if k == 0 else (c if k == 1 else f"{k}{c}")  # noqa: E731
+        return (part(nr, "R") + part(ns, "S")) or "0"
+
+    @property
+    def name(self) -> str:
+        """The paper's name: ``3S``/``4S`` when no contact rolls, else ``R<i>S<j>`` with
+        1-based contact numbers (several joined by commas, e.g. ``R1S2,3``)."""
+        if not self.rolling:
+            return f"{len(self.sliding)}S" if self.sliding else "B"
+        idx = lambda ix: ",".join(str(i + 1) for i in ix)  # noqa: E731
+        s = f"R{idx(self.rolling)}"
+        if self.sliding:
+            s += f"S{idx(self.sliding)}"
+        return s
+
+    def __str__(self) -> str:
+        return self.letters
+
+
+def mode_from_letters(letters: str, n_contacts: int | None = None) -> ContactMode:
+    """Parse ``"RBS"`` into a :class:`ContactMode`, checking the length if given."""
+    mode = ContactMode(str(letters).upper())
+    if n_contacts is not None and mode.n_contacts != n_contacts:
+        raise ModeError(f"mode: expected {n_contacts} letters (one per contact); got {letters!r}")
+    return mode
+
+
+def count_modes(n_contacts: int, dof: int) -> int:
+    """Number of contact modes with ``2 n_R + n_S = dof`` (eq. 49).
+
+    Parameters
+    ----------
+    n_contacts : int
+        ``n_c``.
+    dof : int
+        ``3 + |tau_I|``, the number of applicable constraints.
+
+    Returns
+    -------
+    int
+        0 when ``n_c < dof / 2`` (no mode satisfies the utility conditions).
+    """
+    if n_contacts < 0 or dof < 0:
+        raise ModeError(f"count: contacts and dof must be nonnegative; got {n_contacts}, {dof}")
+    return sum(
+        comb(n_contacts, nr) * comb(n_contacts - nr, dof - 2 * nr)
+        for nr in range(dof // 2 + 1)
+        if dof - 2 * nr <= n_contacts - nr
+    )
+
+
+def _iter_sets(n_contacts: int, dof: int):
+    contacts = range(n_contacts)
+    for nr in range(dof // 2 + 1):
+        ns = dof - 2 * nr
+        if nr + ns > n_contacts:
+            continue
+        for R in combinations(contacts, nr):
+            rest = [i for i in contacts if i not in R]
+            for S in combinations(rest, ns):
+                yield R, S
+
+
+def enumerate_modes(n_contacts: int, dof: int) -> list[ContactMode]:
+    """All modes with ``2 n_R + n_S = dof``, in the paper's order (eqs. 29, 49).
+
+    For large problems use :func:`mode_index_array`, which builds the same list
+    as integer arrays without Python objects per mode.
+    """
+    modes = []
+    for R, S in _iter_sets(n_contacts, dof):
+        letters = ["B"] * n_contacts
+        for i in R:
+            letters[i] = "R"
+        for i in S:
+            letters[i] = "S"
+        modes.append(ContactMode("".join(letters)))
+    return modes
+
+
+def mode_index_array(n_contacts: int, dof: int, start: int = 0, stop: int | None = None):
+    """Modes ``start:stop`` of :func:`enumerate_modes` as a letter-code array.
+
+    Parameters
+    ----------
+    n_contacts, dof : int
+    start, stop : int
+        Slice of the enumeration order (``stop=None``: to the end).
+
+    Returns
+    -------
+    codes : ndarray of uint8, shape (n_modes, n_contacts)
+        0 = breaking, 1 = rolling, 2 = sliding.
+    """
+    total = count_modes(n_contacts, dof)
+    stop = total if stop is None else min(stop, total)
+    out = np.zeros((max(stop - start, 0), n_contacts), dtype=np.uint8)
+    row = 0
+    for k, (R, S) in enumerate(_iter_sets(n_contacts, dof)):
+        if k < start:
+            continue
+        if k >= stop:
+            break
+        out[row, list(R)] = 1
+        out[row, list(S)] = 2
+        row += 1
+    return out
