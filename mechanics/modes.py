@@ -28,6 +28,8 @@ __all__ = [
     "enumerate_modes",
     "count_modes",
     "mode_index_array",
+    "iter_mode_batches",
+    "codes_to_letters",
 ]
 
 
@@ -156,30 +158,63 @@ def enumerate_modes(n_contacts: int, dof: int) -> list[ContactMode]:
     return modes
 
 
-def mode_index_array(n_contacts: int, dof: int, start: int = 0, stop: int | None = None):
-    """Modes ``start:stop`` of :func:`enumerate_modes` as a letter-code array.
+def _combinations(n: int, k: int) -> np.ndarray:
+    """All k-subsets of range(n) in lexicographic order, shape (C(n, k), k)."""
+    if k == 0:
+        return np.zeros((1, 0), dtype=np.intp)
+    flat = np.fromiter((i for c in combinations(range(n), k) for i in c), dtype=np.intp, count=comb(n, k) * k)
+    return flat.reshape(-1, k)
 
-    Parameters
-    ----------
-    n_contacts, dof : int
-    start, stop : int
-        Slice of the enumeration order (``stop=None``: to the end).
 
-    Returns
-    -------
-    codes : ndarray of uint8, shape (n_modes, n_contacts)
+def iter_mode_batches(n_contacts: int, dof: int, batch: int = 8192):
+    """Yield the modes of :func:`enumerate_modes`, in the same order, as letter-code arrays.
+
+    Memory stays bounded by ``batch`` rows whatever the total (eq. 49).
+
+    Yields
+    ------
+    codes : ndarray of uint8, shape (m, n_contacts), m <= batch
         0 = breaking, 1 = rolling, 2 = sliding.
     """
-    total = count_modes(n_contacts, dof)
-    stop = total if stop is None else min(stop, total)
-    out = np.zeros((max(stop - start, 0), n_contacts), dtype=np.uint8)
-    row = 0
-    for k, (R, S) in enumerate(_iter_sets(n_contacts, dof)):
-        if k < start:
+    if batch < 1:
+        raise ModeError(f"batch: expected a positive number of modes; got {batch}")
+    everything = np.arange(n_contacts)
+    for nr in range(dof // 2 + 1):
+        ns = dof - 2 * nr
+        if nr + ns > n_contacts:
             continue
-        if k >= stop:
-            break
-        out[row, list(R)] = 1
-        out[row, list(S)] = 2
-        row += 1
-    return out
+        Rs = _combinations(n_contacts, nr)
+        Sc = _combinations(n_contacts - nr, ns)  # positions within the complement of R
+        per_r = Sc.shape[0]
+        if per_r <= batch:  # several rolling sets per batch
+            pieces = ((slice(lo, lo + batch // per_r), slice(None)) for lo in range(0, Rs.shape[0], batch // per_r))
+        else:  # one rolling set, its sliding sets split
+            pieces = ((slice(i, i + 1), slice(lo, lo + batch)) for i in range(Rs.shape[0]) for lo in range(0, per_r, batch))
+        for r_sl, s_sl in pieces:
+            R, Sc_part = Rs[r_sl], Sc[s_sl]  # (a, nr), (b, ns)
+            a, b = R.shape[0], Sc_part.shape[0]
+            keep = np.ones((a, n_contacts), dtype=bool)
+            keep[np.arange(a)[:, None], R] = False
+            comp = np.broadcast_to(everything, (a, n_contacts))[keep].reshape(a, n_contacts - nr)
+            codes = np.zeros((a, b, n_contacts), dtype=np.uint8)
+            if nr:
+                codes[np.arange(a)[:, None, None], np.arange(b)[None, :, None], R[:, None, :]] = 1
+            if ns:
+                S = comp[:, Sc_part]  # (a, b, ns)
+                codes[np.arange(a)[:, None, None], np.arange(b)[None, :, None], S] = 2
+            yield codes.reshape(a * b, n_contacts)
+
+
+def mode_index_array(n_contacts: int, dof: int) -> np.ndarray:
+    """All modes of :func:`enumerate_modes` as one letter-code array, shape (n_modes, n_contacts).
+
+    0 = breaking, 1 = rolling, 2 = sliding.  For large problems iterate
+    :func:`iter_mode_batches` instead.
+    """
+    parts = list(iter_mode_batches(n_contacts, dof, batch=1 << 16))
+    return np.concatenate(parts) if parts else np.zeros((0, n_contacts), dtype=np.uint8)
+
+
+def codes_to_letters(codes) -> str:
+    """One row of a letter-code array (0/1/2) as mode letters (``B``/``R``/``S``)."""
+    return "".join("BRS"[int(c)] for c in codes)

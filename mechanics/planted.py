@@ -15,7 +15,7 @@ from __future__ import annotations
 import numpy as np
 
 from .contact import wrench_matrices
-from .modes import ContactMode, count_modes, mode_index_array
+from .modes import ContactMode, codes_to_letters, count_modes, mode_index_array
 from .scene import Scene, make_scene
 
 __all__ = ["planted_scene"]
@@ -59,9 +59,7 @@ def planted_scene(
         total = count_modes(n_contacts, dof)
         if total == 0:
             raise ValueError(f"no mode has {dof} constraints with {n_contacts} contacts (eq. 49)")
-        i = int(rng.integers(total))
-        codes = mode_index_array(n_contacts, dof, i, i + 1)[0]
-        mode = ContactMode("".join("BRS"[c] for c in codes))
+        mode = ContactMode(codes_to_letters(mode_index_array(n_contacts, dof)[int(rng.integers(total))]))
     r = rng.uniform(-1, 1, size=(n_contacts, 2))
     ang = rng.uniform(0, 2 * np.pi, size=n_contacts)
     Wn, Wt = wrench_matrices(r, np.column_stack([np.cos(ang), np.sin(ang)]))

@@ -15,13 +15,13 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from .modes import ContactMode, count_modes, mode_index_array
+from .modes import ContactMode, codes_to_letters, count_modes, iter_mode_batches
 from .numerics import DEFAULT_TOLERANCES, Status, Tolerances, hadamard_ratio
 from .scene import Scene
 from .feasibility import velocity_scale
 from .solution import ModeSolution, model_residuals
 
-__all__ = ["SolveResult", "solve", "DEFAULT_BATCH"]
+__all__ = ["SolveResult", "solve", "DEFAULT_BATCH", "Kinematics", "kinematics_stage", "equilibrium_stage", "ScenePool"]
 
 #: Modes per batch.  Memory per batch is about ``batch * k * (k + n_j) * 8`` bytes
 #: several times over; 8192 keeps it to a few MB for k <= 20 and amortises numpy's
@@ -97,89 +97,162 @@ def _assemble(scene: Scene, codes: np.ndarray):
     return idx, contact, slide
 
 
-def _solve_batch(scene: Scene, codes: np.ndarray, tol: Tolerances, vtol: float):
-    """Statuses (m,) of a batch of modes and arrays for the feasible ones."""
+_STATUS = Status.ORDER  # integer status codes index this tuple
+_FEAS, _KSING, _BVIOL, _BZERO, _SZERO, _QSING, _COUL = range(7)
+
+
+class ScenePool:
+    """Per-scene arrays every batch gathers rows from (computed once per solve)."""
+
+    def __init__(self, scene: Scene):
+        self.E, self.V = scene.effort_joints, scene.velocity_joints
+        self.Wrows = np.vstack([scene.Wn.T, scene.Wt.T])  # (2 n_c, 3): w_n, w_t as rows
+        self.Jrows = np.vstack([scene.Jn, scene.Jt])  # (2 n_c, n_j)
+        self.M = np.hstack([self.Wrows, -self.Jrows[:, self.E]])  # rows of P_AI (eq. 23)
+        with np.errstate(divide="ignore"):
+            self.log_row_norm = np.log(np.linalg.norm(self.M, axis=1))
+        self.drive = self.Jrows[:, self.V] @ scene.joint_velocity[self.V]  # right-hand side of eq. (24)
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class Kinematics:
+    """Kinematic stage (eqs. 24-25, 16) for modes that passed it; rows are modes.
+
+    Attributes
+    ----------
+    codes : ndarray of uint8, shape (m, n_c)
+    idx : ndarray of int, shape (m, k)
+        Applicable rows of each mode in ``[n-rows; t-rows]`` order (eq. 14).
+    contact : ndarray of int, shape (m, k)
+        Contact of each applicable row.
+    slide : ndarray of bool, shape (m, k)
+        Row is the normal row of a sliding contact.
+    qdot : ndarray, shape (m, 3)
+    thetadot : ndarray, shape (m, n_j)
+    xi : ndarray, shape (m, n_c)
+        Sliding directions (eq. 16), 0 at rolling and breaking contacts.
+    """
+
+    codes: np.ndarray
+    idx: np.ndarray
+    contact: np.ndarray
+    slide: np.ndarray
+    qdot: np.ndarray
+    thetadot: np.ndarray
+    xi: np.ndarray
+
+    def take(self, rows) -> "Kinematics":
+        """The same stage restricted (or repeated) to ``rows``."""
+        return Kinematics(*(getattr(self, f)[rows] for f in self.__slots__))
+
+
+def kinematics_stage(scene: Scene, pool: "ScenePool", codes: np.ndarray, tol: Tolerances, vtol: float):
+    """Kinematic tests of a batch of modes: P_AI (23-24), breaking (25), sliding directions (16).
+
+    Returns
+    -------
+    status : ndarray of int8, shape (m,)
+        Codes into ``Status.ORDER``; 0 (feasible so far) for modes that passed.
+    live : ndarray of int, shape (m',)
+        Rows that passed.
+    kin : Kinematics
+        Their kinematic solution (independent of mu and of the effort inputs).
+    """
     n_c = scene.n_contacts
-    E, V = scene.effort_joints, scene.velocity_joints
+    E, V = pool.E, pool.V
     m = codes.shape[0]
-    Wrows = np.vstack([scene.Wn.T, scene.Wt.T])  # (2 n_c, 3)
-    Jrows = np.vstack([scene.Jn, scene.Jt])  # (2 n_c, n_j)
-    status = np.full(m, Status.FEASIBLE, dtype=object)
+    status = np.zeros(m, dtype=np.int8)
 
     idx, contact, slide = _assemble(scene, codes)
-    WA = Wrows[idx]  # (m, k, 3)
-    JA = Jrows[idx]  # (m, k, n_j)
-    P = np.concatenate([WA, -JA[:, :, E]], axis=2)  # P_AI, eq. (23)
-    sing = hadamard_ratio(P) < tol.singular
-    status[sing] = Status.KINEMATICS_SINGULAR
+    P = pool.M[idx]  # P_AI of every mode, (m, k, k)
+    sign, logdet = np.linalg.slogdet(P)
+    with np.errstate(over="ignore", invalid="ignore"):
+        h = np.exp(logdet - pool.log_row_norm[idx].sum(axis=1))  # == hadamard_ratio(P)
+    sing = (sign == 0) | ~(h >= tol.singular)
+    status[sing] = _KSING
     P[sing] = np.eye(P.shape[1])
-    thetadot_v = scene.joint_velocity[V]
-    z = np.linalg.solve(P, (JA[:, :, V] @ thetadot_v)[..., None])[..., 0]  # eq. (24)
+    z = np.linalg.solve(P, pool.drive[idx][..., None])[..., 0]  # eq. (24)
     thetadot = np.empty((m, scene.n_joints))
-    thetadot[:, V] = thetadot_v
+    thetadot[:, V] = scene.joint_velocity[V]
     thetadot[:, E] = z[:, 3:]
     qdot = z[:, :3]
-    v = qdot @ Wrows.T - thetadot @ Jrows.T  # eq. (5), (m, 2 n_c)
+    v = qdot @ pool.Wrows.T - thetadot @ pool.Jrows.T  # eq. (5), (m, 2 n_c)
     v_n, v_t = v[:, :n_c], v[:, n_c:]
 
     alive = ~sing
     brk = codes == _B
     b_viol = alive & np.any(brk & (v_n < -vtol), axis=1)  # eq. (15)
-    status[b_viol] = Status.BREAKING_VIOLATED
+    status[b_viol] = _BVIOL
     alive &= ~b_viol
     b_zero = alive & np.any(brk & (v_n <= vtol), axis=1)
-    status[b_zero] = Status.BREAKING_ZERO_SPEED
+    status[b_zero] = _BZERO
     alive &= ~b_zero
     sld = codes == _S
     s_zero = alive & np.any(sld & (np.abs(v_t) <= vtol), axis=1)  # eq. (16) undefined
-    status[s_zero] = Status.ZERO_SLIDING_SPEED
+    status[s_zero] = _SZERO
     alive &= ~s_zero
 
     live = np.flatnonzero(alive)
-    if live.size == 0:
-        return status, live, None
-    idx, contact, slide = idx[live], contact[live], slide[live]
-    codes_l, qdot, thetadot, v_t = codes[live], qdot[live], thetadot[live], v_t[live]
-    xi = np.where(codes_l == _S, np.sign(v_t), 0.0)
-    mu = scene.mu
+    xi = np.where(sld[live], np.sign(v_t[live]), 0.0)
+    kin = Kinematics(codes[live], idx[live], contact[live], slide[live], qdot[live], thetadot[live], xi)
+    return status, live, kin
+
+
+def equilibrium_stage(scene: Scene, pool: "ScenePool", kin: Kinematics, mu: np.ndarray, tau_e: np.ndarray, tol: Tolerances):
+    """Equilibrium (26)-(27) and Coulomb (28) for kinematically admissible modes.
+
+    Parameters
+    ----------
+    mu : ndarray, shape (m, n_c)
+        Friction coefficients per row (rows may repeat a mode with other mu).
+    tau_e : ndarray, shape (m, n_e)
+        Efforts of the effort-controlled joints per row.
+
+    Returns
+    -------
+    status : ndarray of int8, shape (m,)
+    c_n, c_t : ndarray, shape (m, n_c)
+    tau : ndarray, shape (m, n_j)
+    boundary : ndarray of bool, shape (m,)
+        An inequality of (28) holds only within the force tolerance.
+    """
+    n_c = scene.n_contacts
+    E, V, Wrows, Jrows = pool.E, pool.V, pool.Wrows, pool.Jrows
+    m = kin.codes.shape[0]
+    status = np.zeros(m, dtype=np.int8)
+    idx, contact, xi = kin.idx, kin.contact, kin.xi
     # W_Amu and J_Amu: sliding normal rows pick up -mu xi times the tangential row (eqs. 18-20).
-    f = np.where(slide, -mu[contact] * np.take_along_axis(xi, contact, axis=1), 0.0)
+    f = np.where(kin.slide, -np.take_along_axis(mu * xi, contact, axis=1), 0.0)
     partner = contact + n_c
-    WAmu = Wrows[idx] + f[..., None] * Wrows[partner]  # (m', k, 3): columns of W_Amu
-    JAmu = Jrows[idx] + f[..., None] * Jrows[partner]  # (m', k, n_j): columns of J_Amu^T
-    Q = np.concatenate([WAmu, JAmu[:, :, E]], axis=2).transpose(0, 2, 1)  # Q_AI, eq. (26)
+    WAmu = Wrows[idx] + f[..., None] * Wrows[partner]  # (m, k, 3): columns of W_Amu
+    JAmu = Jrows[idx][:, :, E] + f[..., None] * Jrows[partner][:, :, E]  # (m, k, n_e): columns of J_AmuE^T
+    Q = np.concatenate([WAmu, JAmu], axis=2).transpose(0, 2, 1)  # Q_AI, eq. (26)
     q_sing = hadamard_ratio(Q) < tol.singular
-    status[live[q_sing]] = Status.EQUILIBRIUM_SINGULAR
+    status[q_sing] = _QSING
     Q[q_sing] = np.eye(Q.shape[1])
-    tau_in = np.nan_to_num(scene.joint_effort)
-    rhs = np.concatenate([-scene.g_obj, tau_in[E] - scene.g_man[E]])
-    cA = np.linalg.solve(Q, np.broadcast_to(rhs, (live.size, rhs.size))[..., None])[..., 0]
+    rhs = np.concatenate([np.broadcast_to(-scene.g_obj, (m, 3)), tau_e - scene.g_man[E]], axis=1)
+    cA = np.linalg.solve(Q, rhs[..., None])[..., 0]
 
-    ml = live.size
-    rows = np.arange(ml)[:, None]
-    c_n = np.zeros((ml, n_c))
-    c_t = np.zeros((ml, n_c))
+    rows = np.broadcast_to(np.arange(m)[:, None], idx.shape)
+    c_n = np.zeros((m, n_c))
+    c_t = np.zeros((m, n_c))
     is_n = idx < n_c
-    c_n[np.broadcast_to(rows, idx.shape)[is_n], contact[is_n]] = cA[is_n]
-    c_t[np.broadcast_to(rows, idx.shape)[~is_n], contact[~is_n]] = cA[~is_n]
-    c_t = np.where(codes_l == _S, -mu * xi * c_n, c_t)  # eq. (17)
+    c_n[rows[is_n], contact[is_n]] = cA[is_n]
+    c_t[rows[~is_n], contact[~is_n]] = cA[~is_n]
+    sliding = kin.codes == _S
+    c_t = np.where(sliding, -mu * xi * c_n, c_t)  # eq. (17)
 
-    rol = codes_l == _R
-    slack = np.where(rol, np.minimum(mu * c_n + c_t, mu * c_n - c_t), np.where(codes_l == _S, c_n, np.inf))  # eq. (28)
-    ftol = tol.force * np.maximum(np.max(np.abs(cA), axis=1), np.max(np.abs(rhs)))
+    rolling = kin.codes == _R
+    slack = np.where(rolling, np.minimum(mu * c_n + c_t, mu * c_n - c_t), np.where(sliding, c_n, np.inf))  # (28)
+    ftol = tol.force * np.maximum(np.max(np.abs(cA), axis=1), np.max(np.abs(rhs), axis=1))
     worst = slack.min(axis=1)
     coul = ~q_sing & (worst < -ftol)
-    status[live[coul]] = Status.COULOMB_VIOLATED
-    ok = ~q_sing & ~coul
+    status[coul] = _COUL
 
-    tau = np.empty((ml, scene.n_joints))
-    tau[:, E] = tau_in[E]
-    tau[:, V] = (c_n @ scene.Jn + c_t @ scene.Jt)[:, V] + scene.g_man[V]  # eq. (27)
-    feas = dict(
-        index=live[ok], qdot=qdot[ok], thetadot=thetadot[ok], c_n=c_n[ok], c_t=c_t[ok],
-        tau=tau[ok], xi=xi[ok].astype(int), boundary=(worst[ok] <= ftol[ok]),
-    )  # fmt: skip
-    return status, live, feas
+    tau = np.empty((m, scene.n_joints))
+    tau[:, E] = tau_e
+    tau[:, V] = (c_n @ scene.Jn + c_t @ scene.Jt)[:, V] + scene.g_man[V]  # eq. (27), from eq. (3)
+    return status, c_n, c_t, tau, worst <= ftol
 
 
 def solve(scene: Scene, tol: Tolerances = DEFAULT_TOLERANCES, batch: int = DEFAULT_BATCH, residuals: bool = True) -> SolveResult:
@@ -204,20 +277,24 @@ def solve(scene: Scene, tol: Tolerances = DEFAULT_TOLERANCES, batch: int = DEFAU
     counts = dict.fromkeys(Status.ORDER, 0)
     sols = []
     vtol = tol.velocity * velocity_scale(scene)
-    for start in range(0, total, batch):
-        codes = mode_index_array(n_c, dof, start, start + batch)
-        status, _, feas = _solve_batch(scene, codes, tol, vtol)
-        for key, cnt in zip(*np.unique(status.astype(str), return_counts=True)):
-            counts[str(key)] += int(cnt)
-        if feas is None:
-            continue
-        for j, i in enumerate(feas["index"]):
-            mode = ContactMode("".join("BRS"[c] for c in codes[i]))
-            sol = ModeSolution(
-                mode=mode, qdot=feas["qdot"][j], thetadot=feas["thetadot"][j], c_n=feas["c_n"][j],
-                c_t=feas["c_t"][j], tau=feas["tau"][j], xi=feas["xi"][j], on_boundary=bool(feas["boundary"][j]),
-            )  # fmt: skip
-            if residuals:
-                sol = replace(sol, residuals=model_residuals(scene, sol))
-            sols.append(sol)
+    pool = ScenePool(scene)
+    tau_e = np.nan_to_num(scene.joint_effort)[pool.E]
+    for codes in iter_mode_batches(n_c, dof, batch):
+        status, live, kin = kinematics_stage(scene, pool, codes, tol, vtol)
+        if live.size:
+            m = live.size
+            st, c_n, c_t, tau, boundary = equilibrium_stage(
+                scene, pool, kin, np.broadcast_to(scene.mu, (m, n_c)), np.broadcast_to(tau_e, (m, tau_e.size)), tol
+            )
+            status[live] = st
+            for j in np.flatnonzero(st == _FEAS):
+                sol = ModeSolution(
+                    mode=ContactMode(codes_to_letters(kin.codes[j])), qdot=kin.qdot[j], thetadot=kin.thetadot[j],
+                    c_n=c_n[j], c_t=c_t[j], tau=tau[j], xi=kin.xi[j].astype(int), on_boundary=bool(boundary[j]),
+                )  # fmt: skip
+                if residuals:
+                    sol = replace(sol, residuals=model_residuals(scene, sol))
+                sols.append(sol)
+        for code, cnt in enumerate(np.bincount(status, minlength=len(_STATUS))):
+            counts[_STATUS[code]] += int(cnt)
     return SolveResult(scene=scene, modes_tested=total, solutions=tuple(sols), counts=counts, tolerances=tol)
