@@ -46,6 +46,8 @@ class SolveResult:
         Number of modes per :class:`~mechanics.numerics.Status`; degenerate cases
         (singular matrices, zero speeds) are counted here and never reported feasible.
     tolerances : Tolerances
+    statuses : tuple of str or None
+        Status of every tested mode in enumeration order, when ``solve(..., keep_statuses=True)``.
     """
 
     scene: Scene
@@ -53,6 +55,7 @@ class SolveResult:
     solutions: tuple
     counts: dict
     tolerances: Tolerances = field(default=DEFAULT_TOLERANCES)
+    statuses: tuple | None = None
 
     @property
     def feasible_modes(self) -> list[str]:
@@ -255,7 +258,13 @@ def equilibrium_stage(scene: Scene, pool: "ScenePool", kin: Kinematics, mu: np.n
     return status, c_n, c_t, tau, worst <= ftol
 
 
-def solve(scene: Scene, tol: Tolerances = DEFAULT_TOLERANCES, batch: int = DEFAULT_BATCH, residuals: bool = True) -> SolveResult:
+def solve(
+    scene: Scene,
+    tol: Tolerances = DEFAULT_TOLERANCES,
+    batch: int = DEFAULT_BATCH,
+    residuals: bool = True,
+    keep_statuses: bool = False,
+) -> SolveResult:
     """Find every feasible contact mode of ``scene`` (Sections 3.1-3.2).
 
     Parameters
@@ -267,6 +276,8 @@ def solve(scene: Scene, tol: Tolerances = DEFAULT_TOLERANCES, batch: int = DEFAU
         Modes per vectorized batch (memory stays bounded by it).
     residuals : bool
         Evaluate the full-model residuals (eqs. 2-11) of every feasible solution.
+    keep_statuses : bool
+        Keep every mode's status (memory grows with eq. (49); for tests and diagnosis).
 
     Returns
     -------
@@ -277,6 +288,7 @@ def solve(scene: Scene, tol: Tolerances = DEFAULT_TOLERANCES, batch: int = DEFAU
     counts = dict.fromkeys(Status.ORDER, 0)
     sols = []
     vtol = tol.velocity * velocity_scale(scene)
+    kept: list = []
     pool = ScenePool(scene)
     tau_e = np.nan_to_num(scene.joint_effort)[pool.E]
     for codes in iter_mode_batches(n_c, dof, batch):
@@ -297,4 +309,9 @@ def solve(scene: Scene, tol: Tolerances = DEFAULT_TOLERANCES, batch: int = DEFAU
                 sols.append(sol)
         for code, cnt in enumerate(np.bincount(status, minlength=len(_STATUS))):
             counts[_STATUS[code]] += int(cnt)
-    return SolveResult(scene=scene, modes_tested=total, solutions=tuple(sols), counts=counts, tolerances=tol)
+        if keep_statuses:
+            kept.extend(_STATUS[c] for c in status)
+    return SolveResult(
+        scene=scene, modes_tested=total, solutions=tuple(sols), counts=counts, tolerances=tol,
+        statuses=tuple(kept) if keep_statuses else None,
+    )  # fmt: skip

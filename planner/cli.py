@@ -1,0 +1,166 @@
+"""The ``qsplan`` command.
+
+Subcommands::
+
+    qsplan modes SCENE [--mu M ...] [--json]        every feasible contact mode
+    qsplan count --contacts N --dof D [--json]      number of modes tested (eq. 49)
+    qsplan partition SCENE [--mode LETTERS] [--json]  control-mode partitioner (eq. 32)
+    qsplan paper [--out DIR]                        reproduce the paper's examples into DIR
+
+Bad input prints one line on stderr naming the field and the problem and
+exits with status 2; nothing else is written.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+
+__all__ = ["main", "build_parser"]
+
+EXIT_USAGE = 2
+
+
+class _UsageError(Exception):
+    pass
+
+
+class _Parser(argparse.ArgumentParser):
+    """argparse that reports errors in one line (no usage dump) and exits 2."""
+
+    def error(self, message):  # noqa: D102
+        raise _UsageError(f"{self.prog}: {message}")
+
+
+def build_parser() -> argparse.ArgumentParser:
+    p = _Parser(prog="qsplan", description="Quasistatic planar contact-mode prediction (Trinkle & Zeng 1995).")
+    sub = p.add_subparsers(dest="command", required=True, parser_class=_Parser)
+
+    m = sub.add_parser("modes", help="every feasible contact mode of a scene")
+    m.add_argument("scene", help="scene file (.json or .toml; raw or geometric form)")
+    m.add_argument("--mu", type=float, nargs="+", metavar="M", help="friction override: one value or one per contact")
+    m.add_argument("--json", action="store_true", help="machine-readable output on stdout")
+
+    c = sub.add_parser("count", help="number of contact modes tested (eq. 49, Table 1)")
+    c.add_argument("--contacts", type=int, required=True, metavar="N", help="number of contacts n_c")
+    c.add_argument("--dof", type=int, required=True, metavar="D", help="3 + number of effort-controlled joints")
+    c.add_argument("--json", action="store_true")
+
+    t = sub.add_parser("partition", help="control-mode partitions admitted by each contact mode (eq. 32)")
+    t.add_argument("scene")
+    t.add_argument("--mode", metavar="LETTERS", help="rank the effort-joint sets of one mode, e.g. RBS")
+    t.add_argument("--json", action="store_true")
+
+    r = sub.add_parser("paper", help="reproduce the paper's examples (eqs. 37, 42, rod) into --out")
+    r.add_argument("--out", default="out", metavar="DIR", help="output directory (default: out)")
+    r.add_argument("--n", type=int, default=161, help="grid points per mu axis (default 161)")
+    return p
+
+
+def _fmt(x, width=9):
+    return f"{x:{width}.4g}"
+
+
+def _cmd_modes(args, out):
+    from mechanics import load_scene, solve
+
+    scene = load_scene(args.scene, mu=args.mu)
+    result = solve(scene)
+    if args.json:
+        from .report import solve_result_to_dict
+
+        json.dump(solve_result_to_dict(result), out)
+        out.write("\n")
+        return 0
+    from .report import format_solve_result
+
+    out.write(format_solve_result(result, source=args.scene))
+    return 0
+
+
+def _cmd_count(args, out):
+    from mechanics import ModeError, count_modes
+
+    if args.contacts < 0:
+        raise ModeError(f"--contacts: expected a nonnegative integer; got {args.contacts}")
+    if args.dof < 0:
+        raise ModeError(f"--dof: expected a nonnegative integer; got {args.dof}")
+    n = count_modes(args.contacts, args.dof)
+    if args.json:
+        json.dump({"contacts": args.contacts, "dof": args.dof, "modes": n, "all_combinations": 3**args.contacts}, out)
+        out.write("\n")
+    else:
+        out.write(f"{n}\n")
+    return 0
+
+
+def _cmd_partition(args, out):
+    from mechanics import load_scene, mode_from_letters
+    from mechanics.partition import effort_partitions, partition_table
+
+    scene = load_scene(args.scene)
+    if scene.virtual_joints:
+        from mechanics import SceneError
+
+        raise SceneError(f"{args.scene}: joints: the scene gives contact velocities, not joints; nothing to partition")
+    names = scene.joint_names
+    if args.mode:
+        mode = mode_from_letters(args.mode, scene.n_contacts)
+        parts = effort_partitions(scene, mode)
+        rows = [
+            {"effort_joints": [names[i] for i in p.effort_joints], "rcond_P": p.rcond_P, "rcond_Q": p.rcond_Q}
+            for p in parts
+        ]
+        if args.json:
+            json.dump({"mode": mode.letters, "name": mode.name, "partitions": rows}, out)
+            out.write("\n")
+        else:
+            out.write(f"mode {mode.letters} ({mode.name}): {len(rows)} admissible effort-joint sets, best first\n")
+            for r in rows:
+                out.write(f"  effort {{{', '.join(r['effort_joints'])}}}  rcond P {r['rcond_P']:.3g}  Q {r['rcond_Q']:.3g}\n")
+        return 0
+    table = partition_table(scene)
+    if args.json:
+        json.dump({"partitions": [{"effort_joints": [names[i] for i in k], "modes": v} for k, v in table.items()]}, out)
+        out.write("\n")
+    else:
+        for k, v in table.items():
+            out.write(f"effort {{{', '.join(names[i] for i in k)}}}: {len(v)} modes: {' '.join(v)}\n")
+    return 0
+
+
+def _cmd_paper(args, out):
+    from .reproduce import reproduce_paper
+
+    if args.n < 2:
+        from mechanics import QsplanError
+
+        raise QsplanError(f"--n: expected at least 2 grid points; got {args.n}")
+    summary = reproduce_paper(args.out, n=args.n, progress=sys.stderr)
+    out.write(summary)
+    return 0
+
+
+_COMMANDS = {"modes": _cmd_modes, "count": _cmd_count, "partition": _cmd_partition, "paper": _cmd_paper}
+
+
+def main(argv=None) -> int:
+    """Entry point of the ``qsplan`` console script; returns the exit status."""
+    from mechanics import QsplanError
+
+    try:
+        args = build_parser().parse_args(argv)
+        return _COMMANDS[args.command](args, sys.stdout)
+    except _UsageError as exc:
+        print(str(exc), file=sys.stderr)
+        return EXIT_USAGE
+    except QsplanError as exc:
+        print(f"qsplan: error: {exc}", file=sys.stderr)
+        return EXIT_USAGE
+    except BrokenPipeError:
+        return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
