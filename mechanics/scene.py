@@ -140,6 +140,24 @@ class Scene:
             f["joint_effort"] = joint_effort
         return make_scene(**f)
 
+    def with_control(self, effort_controlled, joint_velocity, joint_effort) -> "Scene":
+        """The same scene under another control-mode partition with its inputs.
+
+        Parameters
+        ----------
+        effort_controlled : array-like of bool, shape (n_j,)
+        joint_velocity, joint_effort : array-like, shape (n_j,)
+            Inputs of the velocity- and effort-controlled joints (other entries ignored).
+        """
+        e = np.asarray(effort_controlled, dtype=bool)
+        f = self._fields()
+        f.update(
+            effort_controlled=e,
+            joint_velocity=np.where(e, np.nan, np.asarray(joint_velocity, float)),
+            joint_effort=np.where(e, np.asarray(joint_effort, float), np.nan),
+        )
+        return make_scene(**f)
+
     def moved_origin(self, origin) -> "Scene":
         """The same physical scene expressed about the world point ``origin`` (shape (2,)).
 

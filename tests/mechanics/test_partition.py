@@ -1,0 +1,65 @@
+"""The control-mode partitioner (eqs. 23, 26, 29-32)."""
+
+import numpy as np
+import pytest
+
+from mechanics import ContactMode, ModeError, check_mode, planted_scene, solve
+from mechanics.partition import effort_partitions, partition_table
+
+
+def test_scene_partition_admits_its_planted_mode_and_is_ranked():
+    rng = np.random.default_rng(8)
+    for _ in range(25):
+        nc = int(rng.integers(3, 6))
+        ne = int(rng.integers(0, 3))
+        scene, planted = planted_scene(rng, nc, ne, ne + 2)
+        sol = solve(scene).solution(planted.letters)
+        xi = sol.xi[list(planted.sliding)]
+        parts = effort_partitions(scene, planted, xi=xi)
+        assert tuple(scene.effort_joints) in [p.effort_joints for p in parts]
+        conds = [p.conditioning for p in parts]
+        assert conds == sorted(conds, reverse=True)
+        assert all(len(p.effort_joints) == planted.n_constraints - 3 for p in parts)
+
+
+def test_every_admitted_partition_gives_a_unique_solution():
+    # Switch the scene to each admitted partition: the planted motion stays a solution of eq. (24).
+    rng = np.random.default_rng(12)
+    scene, planted = planted_scene(rng, 4, 1, 3)
+    ref = solve(scene).solution(planted.letters)
+    for p in effort_partitions(scene, planted, xi=ref.xi[list(planted.sliding)]):
+        effort = np.zeros(scene.n_joints, dtype=bool)
+        effort[list(p.effort_joints)] = True
+        alt = scene.with_control(effort, ref.thetadot, ref.tau)
+        got = check_mode(alt, planted)
+        assert got.feasible
+        np.testing.assert_allclose(got.solution.qdot, ref.qdot, atol=1e-9)
+        np.testing.assert_allclose(got.solution.c_n, ref.c_n, atol=1e-9)
+
+
+def test_all_rolling_P_and_Q_share_conditioning():
+    # with no sliding contact Q_AI is P_AI transposed up to column signs
+    scene, _ = planted_scene(np.random.default_rng(1), 4, 1, 3)
+    for p in effort_partitions(scene, ContactMode("RRBB")):
+        assert p.rcond_P == pytest.approx(p.rcond_Q, rel=1e-9)
+
+
+def test_modes_outside_eq29_have_no_partition():
+    scene, _ = planted_scene(np.random.default_rng(2), 4, 0, 2)
+    assert effort_partitions(scene, ContactMode("SBBB")) == []  # 1 < 3 constraints
+    assert effort_partitions(scene, ContactMode("RRRB")) == []  # 6 > 3 + 2 joints
+
+
+def test_partition_table_lists_only_admitting_partitions():
+    scene, planted = planted_scene(np.random.default_rng(3), 3, 1, 2)
+    table = partition_table(scene)
+    assert () in table and all(len(ContactMode(m).letters) == 3 for v in table.values() for m in v)
+    for joints, modes in table.items():
+        for m in modes:
+            assert ContactMode(m).n_constraints == 3 + len(joints)
+
+
+def test_bad_xi_rejected():
+    scene, _ = planted_scene(np.random.default_rng(2), 3, 0, 2)
+    with pytest.raises(ModeError, match="xi"):
+        effort_partitions(scene, ContactMode("SSS"), xi=[1, 0, 1])
