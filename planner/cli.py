@@ -55,7 +55,21 @@ def build_parser() -> argparse.ArgumentParser:
     r = sub.add_parser("paper", help="reproduce the paper's examples (eqs. 37, 42, rod) into --out")
     r.add_argument("--out", default="out", metavar="DIR", help="output directory (default: out)")
     r.add_argument("--n", type=int, default=161, help="grid points per mu axis (default 161)")
+
+    for name in COMMAND_MODULES:
+        _command_module(name).add_parser(sub)
     return p
+
+
+#: Subcommands that live in their own module ``planner.cmd_<name>``, each with
+#: ``add_parser(subparsers)`` and ``run(args, out) -> int``.
+COMMAND_MODULES: tuple = ()
+
+
+def _command_module(name):
+    import importlib
+
+    return importlib.import_module(f"planner.cmd_{name}")
 
 
 def _fmt(x, width=9):
@@ -151,7 +165,9 @@ def main(argv=None) -> int:
 
     try:
         args = build_parser().parse_args(argv)
-        return _COMMANDS[args.command](args, sys.stdout)
+        if args.command in _COMMANDS:
+            return _COMMANDS[args.command](args, sys.stdout)
+        return _command_module(args.command).run(args, sys.stdout)
     except _UsageError as exc:
         print(str(exc), file=sys.stderr)
         return EXIT_USAGE
