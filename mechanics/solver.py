@@ -21,7 +21,16 @@ from .scene import Scene
 from .feasibility import velocity_scale
 from .solution import ModeSolution, model_residuals
 
-__all__ = ["SolveResult", "solve", "DEFAULT_BATCH", "Kinematics", "kinematics_stage", "equilibrium_stage", "ScenePool"]
+__all__ = [
+    "SolveResult",
+    "solve",
+    "DEFAULT_BATCH",
+    "Kinematics",
+    "kinematics_stage",
+    "equilibrium_matrix",
+    "equilibrium_stage",
+    "ScenePool",
+]
 
 #: Modes per batch.  Memory per batch is about ``batch * k * (k + n_j) * 8`` bytes
 #: several times over; 8192 keeps it to a few MB for k <= 20 and amortises numpy's
@@ -201,6 +210,25 @@ def kinematics_stage(scene: Scene, pool: "ScenePool", codes: np.ndarray, tol: To
     return status, live, kin
 
 
+def equilibrium_matrix(pool: "ScenePool", kin: Kinematics, mu: np.ndarray) -> np.ndarray:
+    """``Q_AI`` of eq. (26) for every row: ``[W_Amu; J_AmuI^T]``, shape (m, k, k).
+
+    Column ``j`` belongs to the applicable constraint ``kin.idx[:, j]``; sliding
+    normal columns pick up ``-mu xi`` times the tangential column (eqs. 18-20).
+
+    Parameters
+    ----------
+    mu : ndarray, shape (m, n_c)
+    """
+    n_c = pool.Wrows.shape[0] // 2
+    idx, contact, E = kin.idx, kin.contact, pool.E
+    f = np.where(kin.slide, -np.take_along_axis(mu * kin.xi, contact, axis=1), 0.0)
+    partner = contact + n_c
+    WAmu = pool.Wrows[idx] + f[..., None] * pool.Wrows[partner]  # (m, k, 3): columns of W_Amu
+    JAmu = pool.Jrows[idx][:, :, E] + f[..., None] * pool.Jrows[partner][:, :, E]  # columns of J_AmuI^T
+    return np.concatenate([WAmu, JAmu], axis=2).transpose(0, 2, 1)
+
+
 def equilibrium_stage(scene: Scene, pool: "ScenePool", kin: Kinematics, mu: np.ndarray, tau_e: np.ndarray, tol: Tolerances):
     """Equilibrium (26)-(27) and Coulomb (28) for kinematically admissible modes.
 
@@ -220,16 +248,11 @@ def equilibrium_stage(scene: Scene, pool: "ScenePool", kin: Kinematics, mu: np.n
         An inequality of (28) holds only within the force tolerance.
     """
     n_c = scene.n_contacts
-    E, V, Wrows, Jrows = pool.E, pool.V, pool.Wrows, pool.Jrows
+    E, V = pool.E, pool.V
     m = kin.codes.shape[0]
     status = np.zeros(m, dtype=np.int8)
     idx, contact, xi = kin.idx, kin.contact, kin.xi
-    # W_Amu and J_Amu: sliding normal rows pick up -mu xi times the tangential row (eqs. 18-20).
-    f = np.where(kin.slide, -np.take_along_axis(mu * xi, contact, axis=1), 0.0)
-    partner = contact + n_c
-    WAmu = Wrows[idx] + f[..., None] * Wrows[partner]  # (m, k, 3): columns of W_Amu
-    JAmu = Jrows[idx][:, :, E] + f[..., None] * Jrows[partner][:, :, E]  # (m, k, n_e): columns of J_AmuE^T
-    Q = np.concatenate([WAmu, JAmu], axis=2).transpose(0, 2, 1)  # Q_AI, eq. (26)
+    Q = equilibrium_matrix(pool, kin, mu)
     q_sing = hadamard_ratio(Q) < tol.singular
     status[q_sing] = _QSING
     Q[q_sing] = np.eye(Q.shape[1])
