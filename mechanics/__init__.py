@@ -5,6 +5,9 @@ Public API (everything else is private):
 * contact frames and wrenches (eq. 1): :func:`cross2`, :func:`tangent_from_normal`,
   :func:`wrench_matrix`, :func:`wrench_matrices`, :func:`shift_wrenches`, :func:`point_wrench`
 * scenes: :class:`Scene`, :func:`make_scene`, :func:`load_scene`, :func:`scene_from_dict`
+* manipulators (planar kinematic trees, eq. 5): :func:`make_manipulator`, :func:`link_poses`,
+  :func:`point_jacobian`, :func:`contact_jacobian`, :func:`gravity_efforts`
+* the geometric scene form: :func:`scene_from_geometry`, :func:`find_contacts`
 * contact modes (eqs. 12, 29, 49): :class:`ContactMode`, :func:`enumerate_modes`,
   :func:`count_modes`, :func:`iter_mode_batches`
 * per-mode feasibility, one mode at a time (eqs. 13-28): :func:`check_mode`
@@ -37,6 +40,22 @@ __all__ = [
     "SceneError",
     "ModeCheck",
     "check_mode",
+    "GeometricScene",
+    "geometric_scene_from_dict",
+    "scene_from_geometric_scene",
+    "scene_from_geometry",
+    "CONTACT_TOL",
+    "FoundContact",
+    "find_contacts",
+    "Joint",
+    "Manipulator",
+    "contact_jacobian",
+    "gravity_efforts",
+    "link_polygons",
+    "link_poses",
+    "make_joint",
+    "make_manipulator",
+    "point_jacobian",
     "ContactMode",
     "count_modes",
     "enumerate_modes",
@@ -56,3 +75,34 @@ __all__ = [
     "SolveResult",
     "solve",
 ]
+
+# Geometry needs shapely; load those modules on first use so that ``import mechanics``
+# (and the CLI's solver path) stays light.
+_LAZY = {
+    "GeometricScene": "geometric_scene",
+    "geometric_scene_from_dict": "geometric_scene",
+    "scene_from_geometric_scene": "geometric_scene",
+    "scene_from_geometry": "geometric_scene",
+    "CONTACT_TOL": "geometry",
+    "FoundContact": "geometry",
+    "find_contacts": "geometry",
+    "Joint": "manipulator",
+    "Manipulator": "manipulator",
+    "contact_jacobian": "manipulator",
+    "gravity_efforts": "manipulator",
+    "link_polygons": "manipulator",
+    "link_poses": "manipulator",
+    "make_joint": "manipulator",
+    "make_manipulator": "manipulator",
+    "point_jacobian": "manipulator",
+}
+
+
+def __getattr__(name):
+    if name in _LAZY:
+        import importlib
+
+        value = getattr(importlib.import_module(f".{_LAZY[name]}", __name__), name)
+        globals()[name] = value
+        return value
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
