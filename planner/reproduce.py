@@ -2,7 +2,10 @@
 
 Writes ``fig3_eq37.png`` (four slices perpendicular to mu3), ``fig6_eq42.png``,
 ``fig8_rod.png``, ``table1.txt`` and ``paper_results.json`` with the modes found
-and the checks of the paper's statements.
+and the checks of the paper's statements.  The maps come from
+:func:`mechanics.muspace.mu_slice` (the polynomial path, equal to the solver) and
+show each region's exact boundary; every slice also records how its cell labels
+agree with those boundaries.
 """
 
 from __future__ import annotations
@@ -15,7 +18,7 @@ import numpy as np
 
 from hands.paper import eq37_scene, eq42_scene, rod_scene
 from mechanics import count_modes, scene_from_dict
-from mechanics.muspace import feasibility_map, grid_points
+from mechanics.muspace import boundary_agreement, mu_slice, polynomial_map
 
 __all__ = ["reproduce_paper", "TABLE1"]
 
@@ -25,6 +28,12 @@ TABLE1 = {
     0: [7, 19, 51, 141, 393, 1107],
     1: [6, 16, 45, 126, 357, 1016],
 }
+
+
+def _agreement(sl) -> dict:
+    a = boundary_agreement(sl)
+    return {"label_changes": a.label_changes, "explained": a.explained, "unexplained": a.unexplained,
+            "spurious": a.spurious, "excluded": a.excluded}  # fmt: skip
 
 
 def _summary(mm, n):
@@ -52,7 +61,8 @@ def reproduce_paper(out_dir, n: int = 161, progress=None) -> str:
     progress : file-like, optional
         Receives one line per step.
     """
-    from .plots import new_axes, plot_mu_slice
+    from .muspace_plots import plot_mu_map
+    from .plots import new_axes
 
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
@@ -66,10 +76,12 @@ def reproduce_paper(out_dir, n: int = 161, progress=None) -> str:
     xs = np.linspace(0.0, 2.0, n)
     fig, axes = new_axes(2, 2)
     slices, colours = {}, {}
+    agreement = []
     for ax, mu3 in zip(axes.ravel(), (0.0, 0.5, 1.0, 2.0)):
-        mm = feasibility_map(scene, grid_points([0, 0, mu3], 0, 1, xs, xs))
-        slices[f"mu3={mu3}"] = _summary(mm, n)
-        plot_mu_slice(mm, xs, xs, ax=ax, title=f"eq. (37), $\\mu_3$ = {mu3}", colours=colours)
+        sl = mu_slice(scene, 0, 1, xs, xs, base_mu=[0, 0, mu3])
+        slices[f"mu3={mu3}"] = {**_summary(sl.mumap, n), "boundary_agreement": _agreement(sl)}
+        agreement.append(slices[f"mu3={mu3}"]["boundary_agreement"])
+        plot_mu_map(sl, ax=ax, title=f"eq. (37), $\\mu_3$ = {mu3}", colours=colours)
     fig.suptitle("Fig. 3 reproduced: 3S shrinks as $\\mu_3$ grows, R1S2 unchanged")
     fig.savefig(out / "fig3_eq37.png", dpi=110)
     modes37 = sorted({m for s in slices.values() for m in s["modes_feasible_somewhere"]})
@@ -82,6 +94,7 @@ def reproduce_paper(out_dir, n: int = 161, progress=None) -> str:
         "check_3S_shrinks_with_mu3": all(a > b for a, b in zip(areas3s, areas3s[1:])),
         "check_R1S2_unchanged": max(areasrs) - min(areasrs) == 0.0,
         "check_jam_present": all(s["jam_fraction"] > 0 for s in slices.values()),
+        "check_exact_boundaries_match_cells": all(a["unexplained"] == 0 and a["spurious"] == 0 for a in agreement),
     }
 
     # Fig. 6: eq. (42).
@@ -90,11 +103,13 @@ def reproduce_paper(out_dir, n: int = 161, progress=None) -> str:
     xs = np.linspace(0.0, 1.5, n)
     fig, axes = new_axes(2, 2)
     slices, colours = {}, {}
+    agreement = []
     for ax, mu3 in zip(axes.ravel(), (0.1, 0.3, 0.6, 1.0)):
-        mm = feasibility_map(scene, grid_points([0, 0, mu3], 0, 1, xs, xs))
-        slices[f"mu3={mu3}"] = _summary(mm, n)
-        plot_mu_slice(mm, xs, xs, ax=ax, title=f"eq. (42), $\\mu_3$ = {mu3}", colours=colours)
-    diag = feasibility_map(scene, np.repeat(np.linspace(0, 1.5, n)[:, None], 3, axis=1))
+        sl = mu_slice(scene, 0, 1, xs, xs, base_mu=[0, 0, mu3])
+        slices[f"mu3={mu3}"] = {**_summary(sl.mumap, n), "boundary_agreement": _agreement(sl)}
+        agreement.append(slices[f"mu3={mu3}"]["boundary_agreement"])
+        plot_mu_map(sl, ax=ax, title=f"eq. (42), $\\mu_3$ = {mu3}", colours=colours)
+    diag = polynomial_map(scene, np.repeat(np.linspace(0, 1.5, n)[:, None], 3, axis=1))
     fig.suptitle("Fig. 6 reproduced: four modes, up to three feasible at once")
     fig.savefig(out / "fig6_eq42.png", dpi=110)
     modes42 = sorted({m for s in slices.values() for m in s["modes_feasible_somewhere"]})
@@ -106,6 +121,7 @@ def reproduce_paper(out_dir, n: int = 161, progress=None) -> str:
         "check_three_at_once": max(s["max_modes_at_once"] for s in slices.values()) == 3,
         "smallest_equal_mu_with_a_mode": float(diag.mu[first, 0]),
         "check_none_near_origin": bool(diag.jammed[: max(1, first)].all() and first > 0),
+        "check_exact_boundaries_match_cells": all(a["unexplained"] == 0 and a["spurious"] == 0 for a in agreement),
     }
 
     # Fig. 8: the rod on two supports.
@@ -113,14 +129,12 @@ def reproduce_paper(out_dir, n: int = 161, progress=None) -> str:
     l1, l2 = 1.0, 0.6
     scene = scene_from_dict(rod_scene(l1=l1, l2=l2))
     xs = np.linspace(0.0, 1.0, n)
-    mm = feasibility_map(scene, grid_points([0, 0], 0, 1, xs, xs))
+    sl = mu_slice(scene, 0, 1, xs, xs, base_mu=[0, 0])
+    mm = sl.mumap
     fig, axes = new_axes(1, 1, size=(5.0, 4.5))
-    ax = plot_mu_slice(mm, xs, xs, ax=axes[0, 0], title=f"rod, $l_1$ = {l1}, $l_2$ = {l2}")
-    ax.plot(xs, xs * l2 / l1, "k-", lw=1.5, label="$l_1 \\mu_2 = l_2 \\mu_1$")
-    ax.set_xlim(xs[0], xs[-1])
-    ax.set_ylim(xs[0], xs[-1])
-    ax.legend(loc="upper left", fontsize=8)
+    plot_mu_map(sl, ax=axes[0, 0], title=f"rod, $l_1$ = {l1}, $l_2$ = {l2}: boundary $l_1 \\mu_2 = l_2 \\mu_1$")
     fig.savefig(out / "fig8_rod.png", dpi=110)
+    curve_pts = np.vstack([c.points for c in sl.boundary_curves()])
     names = [m.name for m in mm.modes]
     r2s1 = mm.feasible[:, names.index("R2S1")]
     line = l1 * mm.mu[:, 1] - l2 * mm.mu[:, 0]
@@ -130,6 +144,8 @@ def reproduce_paper(out_dir, n: int = 161, progress=None) -> str:
         "l2": l2,
         "modes": sorted({names[j] for j in np.flatnonzero(mm.feasible.any(axis=0))}),
         "check_R2S1_iff_l1mu2_ge_l2mu1": bool(np.array_equal(r2s1[off_line], line[off_line] > 0)),
+        "check_exact_boundary_is_the_line": bool(np.max(np.abs(l1 * curve_pts[:, 1] - l2 * curve_pts[:, 0])) < 1e-12),
+        "boundary_agreement": _agreement(sl),
     }
 
     # Table 1.
