@@ -11,6 +11,11 @@ Public API (everything else is private):
 * contact modes (eqs. 12, 29, 49): :class:`ContactMode`, :func:`enumerate_modes`,
   :func:`count_modes`, :func:`iter_mode_batches`
 * per-mode feasibility, one mode at a time (eqs. 13-28): :func:`check_mode`
+* control-mode partitions (eq. 32): :func:`effort_partitions`, :func:`partition_table`
+* mu-space (Section 4, Appendices A-B): :func:`feasibility_map`, :func:`polynomial_map`,
+  :func:`mu_slice`, :func:`mode_region`, :func:`region_3s`, :func:`region_rs`, :func:`graphical_test`
+* effort bands (eq. 28, Section 5.2): :func:`effort_band`, :func:`guaranteed_band_box`,
+  :func:`guaranteed_band_shared`, :func:`sampled_band`
 * all feasible modes, vectorized: :func:`solve`, :class:`SolveResult`, :class:`ModeSolution`
 * residuals of the full model (eqs. 2-11): :func:`model_residuals`
 * tolerances and statuses: :class:`Tolerances`, :class:`Status`
@@ -20,7 +25,13 @@ Public API (everything else is private):
 from .contact import cross2, point_wrench, shift_wrenches, tangent_from_normal, wrench_matrices, wrench_matrix
 from .errors import ModeError, QsplanError, SceneError
 from .feasibility import ModeCheck, check_mode
+from .bands import Band, effort_band, effort_bands, guaranteed_band_box, guaranteed_band_shared, possible_band_box, sampled_band
+from .graphical import GraphicalTest, graphical_test, graphical_test_mode
 from .modes import ContactMode, count_modes, enumerate_modes, iter_mode_batches, mode_from_letters
+from .multilinear import Multilinear
+from .muspace import MuMap, MuSlice, boundary_agreement, feasibility_map, grid_points, mu_slice, polynomial_map
+from .partition import Partition, effort_partitions, partition_table
+from .regions import MuRegion, appendix_a, appendix_b, mode_kinematics, mode_region, region_3s, region_rs
 from .numerics import DEFAULT_TOLERANCES, Status, Tolerances
 from .planted import planted_scene
 from .scene import Scene, make_scene
@@ -56,6 +67,34 @@ __all__ = [
     "make_joint",
     "make_manipulator",
     "point_jacobian",
+    "Band",
+    "effort_band",
+    "effort_bands",
+    "guaranteed_band_box",
+    "guaranteed_band_shared",
+    "possible_band_box",
+    "sampled_band",
+    "GraphicalTest",
+    "graphical_test",
+    "graphical_test_mode",
+    "Multilinear",
+    "MuMap",
+    "MuSlice",
+    "boundary_agreement",
+    "feasibility_map",
+    "grid_points",
+    "mu_slice",
+    "polynomial_map",
+    "Partition",
+    "effort_partitions",
+    "partition_table",
+    "MuRegion",
+    "appendix_a",
+    "appendix_b",
+    "mode_kinematics",
+    "mode_region",
+    "region_3s",
+    "region_rs",
     "ContactMode",
     "count_modes",
     "enumerate_modes",

@@ -32,12 +32,11 @@ from itertools import product
 
 import numpy as np
 
-from .errors import ModeError, SceneError
-from .feasibility import velocity_scale
+from .errors import SceneError
 from .modes import ContactMode
 from .numerics import DEFAULT_TOLERANCES, Status, Tolerances
 from .scene import Scene
-from .solver import ScenePool, equilibrium_matrix, kinematics_stage
+from .solver import ScenePool, equilibrium_matrix, single_mode_kinematics
 
 __all__ = [
     "Band",
@@ -135,16 +134,7 @@ def _check_one_effort_joint(scene: Scene) -> int:
 
 def mode_kinematics(scene: Scene, mode: ContactMode, tol: Tolerances = DEFAULT_TOLERANCES) -> ModeKinematics:
     """Run the kinematic stage (eqs. 24-25, 16) for one mode."""
-    if mode.n_contacts != scene.n_contacts:
-        raise ModeError(f"mode: expected {scene.n_contacts} letters; got {mode.letters!r}")
-    if mode.n_constraints != scene.dof:
-        raise ModeError(
-            f"mode {mode.letters}: has {mode.n_constraints} applicable constraints; the scene's partition needs {scene.dof}"
-        )
-    pool = ScenePool(scene)
-    codes = np.array([["BRS".index(c) for c in mode.letters]], dtype=np.uint8)
-    status, live, kin = kinematics_stage(scene, pool, codes, tol, tol.velocity * velocity_scale(scene))
-    return ModeKinematics(mode, Status.ORDER[int(status[0])], pool, kin if live.size else None)
+    return ModeKinematics(*single_mode_kinematics(scene, mode, tol))
 
 
 def band_rows(scene: Scene, mk: ModeKinematics, mu_rows) -> tuple:
@@ -162,7 +152,7 @@ def band_rows(scene: Scene, mk: ModeKinematics, mu_rows) -> tuple:
     -------
     s0, s1 : ndarray, shape (N, r)
         ``s(tau) = s0 + tau * s1`` for the mode's r Coulomb rows: ``mu c_n + c_t`` and
-        ``mu c_n - c_t`` per rolling contact, ``c_n`` per sliding contact.
+        ``mu c_n - c_t`` and ``c_n`` per rolling contact, ``c_n`` per sliding contact.
     det : ndarray, shape (N,)
         ``det Q_AI`` (sign and size tell singularity).
     scale : ndarray, shape (N,)
@@ -198,6 +188,8 @@ def band_rows(scene: Scene, mk: ModeKinematics, mu_rows) -> tuple:
                 row = m * cn + sgn * ct
                 out0.append(row[:, 0])
                 out1.append(row[:, 1])
+            out0.append(cn[:, 0])  # c_n >= 0 (eq. 9); implied by the cone rows only when mu > 0
+            out1.append(cn[:, 1])
         else:
             out0.append(cn[:, 0])
             out1.append(cn[:, 1])

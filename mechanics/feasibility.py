@@ -131,7 +131,8 @@ def check_mode(scene: Scene, mode: ContactMode, tol: Tolerances = DEFAULT_TOLERA
             [np.zeros((nS, 2 * nR)), np.eye(nS)],
         ]
     )
-    slack = BA @ cA
+    # eq. (9) also states c_n >= 0 at rolling contacts; B_A implies it only when mu > 0
+    slack = np.concatenate([BA @ cA, cA[:nR]])
     ftol = tol.force * max(float(np.max(np.abs(cA))), float(np.max(np.abs(rhs))), 1e-300)
     if np.any(slack < -ftol):
         return ModeCheck(mode, Status.COULOMB_VIOLATED)

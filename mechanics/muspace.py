@@ -223,7 +223,7 @@ def _polynomial_status(eqp, mu_points: np.ndarray, tau_e: np.ndarray, tol: Toler
         worst = np.full(mu.shape[0], np.inf)
         for i, a, t in rolling:  # Coulomb slacks (28), as the solver computes them
             mc = mu[:, i] * cA[a]
-            worst = np.minimum(worst, np.minimum(mc + cA[t], mc - cA[t]))
+            worst = np.minimum(worst, np.minimum(np.minimum(mc + cA[t], mc - cA[t]), cA[a]))  # and c_n >= 0 (eq. 9)
         for a in sliding:
             worst = np.minimum(worst, cA[a])
         scale = np.full(mu.shape[0], rhs_scale)

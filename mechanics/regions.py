@@ -36,12 +36,11 @@ from dataclasses import dataclass
 import numpy as np
 
 from .errors import ModeError
-from .feasibility import velocity_scale
 from .modes import ContactMode
 from .multilinear import Multilinear, ZeroBranch, bilinear_zero_set, column_expansion
 from .numerics import DEFAULT_TOLERANCES, Status, Tolerances
 from .scene import Scene
-from .solver import Kinematics, ScenePool, kinematics_stage
+from .solver import Kinematics, ScenePool, check_mode_fits, single_mode_kinematics
 
 __all__ = [
     "MuRegion",
@@ -60,19 +59,6 @@ __all__ = [
     "region_rs",
 ]
 
-_CODE = {"B": 0, "R": 1, "S": 2}
-
-
-def _check_mode(scene: Scene, mode) -> ContactMode:
-    mode = mode if isinstance(mode, ContactMode) else ContactMode(str(mode).upper())
-    if mode.n_contacts != scene.n_contacts:
-        raise ModeError(f"mode: expected {scene.n_contacts} letters (one per contact); got {mode.letters!r}")
-    if mode.n_constraints != scene.dof:
-        raise ModeError(
-            f"mode {mode.letters}: has {mode.n_constraints} applicable constraints but the scene's partition "
-            f"needs {scene.dof} (eq. 29 with |tau_I| = {scene.dof - 3})"
-        )
-    return mode
 
 
 def mode_kinematics(scene: Scene, mode, tol: Tolerances = DEFAULT_TOLERANCES) -> tuple[str, Kinematics | None]:
@@ -85,10 +71,8 @@ def mode_kinematics(scene: Scene, mode, tol: Tolerances = DEFAULT_TOLERANCES) ->
     kin : Kinematics or None
         One row, with the sliding directions ``xi``; None when the mode failed.
     """
-    mode = _check_mode(scene, mode)
-    codes = np.array([[_CODE[c] for c in mode.letters]], dtype=np.uint8)
-    status, live, kin = kinematics_stage(scene, ScenePool(scene), codes, tol, tol.velocity * velocity_scale(scene))
-    return Status.ORDER[int(status[0])], (kin if live.size else None)
+    _, status, _, kin = single_mode_kinematics(scene, mode, tol)
+    return status, kin
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -356,9 +340,10 @@ def _slack_numerators(eqp: EquilibriumPolynomials, tau_e):
             polys.append(N[eqp.column(i, True)])
             labels.append(f"c_n{i + 1} >= 0")
         elif letter == "R":
-            nn, tt = N[eqp.column(i, True)].times(i), N[eqp.column(i, False)]
-            polys += [nn + tt, nn - tt]
-            labels += [f"mu{i + 1} c_n{i + 1} + c_t{i + 1} >= 0", f"mu{i + 1} c_n{i + 1} - c_t{i + 1} >= 0"]
+            raw = N[eqp.column(i, True)]
+            nn, tt = raw.times(i), N[eqp.column(i, False)]
+            polys += [nn + tt, nn - tt, raw]  # c_n >= 0 (eq. 9): implied by the cone rows only when mu_i > 0
+            labels += [f"mu{i + 1} c_n{i + 1} + c_t{i + 1} >= 0", f"mu{i + 1} c_n{i + 1} - c_t{i + 1} >= 0", f"c_n{i + 1} >= 0"]
     return tuple(polys), tuple(labels)
 
 
@@ -397,7 +382,7 @@ def mode_region(scene: Scene, mode, tau_e=None, tol: Tolerances = DEFAULT_TOLERA
     MuRegion
         Empty (``kinematic_status`` says why) when the kinematic stage fails.
     """
-    mode = _check_mode(scene, mode)
+    mode = check_mode_fits(scene, mode)
     status, kin = mode_kinematics(scene, mode, tol)
     if kin is None:
         return _empty(mode, status, scene.n_contacts, _GENERAL)
@@ -500,7 +485,7 @@ def region_3s(scene: Scene, mode, tol: Tolerances = DEFAULT_TOLERANCES) -> MuReg
         no effort-controlled joints).
     """
     source = "Appendix A, eqs. (34)-(36), (50)-(57)"
-    mode = _check_mode(scene, mode)
+    mode = check_mode_fits(scene, mode)
     if mode.kind != "3S":
         raise ModeError(f"mode {mode.letters}: Appendix A covers 3S modes; got a {mode.kind} mode")
     status, kin = mode_kinematics(scene, mode, tol)
@@ -533,7 +518,7 @@ def region_rs(scene: Scene, mode, tol: Tolerances = DEFAULT_TOLERANCES) -> MuReg
         If ``mode`` is not an RS mode of the scene.
     """
     source = "Appendix B, eqs. (39)-(41), (58)-(60)"
-    mode = _check_mode(scene, mode)
+    mode = check_mode_fits(scene, mode)
     if mode.kind != "RS":
         raise ModeError(f"mode {mode.letters}: Appendix B covers RS modes; got a {mode.kind} mode")
     status, kin = mode_kinematics(scene, mode, tol)
@@ -548,5 +533,9 @@ def region_rs(scene: Scene, mode, tol: Tolerances = DEFAULT_TOLERANCES) -> MuReg
     rolled = {(r, s): co.C1, (r,): co.D1}
     plus = Multilinear.from_terms(rs, {**rolled, (s,): co.C2, (): co.D2})  # (40), second line with +
     minus = Multilinear.from_terms(rs, {**rolled, (s,): -co.C2, (): -co.D2})
-    labels = (f"c_n{s + 1} >= 0", f"mu{r + 1} c_n{r + 1} + c_t{r + 1} >= 0", f"mu{r + 1} c_n{r + 1} - c_t{r + 1} >= 0")
-    return MuRegion(mode, status, xi, den, (c_nS, plus, minus), labels, source)
+    c_nR = Multilinear.from_terms(rs, {(s,): co.C1, (): co.D1})  # c_nR >= 0 (eq. 9); (40)-(41) imply it only for mu_R > 0
+    labels = (
+        f"c_n{s + 1} >= 0", f"mu{r + 1} c_n{r + 1} + c_t{r + 1} >= 0", f"mu{r + 1} c_n{r + 1} - c_t{r + 1} >= 0",
+        f"c_n{r + 1} >= 0",
+    )  # fmt: skip
+    return MuRegion(mode, status, xi, den, (c_nS, plus, minus, c_nR), labels, source)

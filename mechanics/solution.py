@@ -91,7 +91,7 @@ def model_residuals(scene: Scene, sol: ModeSolution) -> dict:
         "eq2_workpiece_equilibrium": amax(scene.Wn @ sol.c_n + scene.Wt @ sol.c_t + scene.g_obj),
         "eq3_manipulator_equilibrium": amax(scene.Jn.T @ sol.c_n + scene.Jt.T @ sol.c_t - sol.tau + scene.g_man),
         "eq4_nonpenetration": neg(v_n),
-        "eq7_friction_cone": max(neg(mu * sol.c_n + sol.c_t), neg(mu * sol.c_n - sol.c_t)),
+        "eq7_friction_cone": max(neg(mu * sol.c_n + sol.c_t), neg(mu * sol.c_n - sol.c_t), neg(sol.c_n)),
         "eq9_rolling_velocity": max(amax(v_n[R]), amax(v_t[R])),
         "eq10_sliding_velocity": amax(v_n[S]),
         "eq10_sliding_force": amax(sol.c_t[S] + mu[S] * sol.xi[S] * sol.c_n[S]),

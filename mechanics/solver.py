@@ -28,6 +28,8 @@ __all__ = [
     "Kinematics",
     "kinematics_stage",
     "equilibrium_matrix",
+    "single_mode_kinematics",
+    "check_mode_fits",
     "equilibrium_stage",
     "ScenePool",
 ]
@@ -210,6 +212,41 @@ def kinematics_stage(scene: Scene, pool: "ScenePool", codes: np.ndarray, tol: To
     return status, live, kin
 
 
+def check_mode_fits(scene: Scene, mode) -> ContactMode:
+    """``mode`` (letters or ContactMode) checked against the scene: one letter per contact
+    and ``2 n_R + n_S = 3 + |tau_I|`` (eq. 29 with the scene's partition)."""
+    from .errors import ModeError
+
+    mode = mode if isinstance(mode, ContactMode) else ContactMode(str(mode).upper())
+    if mode.n_contacts != scene.n_contacts:
+        raise ModeError(f"mode: expected {scene.n_contacts} letters (one per contact); got {mode.letters!r}")
+    if mode.n_constraints != scene.dof:
+        raise ModeError(
+            f"mode {mode.letters}: has {mode.n_constraints} applicable constraints but the scene's partition "
+            f"needs {scene.dof} (eq. 29 with |tau_I| = {scene.dof - 3})"
+        )
+    return mode
+
+
+def single_mode_kinematics(scene: Scene, mode, tol: Tolerances = DEFAULT_TOLERANCES):
+    """The mu- and effort-independent kinematic stage (eqs. 24-25, 16) of one mode.
+
+    Returns
+    -------
+    mode : ContactMode
+    status : str
+        ``Status.FEASIBLE`` when the mode passed.
+    pool : ScenePool
+    kin : Kinematics or None
+        One row with the sliding directions ``xi``; None when the mode failed.
+    """
+    mode = check_mode_fits(scene, mode)
+    pool = ScenePool(scene)
+    codes = np.array([["BRS".index(c) for c in mode.letters]], dtype=np.uint8)
+    status, live, kin = kinematics_stage(scene, pool, codes, tol, tol.velocity * velocity_scale(scene))
+    return mode, Status.ORDER[int(status[0])], pool, (kin if live.size else None)
+
+
 def equilibrium_matrix(pool: "ScenePool", kin: Kinematics, mu: np.ndarray) -> np.ndarray:
     """``Q_AI`` of eq. (26) for every row: ``[W_Amu; J_AmuI^T]``, shape (m, k, k).
 
@@ -269,7 +306,9 @@ def equilibrium_stage(scene: Scene, pool: "ScenePool", kin: Kinematics, mu: np.n
     c_t = np.where(sliding, -mu * xi * c_n, c_t)  # eq. (17)
 
     rolling = kin.codes == _R
-    slack = np.where(rolling, np.minimum(mu * c_n + c_t, mu * c_n - c_t), np.where(sliding, c_n, np.inf))  # (28)
+    # (28), plus c_n >= 0 at rolling contacts: eq. (9) states it, and the cone rows imply it only when mu > 0
+    cone = np.minimum(np.minimum(mu * c_n + c_t, mu * c_n - c_t), c_n)
+    slack = np.where(rolling, cone, np.where(sliding, c_n, np.inf))
     ftol = tol.force * np.maximum(np.max(np.abs(cA), axis=1), np.max(np.abs(rhs), axis=1))
     worst = slack.min(axis=1)
     coul = ~q_sing & (worst < -ftol)

@@ -219,3 +219,20 @@ def test_mode_must_fit_the_partition():
     scene, _ = planted_scene(np.random.default_rng(0), 4, 1)
     with pytest.raises(ValueError, match="applicable constraints"):
         check_mode(scene, ContactMode("SSSB"))
+
+
+def test_frictionless_rolling_contact_cannot_pull():
+    # eq. (9): c_n >= 0 at a rolling contact even when mu = 0 (the cone rows of eq. 7 then say only c_t = 0).
+    # Block on a floor, weight outside the supports: RS would need the floor to pull (c_n1 = -0.5).
+    from mechanics import wrench_matrices
+    from mechanics.regions import region_rs
+
+    Wn, Wt = wrench_matrices([[-1, 0], [1, 0]], [[0, 1], [0, 1]])
+    scene = make_scene(Wn, Wt, [[0.0], [0.0]], [[-1.0], [0.0]], [0.0, 0.0], [0, -1, -2], joint_velocity=[1.0])
+    res = solve(scene, keep_statuses=True)
+    assert "RS" not in res.feasible_modes
+    assert check_mode(scene, ContactMode("RS")).status == Status.COULOMB_VIOLATED
+    assert not region_rs(scene, "RS").contains(np.array([[0.0, 0.0]]))[0]
+    mm = feasibility_map(scene, [[0.0, 0.0], [0.0, 0.3]])
+    names = [m.letters for m in mm.modes]
+    assert not mm.feasible[0, names.index("RS")]
