@@ -36,6 +36,7 @@ from .numerics import DEFAULT_TOLERANCES, Status, Tolerances
 from .planted import planted_scene
 from .scene import Scene, make_scene
 from .scene_io import load_scene, scene_from_dict
+from .scene_io_write import scene_to_dict
 from .solution import ModeSolution, model_residuals, relative_velocity
 from .solver import SolveResult, solve
 
@@ -108,6 +109,7 @@ __all__ = [
     "make_scene",
     "load_scene",
     "scene_from_dict",
+    "scene_to_dict",
     "ModeSolution",
     "model_residuals",
     "relative_velocity",
@@ -115,9 +117,25 @@ __all__ = [
     "solve",
 ]
 
-# Geometry needs shapely; load those modules on first use so that ``import mechanics``
+# Geometry needs shapely and the simulator scipy; load those modules on first use so that ``import mechanics``
 # (and the CLI's solver path) stays light.
 _LAZY = {
+    "LPCheck": "lp_check",
+    "lp_mode_feasible": "lp_check",
+    "simulate": "motion",
+    "Motion": "motion",
+    "MotionOptions": "motion",
+    "MotionSystem": "motion",
+    "Segment": "motion",
+    "Stop": "motion",
+    "Event": "motion",
+    "Friction": "motion",
+    "make_friction": "motion",
+    "pose_rate": "motion",
+    "rigid_body_rates": "motion",
+    "FrozenScene": "motion",
+    "frozen_scene_system": "motion",
+    "STOP_KINDS": "motion",
     "GeometricScene": "geometric_scene",
     "geometric_scene_from_dict": "geometric_scene",
     "scene_from_geometric_scene": "geometric_scene",
@@ -135,6 +153,9 @@ _LAZY = {
     "make_manipulator": "manipulator",
     "point_jacobian": "manipulator",
 }
+
+
+__all__ += list(_LAZY)
 
 
 def __getattr__(name):

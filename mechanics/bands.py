@@ -41,7 +41,7 @@ from .solver import ScenePool, equilibrium_matrix, single_mode_kinematics
 __all__ = [
     "Band",
     "ModeKinematics",
-    "mode_kinematics",
+    "band_kinematics",
     "band_rows",
     "effort_band",
     "effort_bands",
@@ -132,7 +132,7 @@ def _check_one_effort_joint(scene: Scene) -> int:
     return int(E[0])
 
 
-def mode_kinematics(scene: Scene, mode: ContactMode, tol: Tolerances = DEFAULT_TOLERANCES) -> ModeKinematics:
+def band_kinematics(scene: Scene, mode: ContactMode, tol: Tolerances = DEFAULT_TOLERANCES) -> ModeKinematics:
     """Run the kinematic stage (eqs. 24-25, 16) for one mode."""
     return ModeKinematics(*single_mode_kinematics(scene, mode, tol))
 
@@ -226,7 +226,7 @@ def effort_bands(scene: Scene, mode: ContactMode, mu_rows, tol: Tolerances = DEF
     """
     _check_one_effort_joint(scene)
     mu_rows = np.atleast_2d(np.asarray(mu_rows, dtype=float))
-    mk = mode_kinematics(scene, mode, tol)
+    mk = band_kinematics(scene, mode, tol)
     N = mu_rows.shape[0]
     if not mk.ok:
         return np.full(N, np.nan), np.full(N, np.nan), np.zeros(N, dtype=bool)
@@ -246,7 +246,7 @@ def effort_band(scene: Scene, mode: ContactMode, mu=None, tol: Tolerances = DEFA
     mu : array-like, shape (n_c,), optional
     """
     joint = _check_one_effort_joint(scene)
-    mk = mode_kinematics(scene, mode, tol)
+    mk = band_kinematics(scene, mode, tol)
     if not mk.ok:
         return Band(mode.letters, joint, np.nan, np.nan, False, f"kinematics: {mk.status}")
     mu = scene.mu if mu is None else np.broadcast_to(np.asarray(mu, float), (scene.n_contacts,))
@@ -283,7 +283,7 @@ def guaranteed_band_box(scene: Scene, mode: ContactMode, lo, hi, tol: Tolerances
     """
     joint = _check_one_effort_joint(scene)
     verts = _box_vertices(scene, mode, lo, hi)
-    mk = mode_kinematics(scene, mode, tol)
+    mk = band_kinematics(scene, mode, tol)
     if not mk.ok:
         return Band(mode.letters, joint, np.nan, np.nan, False, f"kinematics: {mk.status}", "box-vertices")
     s0, s1, det, scale = band_rows(scene, mk, verts)
@@ -315,7 +315,7 @@ def possible_band_box(scene: Scene, mode: ContactMode, lo, hi, tol: Tolerances =
     """
     joint = _check_one_effort_joint(scene)
     verts = _box_vertices(scene, mode, lo, hi)
-    mk = mode_kinematics(scene, mode, tol)
+    mk = band_kinematics(scene, mode, tol)
     if not mk.ok:
         return Band(mode.letters, joint, np.nan, np.nan, False, f"kinematics: {mk.status}", "possible-superset", True)
     s0, s1, det, scale = band_rows(scene, mk, verts)
@@ -390,7 +390,7 @@ def guaranteed_band_shared(scene: Scene, mode: ContactMode, lo: float, hi: float
     joint = _check_one_effort_joint(scene)
     if not (np.isfinite(lo) and np.isfinite(hi)) or lo < 0 or lo > hi:
         raise SceneError(f"mu range: expected 0 <= lo <= hi, finite; got {lo}, {hi}")
-    mk = mode_kinematics(scene, mode, tol)
+    mk = band_kinematics(scene, mode, tol)
     if not mk.ok:
         return Band(mode.letters, joint, np.nan, np.nan, False, f"kinematics: {mk.status}", "shared-roots")
     if hi == lo:

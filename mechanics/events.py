@@ -34,7 +34,7 @@ from .scene import Scene
 __all__ = [
     "ModeValues",
     "mode_values",
-    "mode_kinematics",
+    "mode_motion",
     "signed_hadamard",
     "rk4_step",
     "Event",
@@ -108,7 +108,7 @@ def signed_hadamard(A) -> float:
     return float(sign * np.exp(logdet - np.log(norms).sum())) if sign != 0 else 0.0
 
 
-def mode_kinematics(scene: Scene, mode: ContactMode, ratio: bool = True):
+def mode_motion(scene: Scene, mode: ContactMode, ratio: bool = True):
     """Motion of ``mode`` by eq. (24): ``(qdot (3,), thetadot (n_j,), h_P)``.
 
     ``h_P`` is the signed Hadamard ratio of ``P_AI`` (NaN when ``ratio`` is False, which
@@ -162,7 +162,7 @@ def mode_values(
     n_c = scene.n_contacts
     R, S, B = list(mode.rolling), list(mode.sliding), list(mode.breaking)
     names = scene.contact_names
-    qdot, thetadot, hP = mode_kinematics(scene, mode)
+    qdot, thetadot, hP = mode_motion(scene, mode)
     v_n = scene.Wn.T @ qdot - scene.Jn @ thetadot
     v_t = scene.Wt.T @ qdot - scene.Jt @ thetadot
     if xi is None:
@@ -304,7 +304,7 @@ def mode_rates(system, contacts, mode: ContactMode, mu):
     def f(y):
         if not np.all(np.isfinite(y)):
             return np.full(y.shape, np.nan)
-        qdot, thetadot, _ = mode_kinematics(scene_with_mu(system, y, contacts, mu), mode, ratio=False)
+        qdot, thetadot, _ = mode_motion(scene_with_mu(system, y, contacts, mu), mode, ratio=False)
         return np.asarray(system.rates(y, qdot, thetadot), dtype=float)
 
     return f
