@@ -63,7 +63,7 @@ def main(out_dir="out") -> int:
 
     fig, axes = new_axes(1, 1, size=(6.5, 7.5))
     plot_contact_scene(scene, mode="SSS", mu=[0.3, 0.3, 0.3], ax=axes[0, 0])
-    fig.savefig(out / "fig4_eq37_scene.png", dpi=110)
+    fig.savefig(out / "fig4_eq37_scene.png", dpi=110, bbox_inches="tight")
     print(f"wrote {out / 'fig3_eq37.png'} and {out / 'fig4_eq37_scene.png'}")
     return 0
 

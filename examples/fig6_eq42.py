@@ -61,7 +61,7 @@ def main(out_dir="out") -> int:
 
     fig, axes = new_axes(1, 1, size=(6.5, 7.5))
     plot_contact_scene(scene, mode="SSS", ax=axes[0, 0])
-    fig.savefig(out / "fig5_eq42_scene.png", dpi=110)
+    fig.savefig(out / "fig5_eq42_scene.png", dpi=110, bbox_inches="tight")
     print(f"wrote {out / 'fig6_eq42.png'} and {out / 'fig5_eq42_scene.png'}")
     return 0
 
