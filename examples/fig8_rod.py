@@ -33,7 +33,7 @@ def main(out_dir="out") -> int:
     xs = np.linspace(0.0, 1.0, N)
     sl = mu_slice(scene, 0, 1, xs, xs)
     fig, axes = new_axes(1, 1, size=(6.0, 5.2))
-    ax = plot_mu_map(sl, ax=axes[0, 0], title=f"rod, $l_1$ = {L1:g}, $l_2$ = {L2:g}: boundary $l_1 \\mu_2 = l_2 \\mu_1$")
+    plot_mu_map(sl, ax=axes[0, 0], title=f"rod, $l_1$ = {L1:g}, $l_2$ = {L2:g}: boundary $l_1 \\mu_2 = l_2 \\mu_1$")
     fig.savefig(out / "fig8_rod.png", dpi=110)
 
     curves = sl.boundary_curves()

@@ -104,7 +104,6 @@ def _parse(args, scene):
 def _write_figure(sl, path, source):
     from pathlib import Path
 
-    from mechanics import QsplanError
 
     from .muspace_plots import plot_mu_map
     from .plots import new_axes
@@ -112,11 +111,9 @@ def _write_figure(sl, path, source):
     fixed = ", ".join(f"$\\mu_{k + 1}$ = {sl.base_mu[k]:g}" for k in range(sl.base_mu.size) if k not in (sl.x, sl.y))
     fig, axes = new_axes(1, 1, size=(6.5, 5.5))
     plot_mu_map(sl, ax=axes[0, 0], title=f"{Path(source).name}" + (f": {fixed}" if fixed else ""))
-    try:
-        Path(path).parent.mkdir(parents=True, exist_ok=True)
-        fig.savefig(path, dpi=110)
-    except OSError as exc:
-        raise QsplanError(f"--out: cannot write {str(path)!r}: {exc.strerror or exc}") from None
+    from .plots import save_figure
+
+    save_figure(fig, path)
 
 
 def run(args, out) -> int:

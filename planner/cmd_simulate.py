@@ -163,18 +163,14 @@ def _document(args, motion, cf):
 
 
 def _write_figure(motion, cf, path):
-    from pathlib import Path
 
-    from mechanics import QsplanError
 
     from .motion_plots import rod_motion_figure
 
     fig = rod_motion_figure(motion, closed_form=cf)
-    try:
-        Path(path).parent.mkdir(parents=True, exist_ok=True)
-        fig.savefig(path, dpi=110)
-    except OSError as exc:
-        raise QsplanError(f"--out: cannot write {str(path)!r}: {exc.strerror or exc}") from None
+    from .plots import save_figure
+
+    save_figure(fig, path)
 
 
 def run(args, out) -> int:

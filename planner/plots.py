@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["plot_mu_slice", "new_axes"]
+__all__ = ["plot_mu_slice", "new_axes", "save_figure"]
 
 #: Colours for mode sets, in order of first appearance; "jam" is always light grey.
 _PALETTE = ["#4c72b0", "#dd8452", "#55a868", "#c44e52", "#8172b3", "#937860", "#da8bc3", "#8c8c8c", "#ccb974", "#64b5cd"]
@@ -22,6 +22,20 @@ def new_axes(ncols=1, nrows=1, size=(4.2, 3.8)):
     fig = Figure(figsize=(size[0] * ncols, size[1] * nrows), layout="constrained")
     axes = fig.subplots(nrows, ncols, squeeze=False)
     return fig, axes
+
+
+def save_figure(fig, path, option: str = "--out", dpi: int = 110) -> None:
+    """Write ``fig`` to ``path`` (parent folders created); an unwritable path raises a
+    :class:`~mechanics.QsplanError` naming ``option``."""
+    from pathlib import Path
+
+    from mechanics import QsplanError
+
+    try:
+        Path(path).parent.mkdir(parents=True, exist_ok=True)
+        fig.savefig(path, dpi=dpi, bbox_inches="tight")
+    except OSError as exc:
+        raise QsplanError(f"{option}: cannot write {str(path)!r}: {exc.strerror or exc}") from None
 
 
 def plot_mu_slice(mumap, xs, ys, ax=None, xlabel="$\\mu_1$", ylabel="$\\mu_2$", title=None, names=True, colours=None):

@@ -1,6 +1,5 @@
 """Contact modes: enumeration under the utility conditions, eq. (49) and Table 1."""
 
-import numpy as np
 import pytest
 
 from mechanics import ContactMode, ModeError, count_modes, enumerate_modes, iter_mode_batches, mode_from_letters

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from hands.paper import eq42_scene, rod_scene
-from mechanics import planted_scene, scene_from_dict, solve
+from mechanics import planted_scene, solve
 from mechanics.scene_io_write import scene_to_dict
 from planner.cli import main
 
