@@ -66,7 +66,8 @@ class PlannerOptions:
     validity_resolution : float
         Fraction of the space's maximum extent between validity checks along a motion.
     simplify : bool
-        Shortcut and smooth the path (OMPL's simplifyMax, deterministic).
+        Shortcut and smooth the path (OMPL's simplifyMax, deterministic).  Skipped when a
+        ``state_cost`` is given: the shortcuts minimise length and would undo the cost.
     interpolate : int
         Number of states of the returned path (0: as planned); states are added
         along the path, each checked again.
@@ -151,7 +152,9 @@ def plan_path(
     state_cost : callable, optional
         ``state_cost(x) -> float >= 0``: an optimization objective integrating this cost
         along the path (trapezoid rule) is set, so optimizing planners prefer
-        low-cost states (e.g. ``1 / margin`` to prefer wide effort bands).
+        low-cost states (e.g. ``1 / margin`` to prefer wide effort bands).  Use an
+        optimizing planner (``BITstar`` is fastest here, ``RRTstar``); Python cost calls
+        make ``RRTstar`` slow.
 
     Returns
     -------
@@ -235,7 +238,7 @@ def plan_path(
     exact = status.getStatus() == ob.PlannerStatus.EXACT_SOLUTION
     path = np.zeros((0, d))
     if exact:
-        if options.simplify:
+        if options.simplify and state_cost is None:
             ss.simplifySolution()
         geo = og.PathGeometric(ss.getSolutionPath())  # a copy: nothing dangles after ss goes
         if options.interpolate:

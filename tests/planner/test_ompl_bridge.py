@@ -32,7 +32,7 @@ def test_blocked_goal_reports_no_exact_path():
 
 
 def test_state_cost_steers_an_optimizing_planner():
-    opts = PlannerOptions(planner="RRTstar", iterations=1500, interpolate=50)
+    opts = PlannerOptions(planner="BITstar", iterations=3000, interpolate=50)
     r = plan_path([-1, -1], [1, 1], [-0.8, -0.5], [0.8, -0.5], lambda x: True, opts, state_cost=lambda x: 1.0 + 50.0 * (x[1] < 0))
     assert r.exact and np.mean(r.path[:, 1] > 0) > 0.3  # detours through the cheap upper half
 
