@@ -55,7 +55,7 @@ def format_solve_result(result: SolveResult, source: str = "") -> str:
     """A readable table of the feasible modes, the rejection counts and a verdict."""
     scene = result.scene
     lines = []
-    joints = "contact velocities given" if scene.virtual_joints else f"{scene.n_joints} joints ({len(scene.effort_joints)} effort-controlled)"
+    joints = "contact velocities given" if scene.virtual_joints else f"{scene.n_joints} joint{'s' if scene.n_joints != 1 else ''} ({len(scene.effort_joints)} effort-controlled)"
     lines.append(f"scene {source}: {scene.n_contacts} contacts, {joints}; modes tested: {result.modes_tested} (eq. 49)")
     if result.jammed:
         lines.append("no feasible mode: the scene jams (or the model has no quasistatic solution)")
@@ -72,7 +72,7 @@ def format_solve_result(result: SolveResult, source: str = "") -> str:
             flag = "  (on a region boundary)" if s.on_boundary else ""
             lines.append(
                 f"{s.mode.letters:<{max(4, scene.n_contacts)}}  {s.mode.name:<8} "
-                f"{s.qdot[0]:>9.4g} {s.qdot[1]:>9.4g} {s.qdot[2]:>9.4g}   {forces}{flag}"
+                f"{s.qdot[0] + 0.0:>9.4g} {s.qdot[1] + 0.0:>9.4g} {s.qdot[2] + 0.0:>9.4g}   {forces}{flag}"
             )
             if not scene.virtual_joints:
                 lines.append(

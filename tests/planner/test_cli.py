@@ -138,3 +138,15 @@ def test_paper_writes_results(tmp_path, capsys):
     res = json.loads((out_dir / "paper_results.json").read_text())
     assert res["eq42"]["modes"] == ["3S", "R1S3", "R2S1", "R3S1"]
     assert all(v for r in res.values() if isinstance(r, dict) for k, v in r.items() if k.startswith("check_"))
+
+
+def test_geometric_scene_file(capsys):
+    # the bundled geometric example: a box pushed right and down by a finger tip slides (3S)
+    from pathlib import Path
+
+    path = Path(__file__).parents[2] / "examples" / "scenes" / "box_and_finger.toml"
+    code, out, _ = run(["modes", str(path), "--json"], capsys)
+    doc = json.loads(out)
+    assert code == 0 and [f["mode"] for f in doc["feasible"]] == ["SSS"]
+    f = doc["feasible"][0]
+    assert f["qdot"][0] > 0 and abs(f["qdot"][2]) < 1e-12 and len(f["joint_efforts"]) == 1
