@@ -212,12 +212,16 @@ def plan_path(
     if state_cost is not None:
 
         class _Cost(ob.OptimizationObjective):
+            def __init__(self, info):
+                super().__init__(info)
+                self.info = info
+
             def stateCost(self, s):
                 return ob.Cost(float(state_cost(to_np(s))))
 
             def motionCost(self, a, b):
                 c = 0.5 * (self.stateCost(a).value() + self.stateCost(b).value())
-                return ob.Cost(c * si.distance(a, b))
+                return ob.Cost(c * self.info.distance(a, b))
 
         ss.setOptimizationObjective(_Cost(si))
     ss.setPlanner(_planner(og, si, options.planner))
