@@ -63,7 +63,7 @@ def build_parser() -> argparse.ArgumentParser:
 
 #: Subcommands that live in their own module ``planner.cmd_<name>``, each with
 #: ``add_parser(subparsers)`` and ``run(args, out) -> int``.
-COMMAND_MODULES: tuple = ("muspace", "band", "simulate", "sweep")
+COMMAND_MODULES: tuple = ("muspace", "band", "simulate", "sweep", "plan", "demo")
 
 
 def _command_module(name):

@@ -1,0 +1,107 @@
+"""``qsplan plan``: plan a two-finger task through OMPL with guaranteed torque bands, plots and export.
+
+::
+
+    qsplan plan TASK.toml [--out DIR] [--seed S] [--planner NAME] [--force] [--quiet] [--no-plots]
+
+Reads the task (:mod:`planner.task`), plans it (:func:`planner.plan.plan_task`:
+in-contact segments through OMPL with the band validity checker, regrasps in
+joint space), and writes into DIR (default ``out/plan``) ``plan.csv`` and
+``plan.json`` (the torque trajectory: :mod:`planner.plan_export`) and, unless
+``--no-plots``, ``plan_bands.png``, ``mode_timeline.png`` and ``hand_snapshots.png``.
+Existing files are not overwritten without ``--force`` (checked first).  Progress
+lines go to stderr unless ``--quiet``; a summary to stdout.
+
+When no plan exists the report (where the band closes, which mode closes it, at
+which friction) is written to DIR/failure.json and the command fails with one
+line on stderr naming it (exit 2).
+"""
+
+from __future__ import annotations
+
+import sys
+
+__all__ = ["add_parser", "run", "run_task"]
+
+_FILES = ("plan.csv", "plan.json")
+_PLOTS = ("plan_bands", "mode_timeline", "hand_snapshots")
+
+
+def _common(p, default_out):
+    from .ompl_bridge import PLANNERS
+
+    p.add_argument("--out", default=default_out, metavar="DIR", help=f"output directory (default {default_out})")
+    p.add_argument("--seed", type=int, default=1, metavar="S", help="OMPL's random seed (default 1)")
+    p.add_argument("--planner", choices=PLANNERS, default="RRTConnect", help="OMPL planner (default RRTConnect)")
+    p.add_argument("--force", action="store_true", help="overwrite existing files in DIR")
+    p.add_argument("--quiet", action="store_true", help="no progress lines on stderr")
+    p.add_argument("--no-plots", action="store_true", help="write the torque trajectory only")
+
+
+def add_parser(subparsers):
+    p = subparsers.add_parser("plan", help="plan a two-finger task (TOML) through OMPL with guaranteed torque bands")
+    p.add_argument("task", help="task file (.toml; see planner.task)")
+    _common(p, "out/plan")
+    return p
+
+
+def run_task(task, args, out) -> int:
+    """Plan ``task`` and write the outputs as ``args`` ask (shared by ``qsplan demo``)."""
+    import json
+    from dataclasses import replace
+    from pathlib import Path
+
+    from mechanics import QsplanError
+
+    from .plan import DEFAULT_OPTIONS, PlanFailure, plan_task
+
+    outdir = Path(args.out)
+    planned = [outdir / f for f in _FILES] + ([] if args.no_plots else [outdir / f"{n}.png" for n in _PLOTS])
+    clash = [str(p) for p in planned if p.exists()]
+    if clash and not args.force:
+        raise QsplanError(f"--out: {clash[0]!r} exists ({len(clash)} of the output files do); "
+                          "pass --force to overwrite or choose another --out")  # fmt: skip
+    err = sys.stderr
+
+    def progress(line):
+        if not args.quiet:
+            err.write(f"[qsplan] {line}\n")
+            err.flush()
+
+    options = replace(DEFAULT_OPTIONS, seed=args.seed, planner=args.planner)
+    progress(f"task {task.name!r}: {len(task.waypoints)} in-contact segments, mu in {list(task.mu_range)}, "
+             f"torque resolution {task.torque_resolution:g} N m")  # fmt: skip
+    try:
+        plan = plan_task(task, options, progress)
+    except PlanFailure as exc:
+        outdir.mkdir(parents=True, exist_ok=True)
+        with open(outdir / "failure.json", "w") as f:
+            json.dump(exc.report.as_dict(), f, indent=1)
+        raise QsplanError(f"{exc} (report: {outdir / 'failure.json'})") from None
+    from .plan_export import export_plan
+
+    files = [str(p) for p in export_plan(plan, outdir, force=True)]
+    if not args.no_plots:
+        progress("drawing the plots")
+        from .plan_plots import plan_figures
+        from .plots import save_figure
+
+        for name, fig in plan_figures(plan).items():
+            path = outdir / f"{name}.png"
+            save_figure(fig, path)
+            files.append(str(path))
+    name, t, w = plan.narrowest()
+    out.write(f"{task.name}: planned {len(plan.segments)} in-contact segments and {len(plan.phases) - len(plan.segments)} "
+              f"regrasps, {plan.duration:.4g} s of motion\n")  # fmt: skip
+    out.write(f"planning: {plan.seconds:.3g} s, {plan.validity_checks} validity checks "
+              f"({plan.checks_per_second:.4g} per second inside OMPL)\n")  # fmt: skip
+    out.write(f"narrowest guaranteed band: {w:.6g} N m at t = {t:.4g} s (resolution {task.torque_resolution:g} N m)\n")
+    for f in files:
+        out.write(f"wrote {f}\n")
+    return 0
+
+
+def run(args, out) -> int:
+    from .task import load_task
+
+    return run_task(load_task(args.task), args, out)
