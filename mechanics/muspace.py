@@ -22,10 +22,11 @@ import numpy as np
 
 from .errors import SceneError
 from .feasibility import velocity_scale
-from .modes import ContactMode, codes_to_letters, iter_mode_batches
+from .modes import ContactMode, codes_to_letters, count_modes, iter_mode_batches
 from .numerics import DEFAULT_TOLERANCES, Status, Tolerances
 from .scene import Scene
 from .multilinear import monomials, restrict_coef
+from .parallel import chunk_count, map_chunks, split_range
 from .regions import _active, _polynomials_from_kinematics, empty_region, region_from_polynomials
 from .solver import ScenePool, equilibrium_stage, kinematics_stage
 
@@ -42,6 +43,16 @@ __all__ = [
 
 #: Rows (mode x mu point) per equilibrium batch; bounds memory to a few tens of MB.
 MAP_BATCH = 1 << 16
+
+#: Fewest mode x mu-point rows worth a chunk of their own in :func:`feasibility_map`:
+#: ~0.1 s at the ~1.5e6 rows/s of one core, several times a local pool's start-up.
+MIN_CHUNK_ROWS = 150_000
+
+#: The same for the polynomial path of :func:`mu_slice`, split by modes.  It runs at
+#: ~2e7 rows/s but is bound by memory bandwidth, and on two cores a pool gained
+#: nothing below ~2000^2 points x 5 modes (benchmarks/bench_parallel.py), so a chunk
+#: needs ~0.5 s of work.
+MIN_CHUNK_POLYNOMIAL_ROWS = 10_000_000
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -112,7 +123,8 @@ def _check_mu_points(scene: Scene, mu_points) -> np.ndarray:
     return mu_points
 
 
-def feasibility_map(scene: Scene, mu_points, tol: Tolerances = DEFAULT_TOLERANCES, batch: int = MAP_BATCH) -> MuMap:
+def feasibility_map(scene: Scene, mu_points, tol: Tolerances = DEFAULT_TOLERANCES, batch: int = MAP_BATCH, *,
+                    workers=None, scheduler=None) -> MuMap:  # fmt: skip
     """Feasible modes of ``scene`` at every row of ``mu_points``.
 
     Parameters
@@ -124,14 +136,30 @@ def feasibility_map(scene: Scene, mu_points, tol: Tolerances = DEFAULT_TOLERANCE
     tol : Tolerances
     batch : int
         Rows per equilibrium batch.
+    workers : int or None
+        Local processes (``None``: all cores, 1: in-process); the points are split into
+        chunks of rows, each of at least :data:`MIN_CHUNK_ROWS` mode-point rows, so a
+        small map stays in-process.  See :func:`mechanics.parallel.map_chunks`.
+    scheduler : str or dask.distributed.Client, optional
+        Send the chunks to a Dask cluster instead.
 
     Returns
     -------
     MuMap
+        The same (bit for bit) however it was split: every row is computed alone.
     """
     mu_points = _check_mu_points(scene, mu_points)
-    pool, modes, kstatus, kins = _kinematics_all(scene, tol)
     N = mu_points.shape[0]
+    n_chunks = chunk_count(N * count_modes(scene.n_contacts, scene.dof), MIN_CHUNK_ROWS, workers=workers,
+                           scheduler=scheduler)  # fmt: skip
+    if N and (n_chunks > 1 or scheduler is not None):
+        jobs = [(scene, mu_points[lo:hi], tol, batch) for lo, hi in split_range(N, n_chunks)]
+        parts = map_chunks(_feasibility_chunk, jobs, workers=workers, scheduler=scheduler)
+        stack = lambda f: np.concatenate([getattr(p, f) for p in parts])  # noqa: E731
+        first = parts[0]
+        return MuMap(first.modes, first.kinematic_status, mu_points, stack("feasible"), stack("degenerate"),
+                     stack("boundary"))  # fmt: skip
+    pool, modes, kstatus, kins = _kinematics_all(scene, tol)
     feasible = np.zeros((N, len(modes)), dtype=bool)
     degenerate = np.zeros_like(feasible)
     boundary = np.zeros_like(feasible)
@@ -153,6 +181,12 @@ def feasibility_map(scene: Scene, mu_points, tol: Tolerances = DEFAULT_TOLERANCE
             degenerate[rows_pt, cols] = st == Status.ORDER.index(Status.EQUILIBRIUM_SINGULAR)
             boundary[rows_pt, cols] = (st == 0) & bnd
     return MuMap(tuple(modes), tuple(kstatus), mu_points, feasible, degenerate, boundary)
+
+
+def _feasibility_chunk(job) -> MuMap:
+    """One chunk of rows of :func:`feasibility_map`, in the process that runs it."""
+    scene, mu_points, tol, batch = job
+    return feasibility_map(scene, mu_points, tol, batch, workers=1)
 
 
 def grid_points(base_mu, x: int, y: int, xs, ys) -> np.ndarray:
@@ -237,19 +271,47 @@ def _polynomial_status(eqp, mu_points: np.ndarray, tau_e: np.ndarray, tol: Toler
     return feasible, degenerate, boundary
 
 
-def _polynomial_pass(scene: Scene, mu_points: np.ndarray, tol: Tolerances, batch: int):
-    pool, modes, kstatus, kins = _kinematics_all(scene, tol)
+def _polynomial_columns(scene: Scene, mu_points: np.ndarray, tol: Tolerances, batch: int, kinematics, columns):
+    """``{column: (feasible, degenerate, boundary, region)}`` of the live modes in ``columns``."""
+    pool, _, _, kins = kinematics
+    tau_e = np.nan_to_num(scene.joint_effort)[pool.E]
+    out = {}
+    for mode_cols, kin in kins:
+        for r, col in enumerate(mode_cols):
+            if int(col) in columns:
+                eqp = _polynomials_from_kinematics(scene, pool, kin, r)
+                out[int(col)] = _polynomial_status(eqp, mu_points, tau_e, tol, batch) + (region_from_polynomials(eqp, tau_e),)
+    return out
+
+
+def _polynomial_chunk(job):
+    """Some modes' columns of a slice's polynomial map, in the process that runs it."""
+    scene, grid, tol, batch, columns = job
+    return _polynomial_columns(scene, grid_points(*grid), tol, batch, _kinematics_all(scene, tol), columns)
+
+
+def _polynomial_pass(scene: Scene, mu_points: np.ndarray, tol: Tolerances, batch: int, grid=None, workers=1,
+                     scheduler=None):  # fmt: skip
+    """The polynomial map and every mode's region; with ``grid`` (the arguments of
+    :func:`grid_points`) the modes may be split into chunks, each evaluated whole."""
+    kinematics = _kinematics_all(scene, tol)
+    _, modes, kstatus, kins = kinematics
+    live = [int(c) for mode_cols, _ in kins for c in mode_cols]
     N = mu_points.shape[0]
+    n_chunks = chunk_count(N * len(live), MIN_CHUNK_POLYNOMIAL_ROWS, workers=workers, scheduler=scheduler)
+    if grid is not None and live and (n_chunks > 1 or scheduler is not None):
+        jobs = [(scene, grid, tol, batch, set(live[lo:hi])) for lo, hi in split_range(len(live), n_chunks)]
+        columns = {}
+        for part in map_chunks(_polynomial_chunk, jobs, workers=workers, scheduler=scheduler):
+            columns.update(part)
+    else:
+        columns = _polynomial_columns(scene, mu_points, tol, batch, kinematics, set(live))
     feasible = np.zeros((N, len(modes)), dtype=bool)
     degenerate = np.zeros_like(feasible)
     boundary = np.zeros_like(feasible)
     regions = [None] * len(modes)
-    tau_e = np.nan_to_num(scene.joint_effort)[pool.E]
-    for mode_cols, kin in kins:
-        for r, col in enumerate(mode_cols):
-            eqp = _polynomials_from_kinematics(scene, pool, kin, r)
-            feasible[:, col], degenerate[:, col], boundary[:, col] = _polynomial_status(eqp, mu_points, tau_e, tol, batch)
-            regions[col] = region_from_polynomials(eqp, tau_e)
+    for col, (f, d, b, region) in columns.items():
+        feasible[:, col], degenerate[:, col], boundary[:, col], regions[col] = f, d, b, region
     for j, m in enumerate(modes):
         if regions[j] is None:
             regions[j] = empty_region(m, kstatus[j], scene.n_contacts)
@@ -353,7 +415,7 @@ def _check_axis_values(v, field: str) -> np.ndarray:
 
 
 def mu_slice(scene: Scene, x: int, y: int, xs, ys, base_mu=None, method: str = "polynomial",
-             tol: Tolerances = DEFAULT_TOLERANCES) -> MuSlice:  # fmt: skip
+             tol: Tolerances = DEFAULT_TOLERANCES, *, workers=None, scheduler=None) -> MuSlice:  # fmt: skip
     """Feasible modes on a grid of a 2-D slice of mu-space, with the modes' exact regions.
 
     Parameters
@@ -368,10 +430,17 @@ def mu_slice(scene: Scene, x: int, y: int, xs, ys, base_mu=None, method: str = "
     method : {"polynomial", "solver"}
         ``"polynomial"``: :func:`polynomial_map`; ``"solver"``: :func:`feasibility_map`.
         Both give the solver's answer.
+    workers : int or None
+        Local processes (``None``: all cores, 1: in-process).  ``"polynomial"`` splits
+        the modes into chunks (each of at least :data:`MIN_CHUNK_POLYNOMIAL_ROWS`
+        mode-point rows), ``"solver"`` the points; a small slice stays in-process.
+    scheduler : str or dask.distributed.Client, optional
+        Send the chunks to a Dask cluster instead (:func:`mechanics.parallel.map_chunks`).
 
     Returns
     -------
     MuSlice
+        The same (bit for bit) however it was split.
     """
     n_c = scene.n_contacts
     x, y = _check_axis(x, n_c, "x"), _check_axis(y, n_c, "y")
@@ -384,9 +453,9 @@ def mu_slice(scene: Scene, x: int, y: int, xs, ys, base_mu=None, method: str = "
         raise SceneError(f"base_mu: expected {n_c} finite nonnegative friction coefficients; got {got}")
     pts = grid_points(base, x, y, xs, ys)
     if method == "polynomial":
-        mumap, regions = _polynomial_pass(scene, pts, tol, MAP_BATCH)
+        mumap, regions = _polynomial_pass(scene, pts, tol, MAP_BATCH, (base, x, y, xs, ys), workers, scheduler)
     elif method == "solver":
-        mumap = feasibility_map(scene, pts, tol)
+        mumap = feasibility_map(scene, pts, tol, workers=workers, scheduler=scheduler)
         _, regions = _polynomial_pass(scene, pts[:1], tol, MAP_BATCH)
     else:
         raise SceneError(f"method: expected 'polynomial' or 'solver'; got {method!r}")

@@ -24,11 +24,15 @@ from concurrent.futures import ProcessPoolExecutor
 
 from .errors import QsplanError
 
-__all__ = ["map_chunks", "resolve_workers", "split_range", "CONNECT_TIMEOUT"]
+__all__ = ["map_chunks", "chunk_count", "resolve_workers", "split_range", "CONNECT_TIMEOUT", "MAX_CLUSTER_CHUNKS"]
 
 #: Seconds to wait for a Dask scheduler to answer: long enough for a cluster on a
 #: local network, short enough that a mistyped ``--scheduler`` fails promptly.
 CONNECT_TIMEOUT = 5.0
+
+#: Chunks sent to a cluster when ``workers`` does not say: enough to keep a few dozen
+#: workers busy and balanced, few enough that per-task overhead (~ms) stays negligible.
+MAX_CLUSTER_CHUNKS = 64
 
 
 def resolve_workers(workers) -> int:
@@ -51,6 +55,31 @@ def split_range(n: int, parts: int) -> list[tuple[int, int]]:
     parts = max(1, min(parts, n))
     edges = [n * i // parts for i in range(parts + 1)]
     return [(lo, hi) for lo, hi in zip(edges[:-1], edges[1:]) if hi > lo]
+
+
+def chunk_count(n_units: int, min_units: int, *, workers=None, scheduler=None) -> int:
+    """Into how many chunks to split ``n_units`` of work: one per worker, none under ``min_units``.
+
+    The rule that keeps small jobs in-process: a chunk must hold at least ``min_units``
+    (each caller sizes it at ~0.1 s of work, several times the start-up of a local
+    pool), so work under ``2 min_units`` gives 1, and one chunk runs in-process.
+
+    Parameters
+    ----------
+    n_units : int
+        Size of the work (points, samples, batches: whatever the caller splits).
+    min_units : int
+        Smallest chunk worth sending to another process.
+    workers : int or None
+        Local processes (``None``: all cores); with a scheduler, the number of chunks
+        to send (``None``: up to :data:`MAX_CLUSTER_CHUNKS`).
+    scheduler : str or Client or None
+    """
+    if scheduler is None:
+        cap = resolve_workers(workers)
+    else:
+        cap = MAX_CLUSTER_CHUNKS if workers is None else resolve_workers(workers)
+    return max(1, min(cap, n_units // max(1, min_units)))
 
 
 def _pool_context():
