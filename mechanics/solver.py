@@ -12,6 +12,7 @@ Each mode gets exactly the status the one-mode reference
 from __future__ import annotations
 
 from dataclasses import dataclass, field, replace
+from itertools import islice
 
 import numpy as np
 
@@ -326,6 +327,10 @@ def solve(
     batch: int = DEFAULT_BATCH,
     residuals: bool = True,
     keep_statuses: bool = False,
+    *,
+    workers: int | None = None,
+    scheduler=None,
+    batches: tuple[int, int] | None = None,
 ) -> SolveResult:
     """Find every feasible contact mode of ``scene`` (Sections 3.1-3.2).
 
@@ -340,11 +345,25 @@ def solve(
         Evaluate the full-model residuals (eqs. 2-11) of every feasible solution.
     keep_statuses : bool
         Keep every mode's status (memory grows with eq. (49); for tests and diagnosis).
+    workers : int or None
+        Local processes for chunks of batches (``None``: all cores, 1: in-process);
+        fewer than ``2 * MIN_CHUNK_MODES`` modes stay in-process (:mod:`mechanics.mode_chunks`).
+    scheduler : str or dask.distributed.Client, optional
+        Send the chunks to a Dask cluster instead (:func:`mechanics.parallel.map_chunks`).
+    batches : (int, int), optional
+        Test only batches ``lo <= i < hi`` of the enumeration (one chunk's share).
 
     Returns
     -------
     SolveResult
+        The same (bit for bit) however it was split.
     """
+    if batches is None and (workers != 1 or scheduler is not None):
+        from .mode_chunks import solve_in_chunks
+
+        chunked = solve_in_chunks(scene, tol, batch, residuals, keep_statuses, workers=workers, scheduler=scheduler)
+        if chunked is not None:
+            return chunked
     n_c, dof = scene.n_contacts, scene.dof
     total = count_modes(n_c, dof)
     counts = dict.fromkeys(Status.ORDER, 0)
@@ -353,7 +372,7 @@ def solve(
     kept: list = []
     pool = ScenePool(scene)
     tau_e = np.nan_to_num(scene.joint_effort)[pool.E]
-    for codes in iter_mode_batches(n_c, dof, batch):
+    for codes in islice(iter_mode_batches(n_c, dof, batch), *(batches or (None,))):
         status, live, kin = kinematics_stage(scene, pool, codes, tol, vtol)
         if live.size:
             m = live.size
