@@ -2,7 +2,8 @@
 
 Subcommands::
 
-    qsplan modes SCENE [--mu M ...] [--json]        every feasible contact mode
+    qsplan modes SCENE [--mu M ...] [--json] [--method enumerate|lcp]
+                                                    every feasible contact mode (lcp: one, fast)
     qsplan count --contacts N --dof D [--json]      number of modes tested (eq. 49)
     qsplan partition SCENE [--mode LETTERS] [--json]  control-mode partitioner (eq. 32)
     qsplan paper [--out DIR]                        reproduce the paper's examples into DIR
@@ -41,6 +42,8 @@ def build_parser() -> argparse.ArgumentParser:
     m.add_argument("scene", help="scene file (.json or .toml; raw or geometric form)")
     m.add_argument("--mu", type=float, nargs="+", metavar="M", help="friction override: one value or one per contact")
     m.add_argument("--json", action="store_true", help="machine-readable output on stdout")
+    m.add_argument("--method", choices=("enumerate", "lcp"), default="enumerate",
+                   help="enumerate: every feasible mode (default); lcp: one mode by Lemke's method, fast")  # fmt: skip
 
     c = sub.add_parser("count", help="number of contact modes tested (eq. 49, Table 1)")
     c.add_argument("--contacts", type=int, required=True, metavar="N", help="number of contacts n_c")
@@ -80,6 +83,8 @@ def _cmd_modes(args, out):
     from mechanics import load_scene, solve
 
     scene = load_scene(args.scene, mu=args.mu)
+    if getattr(args, "method", "enumerate") == "lcp":
+        return _cmd_modes_lcp(scene, args, out)
     result = solve(scene)
     if args.json:
         from .report import solve_result_to_dict
@@ -90,6 +95,36 @@ def _cmd_modes(args, out):
     from .report import format_solve_result
 
     out.write(format_solve_result(result, source=args.scene))
+    return 0
+
+
+def _cmd_modes_lcp(scene, args, out):
+    """``qsplan modes --method lcp``: one mode from the LCP (mechanics.lcp), or why there is none."""
+    from mechanics import SolveResult
+    from mechanics.lcp import solve_lcp
+
+    res = solve_lcp(scene)
+    if args.json:
+        from .report import solve_result_to_dict
+
+        one = SolveResult(scene=scene, modes_tested=1, solutions=(res.solution,) if res.solved else (), counts={})
+        doc = solve_result_to_dict(one)
+        doc = {"method": "lcp", "status": res.status, "read_mode": res.letters, "pivots": res.pivots,
+               "feasible": doc["feasible"], "units": doc["units"]}  # fmt: skip
+        json.dump(doc, out)
+        out.write("\n")
+        return 0
+    out.write(f"scene {args.scene}: {scene.n_contacts} contacts; method lcp (Lemke, one solution): {res.status} "
+              f"after {res.pivots} pivots\n")  # fmt: skip
+    if res.solved:
+        s = res.solution
+        out.write(f"mode {s.mode.letters} ({s.mode.name}); verified by check_mode, max residual {s.max_residual:.2g}\n")
+        out.write(f"  qdot {' '.join(_fmt(x) for x in s.qdot)}\n  c_n  {' '.join(_fmt(x) for x in s.c_n)}\n"
+                  f"  c_t  {' '.join(_fmt(x) for x in s.c_t)}\n")  # fmt: skip
+        out.write("other modes may be feasible too: only --method enumerate finds them all\n")
+    else:
+        read = f" (the LCP solution reads as {res.letters}: {res.check_status})" if res.letters else ""
+        out.write(f"no mode found{read}; this does not prove the scene jams: use --method enumerate\n")
     return 0
 
 

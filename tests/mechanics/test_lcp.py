@@ -95,3 +95,22 @@ def test_iteration_cap_reported():
     scene, _ = planted(5, 0)
     res = solve_lcp(scene, max_pivots=1)
     assert res.status == LcpStatus.ITERATION_LIMIT and res.mode is None
+
+
+def test_cli_modes_method_lcp(tmp_path, capsys):
+    import json
+
+    from planner.cli import main
+
+    path = tmp_path / "eq42.json"
+    path.write_text(json.dumps(PAPER_SCENES["eq42"](mu=0.5)))
+    assert main(["modes", str(path), "--method", "lcp", "--json"]) == 0
+    doc = json.loads(capsys.readouterr().out)
+    assert doc["method"] == "lcp" and doc["status"] == "solved"
+    (mode,) = doc["feasible"]
+    enumerated = solve(scene_from_dict(PAPER_SCENES["eq42"](mu=0.5))).feasible_modes
+    assert mode["mode"] in enumerated
+    assert main(["modes", str(path), "--method", "lcp"]) == 0
+    assert "verified by check_mode" in capsys.readouterr().out
+    assert main(["modes", str(path), "--method", "simplex"]) == 2
+    assert "invalid choice" in capsys.readouterr().err
