@@ -20,7 +20,7 @@ number; NaN marks points without a band.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, fields, replace
 
 import numpy as np
 
@@ -32,6 +32,7 @@ from mechanics.bands import (
 )
 from mechanics.errors import QsplanError
 from mechanics.modes import ContactMode, enumerate_modes
+from mechanics.parallel import chunk_count, map_chunks, split_range
 
 from .command import choose_command, default_safety_margin
 from .preclusion import competitor_torques
@@ -63,6 +64,14 @@ PAPER_MU_SAMPLES = 21
 #: Band edges carry rounding of ~1e-14 relative; 1e-9 is far above it and far below
 #: any torque resolution, and a competitor that reaches further in is cut out.
 TOUCH_RTOL = 1e-9
+
+#: Fewest samples worth a chunk of their own in :func:`segment_bands`: one core does
+#: ~100 samples/s of segment 1 (all five sweeps), so 12 are ~0.1 s, several times a
+#: local pool's start-up.
+MIN_CHUNK_SAMPLES = 12
+
+#: The same for :func:`competing_modes` (~300 samples/s on one core).
+MIN_CHUNK_KINEMATIC_SAMPLES = 30
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -244,20 +253,27 @@ def point_band_sweep(samples, mu, mode=None, label=None) -> BandSweep:
     return _sweep(label, mode, samples, bands, "point")
 
 
-def competing_modes(samples, mode=None) -> tuple:
+def _admissible_modes(job) -> set:
+    """Modes other than ``letters`` kinematically admissible at one of ``scenes`` (one chunk)."""
+    scenes, letters = job
+    return {m.letters for m in enumerate_modes(scenes[0].n_contacts, scenes[0].dof)
+            if m.letters != letters and any(band_kinematics(s, m).ok for s in scenes)}  # fmt: skip
+
+
+def competing_modes(samples, mode=None, *, workers=None, scheduler=None) -> tuple:
     """Modes of the segment's control partition, other than ``mode``, kinematically admissible at some sample.
 
     The partition (one effort-controlled joint) fixes ``2 n_R + n_S = 4`` (eq. 29); a mode
     whose kinematics fail (eqs. 24-25, 16) at a sample is infeasible there for every
-    effort and friction, so only these can compete.
+    effort and friction, so only these can compete.  ``workers`` and ``scheduler`` as in
+    :func:`segment_bands` (chunks of at least :data:`MIN_CHUNK_KINEMATIC_SAMPLES`).
     """
     mode = _mode(samples, mode)
+    n_chunks = chunk_count(len(samples), MIN_CHUNK_KINEMATIC_SAMPLES, workers=workers, scheduler=scheduler)
+    jobs = [(samples.scenes[a:b], mode.letters) for a, b in split_range(len(samples), n_chunks)]
+    found = set().union(*map_chunks(_admissible_modes, jobs, workers=workers, scheduler=scheduler))
     scene0 = samples.scenes[0]
-    out = []
-    for m in enumerate_modes(scene0.n_contacts, scene0.dof):
-        if m.letters != mode.letters and any(band_kinematics(s, m).ok for s in samples.scenes):
-            out.append(m.letters)
-    return tuple(out)
+    return tuple(m.letters for m in enumerate_modes(scene0.n_contacts, scene0.dof) if m.letters in found)
 
 
 def _subtract(lo, hi, c_lo, c_hi, atol):
@@ -410,8 +426,47 @@ def narrowest(sweep: BandSweep):
     return k, float(sweep.width[k])
 
 
+def _sample_range(samples, lo: int, hi: int):
+    """Samples ``lo <= k < hi`` of a sampled segment, as a sampled segment."""
+    per_sample = [f.name for f in fields(samples) if f.name != "segment"]
+    return replace(samples, **{name: getattr(samples, name)[lo:hi] for name in per_sample})
+
+
+def _concat_sweeps(parts) -> BandSweep:
+    """One BandSweep from sweeps of consecutive sample ranges (label, mode and method from the first)."""
+    cat = lambda name: _frozen(np.concatenate([getattr(p, name) for p in parts]))  # noqa: E731
+    return replace(parts[0], t=cat("t"), lower=cat("lower"), upper=cat("upper"), feasible=cat("feasible"),
+                   exact=cat("exact"), reasons=tuple(r for p in parts for r in p.reasons))  # fmt: skip
+
+
+def _bands_chunk(job):
+    """The pointwise sweeps of :func:`segment_bands` on one range of samples."""
+    samples, lo, hi, shared, paper_samples, mode, comps = job
+    frictionless = point_band_sweep(samples, 0.0, mode, f"{mode.name}, frictionless (mu = 0)")
+    at_hi = point_band_sweep(samples, hi, mode, f"{mode.name}, mu = {hi:g}")
+    comp_hi = {c: point_band_sweep(samples, hi, c, f"{ContactMode(c).name} ({c}), mu = {hi:g}") for c in comps}
+    guaranteed = guaranteed_sweep(samples, (lo, hi), shared, mode, comps)
+    sampled = sampled_guaranteed_sweep(samples, np.linspace(lo, hi, int(paper_samples)), mode, comps)
+    return frictionless, at_hi, comp_hi, guaranteed, sampled
+
+
+def _merge_chunks(parts):
+    """:func:`_bands_chunk` results of consecutive sample ranges, as one."""
+    if len(parts) == 1:
+        return parts[0]
+    frictionless, at_hi, comp_hi, guaranteed, sampled = zip(*parts)
+    g0 = guaranteed[0]
+    hulls = {c: tuple(_frozen(np.concatenate([g.competitors[c][i] for g in guaranteed])) for i in (0, 1))
+             for c in g0.competitors}  # fmt: skip
+    merged_g = replace(g0, band=_concat_sweeps([g.band for g in guaranteed]),
+                       desired=_concat_sweeps([g.desired for g in guaranteed]), competitors=hulls,
+                       split=_frozen(np.concatenate([g.split for g in guaranteed])))  # fmt: skip
+    return (_concat_sweeps(frictionless), _concat_sweeps(at_hi),
+            {c: _concat_sweeps([d[c] for d in comp_hi]) for c in comp_hi[0]}, merged_g, _concat_sweeps(sampled))  # fmt: skip
+
+
 def segment_bands(samples, mu_range=DEFAULT_MU_RANGE, shared=False, paper_samples=PAPER_MU_SAMPLES,
-                  safety_margin=None, max_margin=None) -> SegmentBands:  # fmt: skip
+                  safety_margin=None, max_margin=None, *, workers=None, scheduler=None) -> SegmentBands:  # fmt: skip
     """Figs. 10-13 for a sampled segment, and the command to export.
 
     Parameters
@@ -427,17 +482,23 @@ def segment_bands(samples, mu_range=DEFAULT_MU_RANGE, shared=False, paper_sample
         N m; default :func:`planner.command.default_safety_margin`.
     max_margin : float, optional
         N m; cap on the command's margin (default none: the midpoint of every bounded band).
+    workers : int or None
+        Local processes for chunks of consecutive samples (``None``: all cores, 1:
+        in-process); fewer than ``2 * MIN_CHUNK_SAMPLES`` samples stay in-process.
+    scheduler : str or dask.distributed.Client, optional
+        Send the chunks to a Dask cluster instead (:func:`mechanics.parallel.map_chunks`).
+        Every sample is computed alone, so the result is the same however it was split.
     """
     lo, hi = _check_mu_range(*mu_range)
     if isinstance(paper_samples, bool) or not isinstance(paper_samples, (int, np.integer)) or paper_samples < 1:
         raise QsplanError(f"paper samples: expected a positive integer; got {paper_samples!r}")
     mode = _mode(samples, None)
-    comps = competing_modes(samples, mode)
-    frictionless = point_band_sweep(samples, 0.0, mode, f"{mode.name}, frictionless (mu = 0)")
-    at_hi = point_band_sweep(samples, hi, mode, f"{mode.name}, mu = {hi:g}")
-    comp_hi = {c: point_band_sweep(samples, hi, c, f"{ContactMode(c).name} ({c}), mu = {hi:g}") for c in comps}
-    guaranteed = guaranteed_sweep(samples, (lo, hi), shared, mode, comps)
-    sampled = sampled_guaranteed_sweep(samples, np.linspace(lo, hi, int(paper_samples)), mode, comps)
+    comps = competing_modes(samples, mode, workers=workers, scheduler=scheduler)
+    n_chunks = chunk_count(len(samples), MIN_CHUNK_SAMPLES, workers=workers, scheduler=scheduler)
+    jobs = [(_sample_range(samples, a, b) if n_chunks > 1 else samples, lo, hi, shared, paper_samples, mode, comps)
+            for a, b in split_range(len(samples), n_chunks)]  # fmt: skip
+    parts = map_chunks(_bands_chunk, jobs, workers=workers, scheduler=scheduler)
+    frictionless, at_hi, comp_hi, guaranteed, sampled = _merge_chunks(parts)
     band = guaranteed.band
     if safety_margin is None:
         safety_margin = default_safety_margin(band) if band.feasible.any() else 1.0
