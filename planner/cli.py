@@ -3,6 +3,7 @@
 Subcommands::
 
     qsplan modes SCENE [--mu M ...] [--json] [--method enumerate|lcp]
+                       [--workers N] [--scheduler ADDRESS]
                                                     every feasible contact mode (lcp: one, fast)
     qsplan count --contacts N --dof D [--json]      number of modes tested (eq. 49)
     qsplan partition SCENE [--mode LETTERS] [--json]  control-mode partitioner (eq. 32)
@@ -18,7 +19,7 @@ import argparse
 import json
 import sys
 
-__all__ = ["main", "build_parser"]
+__all__ = ["main", "build_parser", "add_parallel_options", "parallel_options"]
 
 EXIT_USAGE = 2
 
@@ -44,6 +45,7 @@ def build_parser() -> argparse.ArgumentParser:
     m.add_argument("--json", action="store_true", help="machine-readable output on stdout")
     m.add_argument("--method", choices=("enumerate", "lcp"), default="enumerate",
                    help="enumerate: every feasible mode (default); lcp: one mode by Lemke's method, fast")  # fmt: skip
+    add_parallel_options(m)
 
     c = sub.add_parser("count", help="number of contact modes tested (eq. 49, Table 1)")
     c.add_argument("--contacts", type=int, required=True, metavar="N", help="number of contacts n_c")
@@ -75,6 +77,23 @@ def _command_module(name):
     return importlib.import_module(f"planner.cmd_{name}")
 
 
+def add_parallel_options(p):
+    """``--workers N`` and ``--scheduler ADDRESS`` (see :func:`mechanics.parallel.map_chunks`)."""
+    p.add_argument("--workers", type=int, metavar="N",
+                   help="local processes for independent chunks (default: all cores; 1: in-process)")  # fmt: skip
+    p.add_argument("--scheduler", metavar="ADDRESS",
+                   help="run the chunks on a Dask cluster, e.g. tcp://host:8786 (needs qsplan[cluster])")  # fmt: skip
+
+
+def parallel_options(args) -> dict:
+    """``{"workers": ..., "scheduler": ...}`` from :func:`add_parallel_options`'s arguments, checked."""
+    from mechanics import QsplanError
+
+    if args.workers is not None and args.workers < 1:
+        raise QsplanError(f"--workers: expected a positive number of processes (1 runs in-process); got {args.workers}")
+    return {"workers": args.workers, "scheduler": args.scheduler}
+
+
 def _fmt(x, width=9):
     return f"{x:{width}.4g}"
 
@@ -85,7 +104,7 @@ def _cmd_modes(args, out):
     scene = load_scene(args.scene, mu=args.mu)
     if getattr(args, "method", "enumerate") == "lcp":
         return _cmd_modes_lcp(scene, args, out)
-    result = solve(scene)
+    result = solve(scene, **parallel_options(args))
     if args.json:
         from .report import solve_result_to_dict
 

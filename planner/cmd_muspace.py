@@ -3,6 +3,7 @@
 ::
 
     qsplan muspace SCENE --x muI --y muJ [--fix muK=V ...] --range LO HI --n N [--json] [--out FILE.png]
+                   [--workers N] [--scheduler ADDRESS]
 
 Both axes sample ``np.linspace(LO, HI, N)``; contacts are numbered from 1 as
 the paper's ``mu_i``; coefficients not named keep the scene's values.  With
@@ -40,6 +41,9 @@ def add_parser(subparsers):
     p.add_argument("--n", type=int, required=True, metavar="N", help=f"samples per axis (2..{MAX_N})")
     p.add_argument("--json", action="store_true", help="machine-readable cells on stdout")
     p.add_argument("--out", metavar="FILE.png", help="write the map (png, svg or pdf)")
+    from .cli import add_parallel_options
+
+    add_parallel_options(p)
     return p
 
 
@@ -120,9 +124,11 @@ def run(args, out) -> int:
     from mechanics import load_scene
     from mechanics.muspace import mu_slice
 
+    from .cli import parallel_options
+
     scene = load_scene(args.scene)
     x, y, base, xs = _parse(args, scene)
-    sl = mu_slice(scene, x, y, xs, xs, base_mu=base)
+    sl = mu_slice(scene, x, y, xs, xs, base_mu=base, **parallel_options(args))
     if args.out is not None:
         _write_figure(sl, args.out, args.scene)
     modes = sl.modes

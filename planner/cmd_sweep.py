@@ -5,6 +5,7 @@
     qsplan sweep [--segment 1] [--mu-range LO HI] [--shared-mu] [--samples N] [--duration T]
                  [--effort-joint left|right] [--paper-samples K] [--safety-margin M] [--max-margin M]
                  [--display-limit L] [--out DIR] [--force] [--no-plots] [--json]
+                 [--workers N] [--scheduler ADDRESS]
 
 Builds the default two-finger hand (:func:`hands.two_finger.default_hand`) and the
 segment (1: translate the workpiece left until the left finger meets its longest
@@ -64,12 +65,18 @@ def add_parser(subparsers):
     p.add_argument("--force", action="store_true", help="overwrite existing files in DIR")
     p.add_argument("--no-plots", action="store_true", help="write the schedule only")
     p.add_argument("--json", action="store_true", help="machine-readable summary on stdout")
+    from .cli import add_parallel_options
+
+    add_parallel_options(p)
     return p
 
 
 def _check(args):
     from mechanics import QsplanError
 
+    from .cli import parallel_options
+
+    parallel_options(args)
     lo, hi = args.mu_range
     if not (math.isfinite(lo) and math.isfinite(hi)) or lo < 0 or lo > hi:
         raise QsplanError(f"--mu-range: expected 0 <= LO <= HI (finite); got {lo} {hi}")
@@ -158,8 +165,10 @@ def run(args, out) -> int:
                           "pass --force to overwrite or choose another --out")  # fmt: skip
     seg = first_segment(default_hand(), duration=args.duration, effort_joint=args.effort_joint)
     samples = sample_segment(seg, args.samples)
+    from .cli import parallel_options
+
     sb = segment_bands(samples, tuple(args.mu_range), args.shared_mu, args.paper_samples, args.safety_margin,
-                       args.max_margin)  # fmt: skip
+                       args.max_margin, **parallel_options(args))  # fmt: skip
     from .export import export_schedule
 
     files = export_schedule(sb, args.out, force=True)
