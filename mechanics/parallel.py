@@ -17,6 +17,7 @@ when a scheduler is given.
 
 from __future__ import annotations
 
+import dataclasses
 import multiprocessing
 import os
 import threading
@@ -24,7 +25,15 @@ from concurrent.futures import ProcessPoolExecutor
 
 from .errors import QsplanError
 
-__all__ = ["map_chunks", "chunk_count", "resolve_workers", "split_range", "CONNECT_TIMEOUT", "MAX_CLUSTER_CHUNKS"]
+__all__ = [
+    "map_chunks",
+    "chunk_count",
+    "resolve_workers",
+    "split_range",
+    "first_difference",
+    "CONNECT_TIMEOUT",
+    "MAX_CLUSTER_CHUNKS",
+]
 
 #: Seconds to wait for a Dask scheduler to answer: long enough for a cluster on a
 #: local network, short enough that a mistyped ``--scheduler`` fails promptly.
@@ -156,3 +165,37 @@ def map_chunks(fn, items, *, workers=None, scheduler=None) -> list:
         return [fn(item) for item in items]
     with ProcessPoolExecutor(max_workers=n, mp_context=_pool_context()) as ex:
         return list(ex.map(fn, items))
+
+
+def first_difference(a, b, path: str = "result", skip=("scene", "samples")) -> str | None:
+    """Where two results first differ, or None when they are exactly equal.
+
+    For checking a chunked result against the single-process one: dataclasses field
+    by field (``skip`` names inputs passed through, compared by the caller if at all),
+    dicts in key order, sequences, numpy arrays by dtype, shape and every element
+    (NaN equal to NaN), anything else by ``==``.
+    """
+    if dataclasses.is_dataclass(a) and not isinstance(a, type):
+        if type(a) is not type(b):
+            return path
+        for f in dataclasses.fields(a):
+            if f.name not in skip:
+                d = first_difference(getattr(a, f.name), getattr(b, f.name), f"{path}.{f.name}", skip)
+                if d:
+                    return d
+        return None
+    if isinstance(a, dict):
+        if not isinstance(b, dict) or list(a) != list(b):
+            return path
+        return next((d for k in a if (d := first_difference(a[k], b[k], f"{path}[{k!r}]", skip))), None)
+    if isinstance(a, (tuple, list)):
+        if not isinstance(b, (tuple, list)) or len(a) != len(b):
+            return path
+        return next((d for i, (x, y) in enumerate(zip(a, b)) if (d := first_difference(x, y, f"{path}[{i}]", skip))), None)
+    if hasattr(a, "dtype") and hasattr(a, "shape"):
+        import numpy as np
+
+        ok = (isinstance(b, np.ndarray) and a.dtype == b.dtype and a.shape == b.shape
+              and np.array_equal(a, b, equal_nan=a.dtype.kind in "fc"))  # fmt: skip
+        return None if ok else path
+    return None if (a == b or (a != a and b != b)) else path  # NaN equals NaN here

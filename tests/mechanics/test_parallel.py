@@ -1,7 +1,6 @@
 """Chunked work (mechanics.parallel): a local process pool and a Dask LocalCluster started here
 give exactly the single-process results for modes, mu-space maps and torque-band sweeps."""
 
-import dataclasses
 import math
 import operator
 import socket
@@ -16,7 +15,7 @@ from mechanics import QsplanError, scene_from_dict, solve
 from mechanics import mode_chunks, muspace, parallel
 from mechanics.muspace import feasibility_map, grid_points, mu_slice
 from mechanics.numerics import DEFAULT_TOLERANCES
-from mechanics.parallel import chunk_count, map_chunks, split_range
+from mechanics.parallel import chunk_count, first_difference, map_chunks, split_range
 from mechanics.planted import planted_scene
 from planner import bands_sweep
 from planner.bands_sweep import segment_bands
@@ -45,26 +44,8 @@ def _free_port() -> int:
         return s.getsockname()[1]
 
 
-def same(a, b, path="result"):
-    """Exact equality of nested results: dataclasses, dicts, tuples, arrays (NaN equal to NaN)."""
-    if dataclasses.is_dataclass(a) and not isinstance(a, type):
-        assert type(a) is type(b), path
-        for f in dataclasses.fields(a):
-            if f.name not in ("scene", "samples"):  # inputs, passed through (pickled copies)
-                same(getattr(a, f.name), getattr(b, f.name), f"{path}.{f.name}")
-    elif isinstance(a, dict):
-        assert list(a) == list(b), path
-        for k in a:
-            same(a[k], b[k], f"{path}[{k!r}]")
-    elif isinstance(a, (tuple, list)):
-        assert len(a) == len(b), path
-        for i, (x, y) in enumerate(zip(a, b)):
-            same(x, y, f"{path}[{i}]")
-    elif isinstance(a, np.ndarray):
-        assert a.dtype == b.dtype and a.shape == b.shape, path
-        assert np.array_equal(a, b, equal_nan=a.dtype.kind == "f"), path
-    else:
-        assert a == b or (a != a and b != b), path  # floats: NaN equals NaN here
+def same(a, b):
+    assert first_difference(a, b) is None, first_difference(a, b)
 
 
 # --- map_chunks and the chunking rule -------------------------------------------------------
@@ -119,6 +100,15 @@ def test_unreachable_scheduler_exits_2(monkeypatch, capsys):
 def test_cli_bad_workers_exits_2(command, capsys, tmp_path):
     assert main(command + ["--workers", "0"]) == 2
     assert "--workers: expected a positive number" in capsys.readouterr().err
+
+
+def test_first_difference_finds_the_first_mismatch():
+    a = {"x": (np.array([1.0, np.nan]), 3), "y": "z"}
+    assert first_difference(a, {"x": (np.array([1.0, np.nan]), 3), "y": "z"}) is None
+    assert first_difference(a, {"x": (np.array([1.0, 2.0]), 3), "y": "z"}) == "result['x'][0]"
+    assert first_difference(a, {"x": (np.array([1, 0]), 3), "y": "z"}) == "result['x'][0]"  # dtype
+    assert first_difference(a, {"x": (np.array([1.0, np.nan]), 4), "y": "z"}) == "result['x'][1]"
+    assert first_difference(a, {"y": "z", "x": (np.array([1.0, np.nan]), 3)}) == "result"
 
 
 @pytest.mark.parametrize("n, parts", [(0, 3), (1, 4), (7, 3), (10, 10), (5, 1), (100, 7)])
