@@ -37,6 +37,11 @@ class ModeCheck:
     def feasible(self) -> bool:
         return self.status == Status.FEASIBLE
 
+    @property
+    def ill_conditioned(self) -> bool:
+        """``P_AI`` or ``Q_AI`` failed the Hadamard-ratio test (``Tolerances.singular``): undecided."""
+        return self.status in Status.ILL_CONDITIONED
+
 
 def selection_matrix(indices, n: int) -> np.ndarray:
     """Rows ``e_i^T`` for ``i`` in ``indices`` (eq. 12), shape (len(indices), n)."""

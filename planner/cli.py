@@ -105,15 +105,20 @@ def _cmd_modes(args, out):
     if getattr(args, "method", "enumerate") == "lcp":
         return _cmd_modes_lcp(scene, args, out)
     result = solve(scene, **parallel_options(args))
+    from mechanics.numerics import conditioning_verdict
+
+    verdict = conditioning_verdict(result.counts, result.tolerances)
     if args.json:
         from .report import solve_result_to_dict
 
-        json.dump(solve_result_to_dict(result), out)
+        json.dump({**solve_result_to_dict(result), "ill_conditioned": verdict}, out)
         out.write("\n")
         return 0
     from .report import format_solve_result
 
     out.write(format_solve_result(result, source=args.scene))
+    if verdict:
+        out.write(verdict + "\n")
     return 0
 
 

@@ -54,3 +54,21 @@ def test_concurrent_normals_are_exactly_singular():
     scene = make_scene(Wn, Wt, [[1.0], [0.5], [0.25]], [[0.5], [1.0], [-1.0]], [0.5] * 3, [0.0, -1.0, 0.0],
                        joint_velocity=[1.0])  # fmt: skip
     assert exact_check_mode(scene, ContactMode("SSS")).status != Status.KINEMATICS_SINGULAR
+
+
+def test_ill_conditioned_verdict_names_measure_and_threshold():
+    from mechanics.numerics import DEFAULT_TOLERANCES, conditioning_verdict
+
+    r = np.array([[1.0, 0.0], [0.0, 1.0], [-1.0, -1.0]])
+    n = np.array([[-1.0, 0.0], [0.0, -1.0], [1.0, 1.0]])
+    Wn, Wt = wrench_matrices(r, n)
+    scene = make_scene(Wn, Wt, [[1.0], [0.5], [0.25]], [[0.5], [1.0], [-1.0]], [0.5] * 3, [0.0, -1.0, 0.0],
+                       joint_velocity=[1.0])  # fmt: skip
+    # exactly singular (checked exactly), and the float solver declines it instead of guessing
+    assert exact_check_mode(scene, ContactMode("SSS")).status == Status.KINEMATICS_SINGULAR
+    assert check_mode(scene, ContactMode("SSS")).ill_conditioned
+    verdict = conditioning_verdict(solve(scene).counts)
+    assert verdict.startswith("ill-conditioned: 1 mode(s)")
+    assert "Hadamard ratio" in verdict and f"{DEFAULT_TOLERANCES.singular:g}" in verdict
+    well, _ = planted_scene(np.random.default_rng(3), 4, n_effort=1, n_joints=3)
+    assert conditioning_verdict(solve(well).counts) is None
