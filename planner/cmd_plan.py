@@ -2,12 +2,14 @@
 
 ::
 
-    qsplan plan TASK.toml [--out DIR] [--seed S] [--planner NAME] [--force] [--quiet] [--no-plots]
+    qsplan plan TASK.toml [--out DIR] [--seed S] [--planner NAME] [--force] [--quiet] [--no-plots] [--verify N]
 
 Reads the task (:mod:`planner.task`), plans it (:func:`planner.plan.plan_task`:
 in-contact segments through OMPL with the band validity checker, regrasps in
 joint space), and writes into DIR (default ``out/plan``) ``plan.csv`` and
-``plan.json`` (the torque trajectory: :mod:`planner.plan_export`) and, unless
+``plan.json`` (the torque trajectory: :mod:`planner.plan_export`), ``replay.json``
+(the exported file re-simulated, :mod:`planner.replay`, at ``--verify`` friction
+vectors of the interval; exit 1 if any run leaves the planned modes) and, unless
 ``--no-plots``, ``plan_bands.png``, ``mode_timeline.png`` and ``hand_snapshots.png``.
 Existing files are not overwritten without ``--force`` (checked first).  Progress
 lines go to stderr unless ``--quiet``; a summary to stdout.
@@ -23,7 +25,7 @@ import sys
 
 __all__ = ["add_parser", "run", "run_task"]
 
-_FILES = ("plan.csv", "plan.json")
+_FILES = ("plan.csv", "plan.json", "replay.json")
 _PLOTS = ("plan_bands", "mode_timeline", "hand_snapshots")
 
 
@@ -36,6 +38,9 @@ def _common(p, default_out):
     p.add_argument("--force", action="store_true", help="overwrite existing files in DIR")
     p.add_argument("--quiet", action="store_true", help="no progress lines on stderr")
     p.add_argument("--no-plots", action="store_true", help="write the torque trajectory only")
+    p.add_argument("--verify", type=int, default=3, metavar="N",
+                   help="re-simulate the exported plan at N friction vectors from the interval (the two uniform "
+                        "extremes, then seeded random ones; 0: skip; default 3)")  # fmt: skip
 
 
 def add_parser(subparsers):
@@ -55,6 +60,8 @@ def run_task(task, args, out) -> int:
 
     from .plan import DEFAULT_OPTIONS, PlanFailure, plan_task
 
+    if args.verify < 0:
+        raise QsplanError(f"--verify: expected a nonnegative number of friction vectors; got {args.verify}")
     outdir = Path(args.out)
     planned = [outdir / f for f in _FILES] + ([] if args.no_plots else [outdir / f"{n}.png" for n in _PLOTS])
     clash = [str(p) for p in planned if p.exists()]
@@ -90,15 +97,50 @@ def run_task(task, args, out) -> int:
             path = outdir / f"{name}.png"
             save_figure(fig, path)
             files.append(str(path))
+    replays = _verify(plan, outdir / "plan.csv", args, progress)
+    if replays:
+        with open(outdir / "replay.json", "w") as f:
+            json.dump([_replay_dict(r) for r in replays], f, indent=1)
+        files.append(str(outdir / "replay.json"))
     name, t, w = plan.narrowest()
     out.write(f"{task.name}: planned {len(plan.segments)} in-contact segments and {len(plan.phases) - len(plan.segments)} "
               f"regrasps, {plan.duration:.4g} s of motion\n")  # fmt: skip
     out.write(f"planning: {plan.seconds:.3g} s, {plan.validity_checks} validity checks "
               f"({plan.checks_per_second:.4g} per second inside OMPL)\n")  # fmt: skip
     out.write(f"narrowest guaranteed band: {w:.6g} N m at t = {t:.4g} s (resolution {task.torque_resolution:g} N m)\n")
+    for r in replays:
+        out.write(f"re-simulated at {r.summary()}\n")
     for f in files:
         out.write(f"wrote {f}\n")
+    if not all(r.followed for r in replays):
+        sys.stderr.write("qsplan: error: the exported plan left its planned modes in re-simulation (see replay.json)\n")
+        return 1
     return 0
+
+
+def _verify(plan, csv_path, args, progress) -> list:
+    """Re-simulate the exported file (:func:`planner.replay.replay_plan`) at ``args.verify`` friction vectors."""
+    from .plan_export import read_plan_csv
+    from .replay import friction_samples, replay_plan
+
+    mus = friction_samples(plan.task.mu_range, args.verify, args.seed, shared=plan.task.shared_mu)
+    columns = read_plan_csv(csv_path)
+    out = []
+    for mu in mus:
+        progress(f"re-simulating the exported plan at mu = {[round(float(m), 4) for m in mu]}")
+        out.append(replay_plan(columns, plan.task.hand, mu))
+    return out
+
+
+def _replay_dict(r) -> dict:
+    import math
+
+    def num(v):  # JSON has no NaN: null
+        return float(v) if math.isfinite(v) else None
+
+    return {"mu": [float(m) for m in r.mu], "followed": r.followed, "x_error_m": num(r.x_error),
+            "segments": [{"phase": s.phase, "planned_mode": s.planned_mode, "modes": list(s.labels), "stop": s.stop,
+                          "x_error_m": num(s.x_error), "x_end_m": num(s.x_end)} for s in r.segments]}  # fmt: skip
 
 
 def run(args, out) -> int:

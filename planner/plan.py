@@ -25,7 +25,12 @@
 3. **From path to plan.**  Each segment's path is swept every :data:`SWEEP_STEP`,
    time-parameterized at the largest constant speed within the workpiece and joint
    speed limits, and each command is chosen in the guaranteed band with the largest
-   margin (:func:`planner.command.choose_command`); a command outside its band is
+   margin that can be kept along the whole segment: half its narrowest band, from
+   both edges (:func:`planner.command.choose_command` with ``max_margin`` = that
+   half-width).  So the command is the midpoint where the band is narrowest and
+   ``lower + margin`` elsewhere: continuous, and close to the torque the mode needs
+   (the pointwise midpoint runs to many times that torque where the upper edge
+   blows up, and jumps where it becomes infinite).  A command outside its band is
    never emitted (:func:`Plan.check` raises).
 
 When a segment has no path, :class:`PlanFailure` carries a
@@ -224,13 +229,14 @@ class Plan:
         return self.validity_checks / self.ompl_seconds if self.ompl_seconds > 0 else float("nan")
 
     def narrowest(self):
-        """``(segment name, t, width)`` of the narrowest guaranteed band of the plan (s, N m)."""
-        best = (None, np.nan, np.inf)
+        """``(segment name, t, width)`` of the narrowest guaranteed band of the plan (s, N m; width inf when
+        every band is unbounded)."""
+        best = None
         for s in self.segments:
             k = int(np.argmin(s.width))
-            if s.width[k] < best[2]:
+            if best is None or s.width[k] < best[2]:
                 best = (s.name, float(s.t[k]), float(s.width[k]))
-        return best
+        return best or (None, np.nan, np.inf)
 
     def check(self) -> None:
         """Raise :class:`mechanics.QsplanError` unless every command lies in its band with a positive margin."""
@@ -458,7 +464,7 @@ def _segment(task, i, x0, x1, t0, options, progress, counters):
         safety = default_safety_margin(band)
     except QsplanError:  # unbounded everywhere: keep the controller's resolution from the finite edge
         safety = task.torque_resolution
-    command, margin = choose_command(band.lower, band.upper, safety)
+    command, margin = choose_command(band.lower, band.upper, safety, max_margin=safety)
     s = np.concatenate([[0.0], np.cumsum(np.abs(np.diff(x)))])
     v = 1 - (0 if effort == "left" else 1)
     qd = S.qd.copy()

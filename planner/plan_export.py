@@ -107,9 +107,9 @@ def plan_metadata(plan) -> dict:
         "torque_resolution_N_m": task.torque_resolution,
         "limits": {"joints_rad": task.joint_limits.tolist(), "joint_speed_rad_s": task.joint_speed,
                    "workpiece_speed_m_s": task.workpiece_speed},
-        "narrowest_band": {"phase": name, "t_s": t, "width_N_m": _num(w)},
+        "narrowest_band": {"phase": name, "t_s": _num(t), "width_N_m": _num(w)},
         "planner": {"name": plan.options.planner, "seed": plan.options.seed, "seconds": plan.seconds,
-                    "validity_checks": plan.validity_checks, "checks_per_second": plan.checks_per_second},
+                    "validity_checks": plan.validity_checks, "checks_per_second": _num(plan.checks_per_second)},
         "phases": phases,
         "hand": {"workpiece_vertices_m": h.workpiece.tolist(), "workpiece_mass_kg": h.workpiece_mass,
                  "finger_base_m": h.finger_base, "finger_length_m": h.finger_length, "finger_width_m": h.finger_width,
@@ -140,6 +140,7 @@ def export_plan(plan, out_dir, stem: str = "plan", force: bool = False) -> list:
            "data": {k: [_json_value(v) for v in vals] for k, vals in cols.items()}, "metadata": plan_metadata(plan),
            "null": "tau_<joint>_min: unbounded below; tau_<joint>_max: unbounded above; elsewhere: not applicable "
                    "(the joint is velocity-controlled, or a regrasp row)"}  # fmt: skip
+    text = json.dumps(doc, indent=1, allow_nan=False) + "\n"  # before writing anything: no half-written files
     try:
         out.mkdir(parents=True, exist_ok=True)
         with open(paths[0], "w", newline="") as f:
@@ -148,8 +149,7 @@ def export_plan(plan, out_dir, stem: str = "plan", force: bool = False) -> list:
             for row in zip(*(cols[n] for n in names)):
                 w.writerow([_cell(v) for v in row])
         with open(paths[1], "w") as f:
-            json.dump(doc, f, indent=1, allow_nan=False)
-            f.write("\n")
+            f.write(text)
     except OSError as exc:
         raise QsplanError(f"--out: cannot write into {str(out)!r}: {exc.strerror or exc}") from None
     return paths

@@ -1,5 +1,7 @@
 """Planning two-finger tasks: task files, the band guarantee of an exported plan (re-swept independently), failure reports."""
 
+from dataclasses import replace
+
 import numpy as np
 import pytest
 
@@ -8,7 +10,10 @@ from mechanics import QsplanError
 from mechanics.bands import guaranteed_band_box
 from mechanics.modes import ContactMode
 from planner.plan_export import export_plan, read_plan_csv
-from planner.task import load_task, make_task, task_paths
+from mechanics.solver import solve
+from planner.plan import check_free_state
+from planner.replay import friction_samples, replay_plan
+from planner.task import demo_task_path, load_task, make_task, task_paths
 
 
 def test_bundled_tasks_load():
@@ -38,47 +43,103 @@ def test_task_validation_names_the_field(tmp_path, text, match):
 
 
 @pytest.fixture(scope="module")
-def small_plan():
+def demo_files(tmp_path_factory):
+    """The bundled demo task planned once, exported, and read back from the file."""
     from planner.plan import plan_task
 
-    task = make_task(default_hand(), 0.0, [-0.02, 0.0], torque_resolution=0.02, name="small")
-    return plan_task(task)
+    plan = plan_task(load_task(demo_task_path()))
+    out = tmp_path_factory.mktemp("demo")
+    export_plan(plan, out)
+    return plan, out, read_plan_csv(out / "plan.csv")
 
 
-@pytest.mark.ompl
-def test_exported_plan_keeps_every_command_in_an_independently_reswept_band(small_plan, tmp_path):
-    export_plan(small_plan, tmp_path)
-    with pytest.raises(QsplanError, match="exists"):
-        export_plan(small_plan, tmp_path)
-    d = read_plan_csv(tmp_path / "plan.csv")
-    hand = small_plan.task.hand
-    lo, hi = small_plan.task.mu_range
-    rows = np.flatnonzero(d["mode"] == "SSSS")
-    assert rows.size > 50 and set(d["mode"]) == {"SSSS", "free"}
-    for k in rows:
-        pose = np.array([d["x_workpiece"][k], d["y_workpiece"][k], d["theta_workpiece"][k]])
-        q = np.array([d["q_left"][k], d["q_right"][k]])
-        assert np.allclose(q, finger_angles(hand, pose)[0], atol=1e-9)  # the grasp is the tangency
+def _rows(d):
+    """In-contact rows of an exported plan: index, pose (3,), q (2,), effort joint, velocity joint."""
+    for k in np.flatnonzero(d["mode"] != "free"):
         e = str(d["effort_joint"][k])
-        v = "left" if e == "right" else "right"
-        scene = hand_scene(hand, pose, q, e, velocity=d[f"qd_{v}"][k])
-        band = guaranteed_band_box(scene, ContactMode("SSSS"), lo, hi)  # the desired mode, recomputed from the file
-        tau = d[f"tau_{e}"][k]
-        assert band.feasible and band.lower - 1e-9 <= d[f"tau_{e}_min"][k] and d[f"tau_{e}_max"][k] <= band.upper + 1e-9
-        assert d[f"tau_{e}_min"][k] < tau < d[f"tau_{e}_max"][k]
-        assert d[f"tau_{e}_max"][k] - d[f"tau_{e}_min"][k] >= small_plan.task.torque_resolution
-    t = d["t"]
-    assert np.all(np.diff(t) >= 0)
-    qd = np.nan_to_num(np.vstack([d["qd_left"], d["qd_right"]]))
-    assert np.abs(qd).max() <= small_plan.task.joint_speed * (1 + 1e-9)
+        pose = np.array([d["x_workpiece"][k], d["y_workpiece"][k], d["theta_workpiece"][k]])
+        yield k, pose, np.array([d["q_left"][k], d["q_right"][k]]), e, ("left" if e == "right" else "right")
 
 
 @pytest.mark.ompl
-def test_plan_counts_and_checks(small_plan):
-    small_plan.check()
-    assert len(small_plan.segments) == 2 and len(small_plan.phases) == 3
-    assert small_plan.validity_checks > 0 and small_plan.checks_per_second > 0
-    assert small_plan.segments[0].effort_joint == "right"  # the trailing (pushing) finger when sliding left
+def test_demo_export_keeps_every_command_inside_the_desired_modes_exact_band(demo_files, tmp_path):
+    plan, out, d = demo_files
+    with pytest.raises(QsplanError, match="exists"):
+        export_plan(plan, out)  # nothing a user has is overwritten
+    hand, task = plan.task.hand, plan.task
+    lo, hi = task.mu_range
+    assert set(d["mode"]) == {"SSSS", "free"} and np.sum(d["mode"] == "SSSS") > 200
+    for k, pose, q, e, v in _rows(d):
+        assert np.allclose(q, finger_angles(hand, pose)[0], atol=1e-9)  # the grasp is the tangency
+        scene = hand_scene(hand, pose, q, e, velocity=d[f"qd_{v}"][k])
+        band = guaranteed_band_box(scene, ContactMode("SSSS"), lo, hi)  # exact, over the corners of the mu box
+        assert band.feasible and band.lower - 1e-9 <= d[f"tau_{e}_min"][k] and d[f"tau_{e}_max"][k] <= band.upper + 1e-9
+        assert d[f"tau_{e}_min"][k] < d[f"tau_{e}"][k] < d[f"tau_{e}_max"][k]
+        assert d[f"tau_{e}_max"][k] - d[f"tau_{e}_min"][k] >= task.torque_resolution
+    assert np.all(np.diff(d["t"]) >= 0)
+    qd = np.nan_to_num(np.vstack([d["qd_left"], d["qd_right"]]))
+    assert np.abs(qd).max() <= task.joint_speed * (1 + 1e-9)
+
+
+@pytest.mark.ompl
+def test_demo_commands_leave_4s_the_only_feasible_mode_at_sampled_friction(demo_files):
+    """A second method: the full all-modes solver with the exported command as the effort, at the corners of the
+    friction box and seeded random points inside it, must find 4S alone, sliding the planned way."""
+    plan, _, d = demo_files
+    lo, hi = plan.task.mu_range
+    rng = np.random.default_rng(7)
+    corners = np.array(np.meshgrid(*[[lo, hi]] * 4)).reshape(4, -1).T
+    mus = np.vstack([corners, rng.uniform(lo, hi, (4, 4))])
+    checked = 0
+    for k, pose, q, e, v in list(_rows(d))[::3]:
+        scene = hand_scene(plan.task.hand, pose, q, e, velocity=d[f"qd_{v}"][k], effort=d[f"tau_{e}"][k])
+        nxt = min(k + 1, d["t"].size - 1)
+        direction = np.sign(d["x_workpiece"][nxt] - d["x_workpiece"][k - 1 if nxt == k else k])
+        for mu in mus:
+            res = solve(replace(scene, mu=mu))
+            assert res.feasible_modes == ["SSSS"], (k, mu, res.feasible_modes)
+            sol = res.solutions[0]
+            assert sol.max_residual < 1e-9
+            xdot = sol.qdot[0] - sol.qdot[2] * pose[1]  # the centre of mass's velocity (the world origin is the palm's)
+            assert np.sign(xdot) == direction
+            checked += 1
+    assert checked > 1500
+
+
+@pytest.mark.ompl
+def test_demo_export_resimulated_follows_the_planned_modes(demo_files):
+    plan, _, d = demo_files
+    for mu in friction_samples(plan.task.mu_range, 3, seed=3):
+        r = replay_plan(d, plan.task.hand, mu)
+        assert r.followed, r.summary()
+        assert [s.labels for s in r.segments] == [("SSSS",)] * 3
+        assert r.x_error < 1e-6  # the 4S motion is fixed by the kinematics: the planned path, to integration error
+
+
+@pytest.mark.ompl
+def test_resimulation_catches_commands_outside_the_band(demo_files):
+    plan, _, d = demo_files
+    e = str(d["effort_joint"][0])
+    bad = dict(d)
+    bad[f"tau_{e}"] = np.where(d["mode"] != "free", d[f"tau_{e}_min"] - 0.5, np.nan)
+    r = replay_plan(bad, plan.task.hand, plan.task.mu_range[1])
+    assert not r.followed and r.segments[0].phase == 0
+    assert "feasible modes" in r.segments[0].stop
+
+
+@pytest.mark.ompl
+def test_plan_counts_and_checks(demo_files):
+    plan = demo_files[0]
+    plan.check()
+    assert len(plan.segments) == 3 and len(plan.phases) == 5
+    assert plan.validity_checks > 0 and plan.checks_per_second > 0
+    assert plan.segments[0].effort_joint == "right"  # the trailing (pushing) finger when sliding left
+    for seg in plan.segments:  # each command keeps half the narrowest band of its segment from both edges
+        half = 0.5 * np.min(seg.width)
+        assert np.all(seg.margin >= half * (1 - 1e-12)) and np.all(seg.command - seg.lower >= half * (1 - 1e-12))
+    for ph in plan.phases[1::2]:  # regrasps: collision-free, the fingers end where they started
+        assert all(check_free_state(plan.task, ph.x, q) for q in ph.q[1:-1])
+        assert np.allclose(ph.q[0], ph.q[-1])
 
 
 @pytest.mark.ompl

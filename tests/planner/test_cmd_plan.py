@@ -1,0 +1,72 @@
+"""``qsplan plan`` / ``qsplan demo``: outputs, re-simulation, refusing to overwrite, failure reports (exit 2)."""
+
+import json
+
+import pytest
+
+from planner.cli import main
+from planner.plan_export import read_plan_csv
+
+SMALL_TASK = """
+name = "small"
+[hand]
+workpiece = [[0.0, 0.0], [0.080, 0.0], [0.085, 0.080], [0.008, 0.100]]
+[motion]
+start_x = 0.0
+waypoints = [-0.02, 0.0]
+[friction]
+range = [0.0, 0.2]
+[controller]
+torque_resolution = 0.02
+"""
+
+
+def run(args, capsys):
+    code = main(args)
+    out, err = capsys.readouterr()
+    return code, out, err
+
+
+@pytest.mark.ompl
+def test_plan_writes_the_trajectory_and_its_resimulation(tmp_path, capsys):
+    task = tmp_path / "small.toml"
+    task.write_text(SMALL_TASK)
+    out = tmp_path / "out"
+    code, stdout, err = run(["plan", str(task), "--out", str(out), "--no-plots", "--verify", "2", "--quiet"], capsys)
+    assert code == 0 and err == ""
+    assert "planned 2 in-contact segments and 1 regrasps" in stdout
+    assert stdout.count("re-simulated at mu = ") == 2 and "followed SSSS SSSS" in stdout
+    d = read_plan_csv(out / "plan.csv")
+    assert set(d["mode"]) == {"SSSS", "free"}
+    replays = json.loads((out / "replay.json").read_text())
+    assert [r["mu"] for r in replays] == [[0.0] * 4, [0.2] * 4] and all(r["followed"] for r in replays)
+    assert {s["planned_mode"] for r in replays for s in r["segments"]} == {"SSSS"}
+    # a second run refuses to overwrite, in one line, before planning
+    before = (out / "plan.csv").read_bytes()
+    code, stdout, err = run(["plan", str(task), "--out", str(out), "--no-plots", "--quiet"], capsys)
+    assert code == 2 and err.count("\n") == 1 and "--force" in err and "exists" in err
+    assert (out / "plan.csv").read_bytes() == before
+
+
+@pytest.mark.ompl
+def test_infeasible_task_fails_with_a_named_report(tmp_path, capsys):
+    task = tmp_path / "wide.toml"
+    task.write_text(SMALL_TASK.replace("range = [0.0, 0.2]", "range = [0.0, 0.5]").replace("[-0.02, 0.0]", "[-0.04]")
+                    .replace("torque_resolution = 0.02", "torque_resolution = 0.05"))  # fmt: skip
+    code, stdout, err = run(["plan", str(task), "--out", str(tmp_path / "o"), "--quiet"], capsys)
+    assert code == 2 and err.startswith("qsplan: error: ") and err.count("\n") == 1
+    assert "band closes at x in" in err and "failure.json" in err
+    report = json.loads((tmp_path / "o" / "failure.json").read_text())
+    assert report["message"] in err and report["mu_closes"] is not None
+
+
+@pytest.mark.parametrize("args, match", [
+    (["plan", "missing.toml"], "task: cannot read"),
+    (["plan", "TASK", "--verify", "-1"], "--verify"),
+])  # fmt: skip
+def test_bad_input_is_one_line_exit_2(tmp_path, capsys, args, match):
+    task = tmp_path / "t.toml"
+    task.write_text(SMALL_TASK)
+    args = [str(task) if a == "TASK" else a for a in args]
+    code, stdout, err = run(args + ["--out", str(tmp_path / "o")], capsys)
+    assert code == 2 and match in err and err.count("\n") == 1 and "Traceback" not in err
