@@ -155,19 +155,23 @@ def chunks_sent(monkeypatch):
 
 @pytest.fixture(scope="module")
 def mode_scene():
-    """A seeded scene with 8953 modes (n_c = 10, 3 + |tau_I| = 10) and a planted feasible mode."""
-    scene, planted = planted_scene(np.random.default_rng(7), 10, 7, 9)
+    """A seeded scene with 73789 modes (n_c = 12, 3 + |tau_I| = 12) and a planted feasible mode.
+
+    With this seed, arrays as Dask delivers them (unaligned views of its frames) changed
+    the last bits of a residual of eq. (2): the test caught that before map_chunks unpickled
+    the items itself."""
+    scene, planted = planted_scene(np.random.default_rng(1995), 12, 9, 11)
     return scene, planted
 
 
 @pytest.fixture(scope="module")
 def mode_reference(mode_scene):
-    return solve(mode_scene[0], batch=512, keep_statuses=True, workers=1)
+    return solve(mode_scene[0], batch=4096, keep_statuses=True, workers=1)
 
 
 def _chunked_solve(monkeypatch, scene, **kw):
     monkeypatch.setattr(mode_chunks, "MIN_CHUNK_MODES", 1)  # split even this small scene
-    return solve(scene, batch=512, keep_statuses=True, **kw)
+    return solve(scene, batch=4096, keep_statuses=True, **kw)
 
 
 def test_modes_identical_on_pool(monkeypatch, chunks_sent, mode_scene, mode_reference):
