@@ -52,7 +52,7 @@ from mechanics.feasibility import velocity_scale
 from mechanics.lcp import solve_lcp
 from mechanics.modes import mode_index_array
 from mechanics.numerics import DEFAULT_TOLERANCES, Status, hadamard_ratio
-from mechanics.solver import ScenePool, _assemble, equilibrium_matrix, kinematics_stage  # rows of P_AI as the solver builds them
+from mechanics.solver import ScenePool, equilibrium_matrix, kinematics_stage
 
 CHARTS = Path(__file__).resolve().parent / "charts"
 FAMILIES = ("concurrent", "parallel", "slip", "cone", "mu")
@@ -164,8 +164,9 @@ def mode_conditioning(scene):
     codes = mode_index_array(scene.n_contacts, scene.dof)
     pool = ScenePool(scene)
     tol0 = replace(DEFAULT_TOLERANCES, singular=0.0)
-    idx, _, _ = _assemble(scene, codes)
-    h = hadamard_ratio(pool.M[idx])
+    mask = np.concatenate([codes != 0, codes == 1], axis=1)  # applicable rows [n-rows; t-rows] (eq. 14)
+    idx = np.argsort(~mask, axis=1, kind="stable")[:, : scene.dof]
+    h = hadamard_ratio(pool.M[idx])  # P_AI (eq. 23)
     _, live, kin = kinematics_stage(scene, pool, codes, tol0, DEFAULT_TOLERANCES.velocity * velocity_scale(scene))
     if live.size:
         Q = equilibrium_matrix(pool, kin, np.broadcast_to(scene.mu, (live.size, scene.n_contacts)))
