@@ -260,7 +260,7 @@ def print_tables(mode_rows, scene_rows, sweep):
     print(f"{'h in':>20} {'modes':>6} {'wrong':>6} {'flagged':>8} {'declined':>9}")
     for lo, hi, w, f, d, m in _bins(mode_rows):
         print(f"[{lo:8.0e}, {hi:8.0e}) {m:>6} {w:>6} {f:>8} {d:>9}")
-    print("\nThreshold sweep over Tolerances.singular (all modes of all scenes): wrong answers left, "
+    print("\nThreshold sweep over Tolerances.singular (all modes of all scenes): false modes (incl. flagged on_boundary), "
           "exactly feasible modes declined as singular")  # fmt: skip
     print(f"{'threshold':>10} {'false':>6} {'missed':>7} {'declined':>9} {'exceptions':>11} {'modes':>6}")
     for T in THRESHOLDS:
