@@ -106,7 +106,8 @@ def conditioning_verdict(counts: dict, tol: Tolerances = DEFAULT_TOLERANCES) -> 
         return None
     return (
         f"ill-conditioned: {k + q} mode(s) undecided, Hadamard ratio of P_AI (eq. 23: {k}) or Q_AI "
-        f"(eq. 26: {q}) below Tolerances.singular = {tol.singular:g}; the feasible set may lack them"
+        f"(eq. 26: {q}) below Tolerances.singular = {tol.singular:g}; exactly singular ones are outside the "
+        "model (eq. 32), nearly singular ones may be feasible and are missing from the set"
     )
 
 

@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from mechanics import SolveResult
+from mechanics.numerics import Status
 
 __all__ = ["solve_result_to_dict", "format_solve_result"]
 
@@ -57,7 +58,11 @@ def format_solve_result(result: SolveResult, source: str = "") -> str:
     lines = []
     joints = "contact velocities given" if scene.virtual_joints else f"{scene.n_joints} joint{'s' if scene.n_joints != 1 else ''} ({len(scene.effort_joints)} effort-controlled)"
     lines.append(f"scene {source}: {scene.n_contacts} contacts, {joints}; modes tested: {result.modes_tested} (eq. 49)")
-    if result.jammed:
+    undecided = sum(result.counts.get(k, 0) for k in Status.DEGENERATE)
+    if result.jammed and undecided:
+        lines.append(f"no feasible mode found, but {undecided} mode(s) were not decided (degenerate or ill-conditioned, "
+                     "see below): not a proven jam")  # fmt: skip
+    elif result.jammed:
         lines.append("no feasible mode: the scene jams (or the model has no quasistatic solution)")
     else:
         verdict = "AMBIGUOUS: several modes are feasible" if result.ambiguous else "unique"

@@ -150,3 +150,18 @@ def test_geometric_scene_file(capsys):
     assert code == 0 and [f["mode"] for f in doc["feasible"]] == ["SSS"]
     f = doc["feasible"][0]
     assert f["qdot"][0] > 0 and abs(f["qdot"][2]) < 1e-12 and len(f["joint_efforts"]) == 1
+
+
+def test_no_feasible_mode_with_undecided_modes_is_not_called_a_jam():
+    from mechanics import SolveResult
+    from mechanics.scene_io import scene_from_dict
+    from mechanics.numerics import Status
+    from planner.report import format_solve_result
+
+    scene = scene_from_dict(eq42_scene(0.5))
+    counts = dict.fromkeys(Status.ORDER, 0)
+    counts.update(kinematics_singular=1, coulomb_violated=6)
+    text = format_solve_result(SolveResult(scene=scene, modes_tested=7, solutions=(), counts=counts))
+    assert "not a proven jam" in text and "the scene jams" not in text
+    counts.update(kinematics_singular=0, coulomb_violated=7)
+    assert "the scene jams" in format_solve_result(SolveResult(scene=scene, modes_tested=7, solutions=(), counts=counts))
