@@ -30,6 +30,7 @@ __all__ = [
     "mode_index_array",
     "iter_mode_batches",
     "codes_to_letters",
+    "mode_order_key",
 ]
 
 
@@ -218,3 +219,10 @@ def mode_index_array(n_contacts: int, dof: int) -> np.ndarray:
 def codes_to_letters(codes) -> str:
     """One row of a letter-code array (0/1/2) as mode letters (``B``/``R``/``S``)."""
     return "".join("BRS"[int(c)] for c in codes)
+
+
+def mode_order_key(letters: str) -> tuple:
+    """Sort key giving the order of :func:`enumerate_modes`: ``n_R``, then the rolling set, then
+    the sliding set, lexicographically (0-based indices)."""
+    R = tuple(i for i, c in enumerate(letters) if c == "R")
+    return len(R), R, tuple(i for i, c in enumerate(letters) if c == "S")

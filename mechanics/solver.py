@@ -33,7 +33,15 @@ __all__ = [
     "check_mode_fits",
     "equilibrium_stage",
     "ScenePool",
+    "test_codes",
+    "SEARCH_MIN_MODES",
 ]
+
+#: Fewest modes (eq. 49) for which ``search="auto"`` prunes breaking sets
+#: (:mod:`mechanics.mode_search`): below it one programme per breaking set costs
+#: more than testing every mode (benchmarks/bench_scale.py: n_c = 12, 73,789 modes,
+#: is about even).
+SEARCH_MIN_MODES = 200_000
 
 #: Modes per batch.  Memory per batch is about ``batch * k * (k + n_j) * 8`` bytes
 #: several times over; 8192 keeps it to a few MB for k <= 20 and amortises numpy's
@@ -321,6 +329,47 @@ def equilibrium_stage(scene: Scene, pool: "ScenePool", kin: Kinematics, mu: np.n
     return status, c_n, c_t, tau, worst <= ftol
 
 
+def test_codes(scene: Scene, codes: np.ndarray, tol: Tolerances = DEFAULT_TOLERANCES, residuals: bool = True,
+               *, pool: "ScenePool | None" = None, vtol: float | None = None):  # fmt: skip
+    """Test a batch of modes: kinematics (24-25, 16), then equilibrium and Coulomb (26-28) for the survivors.
+
+    Parameters
+    ----------
+    codes : ndarray of uint8, shape (m, n_c)
+        Letter codes (0 B, 1 R, 2 S), each mode with ``2 n_R + n_S = 3 + |tau_I|``.
+    pool, vtol : optional
+        The scene's :class:`ScenePool` and absolute velocity tolerance, if already computed.
+
+    Returns
+    -------
+    status : ndarray of int8, shape (m,)
+        Codes into ``Status.ORDER``.
+    solutions : list of ModeSolution
+        The feasible modes, in the order of ``codes``.
+    """
+    n_c = scene.n_contacts
+    pool = ScenePool(scene) if pool is None else pool
+    vtol = tol.velocity * velocity_scale(scene) if vtol is None else vtol
+    tau_e = np.nan_to_num(scene.joint_effort)[pool.E]
+    sols = []
+    status, live, kin = kinematics_stage(scene, pool, codes, tol, vtol)
+    if live.size:
+        m = live.size
+        st, c_n, c_t, tau, boundary = equilibrium_stage(
+            scene, pool, kin, np.broadcast_to(scene.mu, (m, n_c)), np.broadcast_to(tau_e, (m, tau_e.size)), tol
+        )
+        status[live] = st
+        for j in np.flatnonzero(st == _FEAS):
+            sol = ModeSolution(
+                mode=ContactMode(codes_to_letters(kin.codes[j])), qdot=kin.qdot[j], thetadot=kin.thetadot[j],
+                c_n=c_n[j], c_t=c_t[j], tau=tau[j], xi=kin.xi[j].astype(int), on_boundary=bool(boundary[j]),
+            )  # fmt: skip
+            if residuals:
+                sol = replace(sol, residuals=model_residuals(scene, sol))
+            sols.append(sol)
+    return status, sols
+
+
 def solve(
     scene: Scene,
     tol: Tolerances = DEFAULT_TOLERANCES,
@@ -331,6 +380,7 @@ def solve(
     workers: int | None = None,
     scheduler=None,
     batches: tuple[int, int] | None = None,
+    search: str = "auto",
 ) -> SolveResult:
     """Find every feasible contact mode of ``scene`` (Sections 3.1-3.2).
 
@@ -352,12 +402,28 @@ def solve(
         Send the chunks to a Dask cluster instead (:func:`mechanics.parallel.map_chunks`).
     batches : (int, int), optional
         Test only batches ``lo <= i < hi`` of the enumeration (one chunk's share).
+    search : {"auto", "prune", "all"}
+        ``"all"`` tests every mode; ``"prune"`` tests only the modes whose breaking
+        set admits equilibrium (:func:`mechanics.mode_search.search_solve`, the same
+        solutions, the untested modes counted under ``PRUNED``); ``"auto"`` prunes
+        from :data:`SEARCH_MIN_MODES` modes on.  ``keep_statuses`` and ``batches``
+        always test every mode.
 
     Returns
     -------
     SolveResult
         The same (bit for bit) however it was split.
     """
+    if search not in ("auto", "prune", "all"):
+        from .errors import QsplanError
+
+        raise QsplanError(f"search: expected 'auto', 'prune' or 'all'; got {search!r}")
+    if search == "auto":
+        search = "prune" if count_modes(scene.n_contacts, scene.dof) >= SEARCH_MIN_MODES else "all"
+    if search == "prune" and batches is None and not keep_statuses:
+        from .mode_search import search_solve
+
+        return search_solve(scene, tol, batch, residuals, workers=workers, scheduler=scheduler)
     if batches is None and (workers != 1 or scheduler is not None):
         from .mode_chunks import solve_in_chunks
 
@@ -371,23 +437,9 @@ def solve(
     vtol = tol.velocity * velocity_scale(scene)
     kept: list = []
     pool = ScenePool(scene)
-    tau_e = np.nan_to_num(scene.joint_effort)[pool.E]
     for codes in islice(iter_mode_batches(n_c, dof, batch), *(batches or (None,))):
-        status, live, kin = kinematics_stage(scene, pool, codes, tol, vtol)
-        if live.size:
-            m = live.size
-            st, c_n, c_t, tau, boundary = equilibrium_stage(
-                scene, pool, kin, np.broadcast_to(scene.mu, (m, n_c)), np.broadcast_to(tau_e, (m, tau_e.size)), tol
-            )
-            status[live] = st
-            for j in np.flatnonzero(st == _FEAS):
-                sol = ModeSolution(
-                    mode=ContactMode(codes_to_letters(kin.codes[j])), qdot=kin.qdot[j], thetadot=kin.thetadot[j],
-                    c_n=c_n[j], c_t=c_t[j], tau=tau[j], xi=kin.xi[j].astype(int), on_boundary=bool(boundary[j]),
-                )  # fmt: skip
-                if residuals:
-                    sol = replace(sol, residuals=model_residuals(scene, sol))
-                sols.append(sol)
+        status, found = test_codes(scene, codes, tol, residuals, pool=pool, vtol=vtol)
+        sols.extend(found)
         for code, cnt in enumerate(np.bincount(status, minlength=len(_STATUS))):
             counts[_STATUS[code]] += int(cnt)
         if keep_statuses:
