@@ -15,9 +15,9 @@ or ``PYTHONPATH=.``: ``python benchmarks/bench_parallel.py [--repeat 3]``.
 
 import argparse
 import inspect
-import time
 
 import numpy as np
+from bench_muspace import best_of  # the script's own folder is on sys.path
 
 from hands.paper import eq42_scene
 from hands.segments import first_segment, sample_segment
@@ -29,15 +29,6 @@ from mechanics.planted import planted_scene
 from planner.bands_sweep import segment_bands
 
 SEED = 1995
-
-
-def best_of(f, repeat):
-    best, out = np.inf, None
-    for _ in range(repeat):
-        t = time.perf_counter()
-        out = f()
-        best = min(best, time.perf_counter() - t)
-    return best, out
 
 
 def tasks():
