@@ -30,6 +30,7 @@ from .graphical import GraphicalTest, graphical_test, graphical_test_mode
 from .modes import ContactMode, count_modes, enumerate_modes, iter_mode_batches, mode_from_letters
 from .multilinear import Multilinear
 from .muspace import MuMap, MuSlice, boundary_agreement, feasibility_map, grid_points, mu_slice, polynomial_map
+from .parallel import map_chunks
 from .partition import Partition, effort_partitions, partition_table
 from .regions import MuRegion, appendix_a, appendix_b, mode_kinematics, mode_region, region_3s, region_rs
 from .numerics import DEFAULT_TOLERANCES, Status, Tolerances
@@ -86,6 +87,7 @@ __all__ = [
     "grid_points",
     "mu_slice",
     "polynomial_map",
+    "map_chunks",
     "Partition",
     "effort_partitions",
     "partition_table",

@@ -153,7 +153,8 @@ def map_chunks(fn, items, *, workers=None, scheduler=None) -> list:
         Picklable arguments, one per chunk of work.
     workers : int or None
         Local processes; ``None`` means all cores, 1 means in-process (no pool).
-        A single item always runs in-process.  Ignored when ``scheduler`` is given.
+        A single item always runs in-process.  Ignored when ``scheduler`` is given
+        (callers then use it as the number of chunks: :func:`chunk_count`).
     scheduler : str or dask.distributed.Client or None
         Address of a Dask scheduler (``"tcp://host:8786"``) or a connected client:
         the chunks run on that cluster.  A client passed in is left open.
