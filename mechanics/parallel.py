@@ -153,8 +153,9 @@ def map_chunks(fn, items, *, workers=None, scheduler=None) -> list:
         Picklable arguments, one per chunk of work.
     workers : int or None
         Local processes; ``None`` means all cores, 1 means in-process (no pool).
-        A single item always runs in-process.  Ignored when ``scheduler`` is given
-        (callers then use it as the number of chunks: :func:`chunk_count`).
+        A single item, or a call from a daemon process, runs in-process.  Ignored
+        when ``scheduler`` is given (callers then use it as the number of chunks:
+        :func:`chunk_count`).
     scheduler : str or dask.distributed.Client or None
         Address of a Dask scheduler (``"tcp://host:8786"``) or a connected client:
         the chunks run on that cluster.  A client passed in is left open.
@@ -181,7 +182,7 @@ def map_chunks(fn, items, *, workers=None, scheduler=None) -> list:
             if owned:
                 client.close()
     n = min(resolve_workers(workers), len(items))
-    if n <= 1:
+    if n <= 1 or multiprocessing.current_process().daemon:  # a daemon (a Dask worker) may not start processes
         return [fn(item) for item in items]
     with ProcessPoolExecutor(max_workers=n, mp_context=_pool_context()) as ex:
         return list(ex.map(fn, items))

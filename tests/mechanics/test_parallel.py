@@ -4,6 +4,7 @@ give exactly the single-process results for modes, mu-space maps and torque-band
 import math
 import operator
 import socket
+from functools import partial
 
 import numpy as np
 import pytest
@@ -61,6 +62,12 @@ def test_map_chunks_on_cluster_keeps_input_order(client):
     items = [float(i) for i in range(20)]
     assert map_chunks(math.sqrt, items, scheduler=client) == [math.sqrt(x) for x in items]
     assert map_chunks(math.sqrt, items, scheduler=client.scheduler.address) == [math.sqrt(x) for x in items]
+
+
+def test_pool_inside_a_cluster_worker_runs_in_process(client):
+    # a Dask worker is a daemon process, which may not start a pool of its own
+    nested = partial(map_chunks, workers=2)
+    assert client.submit(nested, operator.neg, [1, 2, 3], pure=False).result(timeout=CLUSTER_TIMEOUT) == [-1, -2, -3]
 
 
 def test_errors_in_chunks_propagate():
