@@ -4,6 +4,7 @@ give exactly the single-process results for modes, mu-space maps and torque-band
 import math
 import operator
 import socket
+import sys
 from functools import partial
 
 import numpy as np
@@ -91,6 +92,12 @@ def test_unreachable_scheduler_is_a_clean_error(monkeypatch):
     address = f"tcp://127.0.0.1:{_free_port()}"
     with pytest.raises(QsplanError, match=f"--scheduler {address}: cannot reach a Dask scheduler"):
         map_chunks(abs, [1], scheduler=address)
+
+
+def test_missing_dask_names_the_extra(monkeypatch):
+    monkeypatch.setitem(sys.modules, "distributed", None)  # import distributed -> ImportError
+    with pytest.raises(QsplanError, match=r"needs Dask distributed; install it with: pip install 'qsplan\[cluster\]'"):
+        map_chunks(abs, [1], scheduler="tcp://127.0.0.1:8786")
 
 
 def test_unreachable_scheduler_exits_2(monkeypatch, capsys):
