@@ -2,7 +2,7 @@
 
 ::
 
-    qsplan plan TASK.toml [--out DIR] [--seed S] [--planner NAME] [--force] [--quiet] [--no-plots] [--verify N]
+    qsplan plan TASK.toml [--out DIR] [--seed S] [--planner NAME] [--time-limit SECONDS] [--force] [--quiet] [--no-plots] [--verify N]
 
 Reads the task (:mod:`planner.task`), plans it (:func:`planner.plan.plan_task`:
 in-contact segments through OMPL with the band validity checker, regrasps in
@@ -35,6 +35,8 @@ def _common(p, default_out):
     p.add_argument("--out", default=default_out, metavar="DIR", help=f"output directory (default {default_out})")
     p.add_argument("--seed", type=int, default=1, metavar="S", help="OMPL's random seed (default 1)")
     p.add_argument("--planner", choices=PLANNERS, default="RRTConnect", help="OMPL planner (default RRTConnect)")
+    p.add_argument("--time-limit", type=float, default=None, metavar="SECONDS",
+                   help="time limit of each OMPL query (default 120; the iteration budget decides first)")
     p.add_argument("--force", action="store_true", help="overwrite existing files in DIR")
     p.add_argument("--quiet", action="store_true", help="no progress lines on stderr")
     p.add_argument("--no-plots", action="store_true", help="write the torque trajectory only")
@@ -75,7 +77,10 @@ def run_task(task, args, out) -> int:
             err.write(f"[qsplan] {line}\n")
             err.flush()
 
-    options = replace(DEFAULT_OPTIONS, seed=args.seed, planner=args.planner)
+    limit = DEFAULT_OPTIONS.time_limit if args.time_limit is None else args.time_limit
+    if not (limit > 0 and limit < float("inf")):
+        raise QsplanError(f"--time-limit: expected a positive number of seconds; got {args.time_limit}")
+    options = replace(DEFAULT_OPTIONS, seed=args.seed, planner=args.planner, time_limit=limit)
     progress(f"task {task.name!r}: {len(task.waypoints)} in-contact segments, mu in {list(task.mu_range)}, "
              f"torque resolution {task.torque_resolution:g} N m")  # fmt: skip
     try:

@@ -78,7 +78,9 @@ MODE = "SSSS"
 
 #: RRTConnect, deterministic, seed 1; edges checked every 2 % of the range (0.8 mm over a 4 cm
 #: segment, below the 0.5 mm dense sweep that follows only by a factor 1.6: the sweep is the guarantee).
-DEFAULT_OPTIONS = PlannerOptions(validity_resolution=0.02, iterations=2_000)
+#: The iteration budget decides (same inputs, same plan); the time limit per OMPL query (s) is a
+#: safety net well above the few seconds a query takes, so a loaded machine does not change the answer.
+DEFAULT_OPTIONS = PlannerOptions(validity_resolution=0.02, iterations=2_000, time_limit=120.0)
 
 
 class PlanFailure(QsplanError):

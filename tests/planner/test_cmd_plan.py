@@ -63,6 +63,7 @@ def test_infeasible_task_fails_with_a_named_report(tmp_path, capsys):
 @pytest.mark.parametrize("args, match", [
     (["plan", "missing.toml"], "task: cannot read"),
     (["plan", "TASK", "--verify", "-1"], "--verify"),
+    (["plan", "TASK", "--time-limit", "0"], "--time-limit"),
 ])  # fmt: skip
 def test_bad_input_is_one_line_exit_2(tmp_path, capsys, args, match):
     task = tmp_path / "t.toml"
