@@ -1,6 +1,6 @@
 """Benchmark: chunked work in-process, on a local process pool and on a Dask LocalCluster.
 
-For each task (every mode of a seeded n_c = 12 scene by the plain batch solve; a
+For each task (every mode of a seeded n_c = 13 scene by the plain batch solve; a
 400 x 400 mu-space map of eq. (42) by ``feasibility_map``; a 2000 x 2000 slice by the
 polynomial path; the torque bands along 200 samples of segment 1) prints one row
 per way of running it: 1 worker (in-process), 2 local workers, and a local Dask
@@ -33,7 +33,7 @@ SEED = 1995
 
 def tasks():
     """``(name, f(**parallel_kwargs))`` for each task."""
-    scene12, _ = planted_scene(np.random.default_rng(SEED), 12, 9, 11)
+    scene13, _ = planted_scene(np.random.default_rng(SEED), 13, 10, 12)
     plain = {"search": "all"} if "search" in inspect.signature(solve).parameters else {}
     eq42 = scene_from_dict(eq42_scene(0.5))
     xs400 = np.linspace(0.0, 1.5, 400)
@@ -41,7 +41,7 @@ def tasks():
     xs2000 = np.linspace(0.0, 1.5, 2000)
     samples = sample_segment(first_segment(default_hand()), 200)
     return [
-        ("modes, n_c = 12 (73789 modes)", lambda **kw: solve(scene12, **plain, **kw)),
+        ("modes, n_c = 13 (212941 modes)", lambda **kw: solve(scene13, **plain, **kw)),
         ("feasibility_map 400 x 400", lambda **kw: feasibility_map(eq42, pts400, **kw)),
         ("mu_slice polynomial 2000 x 2000", lambda **kw: mu_slice(eq42, 0, 1, xs2000, xs2000, **kw)),
         ("segment_bands, 200 samples", lambda **kw: segment_bands(samples, **kw)),

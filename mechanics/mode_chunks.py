@@ -16,10 +16,10 @@ from .parallel import chunk_count, map_chunks, split_range
 
 __all__ = ["MIN_CHUNK_MODES", "solve_in_chunks", "merge_results"]
 
-#: Fewest modes worth a chunk of their own: one core tests ~1.2e5 modes/s (n_c = 12,
-#: benchmarks/bench_modes.py), so 16384 modes are ~0.14 s, several times a local
-#: pool's start-up; fewer modes stay in-process.
-MIN_CHUNK_MODES = 16384
+#: Fewest modes worth a chunk of their own: one core tests ~2.5e5 modes/s (n_c = 12..14),
+#: so 65536 modes are ~0.25 s.  Two workers gained nothing on n_c = 12 (73789 modes,
+#: ~0.3 s, which now stays in-process) and 1.5x from n_c = 13 on (bench_parallel.py).
+MIN_CHUNK_MODES = 65536
 
 
 def _solve_chunk(job):

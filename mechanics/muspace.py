@@ -49,9 +49,9 @@ MAP_BATCH = 1 << 16
 MIN_CHUNK_ROWS = 150_000
 
 #: The same for the polynomial path of :func:`mu_slice`, split by modes.  It runs at
-#: ~2e7 rows/s and is bound by memory bandwidth: on two shared cores a pool of two
-#: ran 0.5x to 1.6x as fast at 2000^2 points x 5 modes (benchmarks/bench_parallel.py),
-#: so a chunk must hold ~0.5 s of work.
+#: ~2e7 rows/s and is bound by memory bandwidth: two local workers ran 1.3x as fast
+#: at 2000^2 points x 5 modes (benchmarks/bench_parallel.py), so a chunk must hold
+#: ~0.5 s of work.
 MIN_CHUNK_POLYNOMIAL_ROWS = 10_000_000
 
 

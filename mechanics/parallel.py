@@ -93,6 +93,19 @@ def chunk_count(n_units: int, min_units: int, *, workers=None, scheduler=None) -
     return max(1, min(cap, n_units // max(1, min_units)))
 
 
+def _one_blas_thread():
+    """Pool initializer: one BLAS thread per worker process.
+
+    The workers already fill the cores; a forked worker would otherwise keep the
+    parent's BLAS thread pool, and two workers with two BLAS threads each ran the
+    n_c = 12..14 mode solves 0.75-0.86x as fast as one process instead of 1.5-1.9x
+    (benchmarks/bench_parallel.py).  Dask's workers do the same by default.
+    """
+    from threadpoolctl import threadpool_limits
+
+    threadpool_limits(limits=1)
+
+
 def _pool_context():
     # fork starts a worker in ~10 ms instead of ~0.5 s (spawn re-imports numpy and
     # scipy), but forking a process that runs other threads (a Dask client's event
@@ -184,7 +197,7 @@ def map_chunks(fn, items, *, workers=None, scheduler=None) -> list:
     n = min(resolve_workers(workers), len(items))
     if n <= 1 or multiprocessing.current_process().daemon:  # a daemon (a Dask worker) may not start processes
         return [fn(item) for item in items]
-    with ProcessPoolExecutor(max_workers=n, mp_context=_pool_context()) as ex:
+    with ProcessPoolExecutor(max_workers=n, mp_context=_pool_context(), initializer=_one_blas_thread) as ex:
         return list(ex.map(fn, items))
 
 
