@@ -48,12 +48,15 @@ from math import comb
 import numpy as np
 
 from .modes import _combinations, count_modes, mode_order_key
-from .numerics import DEFAULT_TOLERANCES, Status, Tolerances
+from .feasibility import velocity_scale
+from .numerics import DEFAULT_TOLERANCES, Status, Tolerances, hadamard_ratio
 from .parallel import chunk_count, map_chunks, split_range
 from .scene import Scene
 
 __all__ = [
     "PRUNED",
+    "PRUNED_KINEMATIC",
+    "penetrates",
     "CONE_WIDENING",
     "FORCE_RATIO",
     "MIN_LP_CHUNK",
@@ -72,13 +75,30 @@ PRUNED = "pruned_equilibrium_infeasible"
 #: ``-ftol`` (both cone rows then lose ``2 mu ftol``); 4 leaves a margin for rounding.
 CONE_WIDENING = 4.0
 
+#: Status of the untested modes whose breaking contacts penetrate in the reduced system (:func:`penetrates`).
+PRUNED_KINEMATIC = "pruned_breaking_violated"
+
+#: A reduced kinematic system (``v_n = 0`` rows, or the ``p x p`` rolling rows) with a smaller
+#: Hadamard ratio / singular-value ratio is not trusted to reject a mode: 1e-8 keeps its
+#: rounding (1e-16 / 1e-8) far below :data:`PENETRATION_MARGIN`.
+REDUCED_SINGULAR = 1e-8
+
+#: Relative to the scene's driving speed: a breaking contact of the reduced solve must penetrate
+#: by more than this to reject the mode without the reference test (1e3 times ``tol.velocity``'s
+#: default, and 1e2 above the reduced solve's rounding).
+PENETRATION_MARGIN = 1e-6
+
+#: Rolling sets per reduced solve (memory: ``REDUCED_CHUNK * p * p * 8`` bytes, p <= 10 here).
+REDUCED_CHUNK = 32768
+
 #: Largest ratio of a mode's forces to its loads up to which the widened cones contain
 #: every force the reference accepts: 1e6 is far beyond well-posed grasps (forces within
 #: a few orders of the loads) and keeps the widening (4e-3 of the loads at mu <= 1) small.
 FORCE_RATIO = 1e6
 
-#: Fewest candidate breaking sets (one programme of ~2-5 ms each) worth a chunk in another process.
-MIN_LP_CHUNK = 48
+#: Fewest candidate breaking sets (one programme of ~0.5 ms each with highspy) worth a chunk in
+#: another process (~0.1 s of work, several times a local pool's start-up).
+MIN_LP_CHUNK = 200
 
 #: Fewest modes worth a chunk of the testing stage in another process (~0.1 s of work).
 MIN_TEST_CHUNK = 16384
@@ -128,6 +148,56 @@ def equilibrium_relaxation(scene: Scene, tol: Tolerances = DEFAULT_TOLERANCES) -
     return EquilibriumRelaxation(scene, tol)
 
 
+class _Programme:
+    """The relaxation as a reusable linear programme: HiGHS through ``highspy`` when installed
+    (one model, only the bounds change, warm-started: ~0.5 ms a set), else ``scipy.optimize.linprog``
+    (~5 ms a set, mostly its input checks)."""
+
+    def __init__(self, rel: EquilibriumRelaxation):
+        self.rel = rel
+        self.n_vars = rel.A_eq.shape[1]
+        try:
+            import highspy
+        except ImportError:
+            self.highs = None
+            return
+        from scipy.sparse import csr_matrix
+
+        h = highspy.Highs()
+        h.setOptionValue("output_flag", False)
+        h.setOptionValue("simplex_strategy", 1)  # dual simplex: the bounds change, the last basis stays dual feasible
+        inf = highspy.kHighsInf
+        h.addVars(self.n_vars, np.full(self.n_vars, -inf), np.full(self.n_vars, inf))
+        A = csr_matrix(np.vstack([rel.A_eq, rel.A_ub]))
+        lower = np.concatenate([rel.b_eq, np.full(rel.b_ub.size, -inf)])
+        upper = np.concatenate([rel.b_eq, rel.b_ub])
+        h.addRows(A.shape[0], lower, upper, A.nnz, A.indptr[:-1].astype(np.int32), A.indices.astype(np.int32), A.data)
+        self.highs, self.infeasible, self.inf = h, highspy.HighsModelStatus.kInfeasible, inf
+        self.cols = np.arange(self.n_vars, dtype=np.int32)
+
+    def __call__(self, breaking) -> bool:
+        if self.rel.trivial:
+            return True
+        fixed = [j for i in breaking for j in (2 * i, 2 * i + 1)]
+        if self.highs is None:
+            from scipy.optimize import linprog
+
+            bounds = [(None, None)] * self.n_vars
+            for j in fixed:
+                bounds[j] = (0.0, 0.0)
+            res = linprog(
+                np.zeros(self.n_vars), A_ub=self.rel.A_ub, b_ub=self.rel.b_ub, A_eq=self.rel.A_eq,
+                b_eq=self.rel.b_eq, bounds=bounds, method="highs",
+            )  # fmt: skip
+            return res.status != 2  # 2: proven infeasible; anything else keeps the set
+        lower = np.full(self.n_vars, -self.inf)
+        upper = np.full(self.n_vars, self.inf)
+        lower[fixed] = upper[fixed] = 0.0
+        self.highs.changeColsBounds(self.n_vars, self.cols, lower, upper)
+        self.highs.run()
+        return self.highs.getModelStatus() != self.infeasible  # only a proof of infeasibility prunes
+
+
 def admits_equilibrium(rel: EquilibriumRelaxation, breaking) -> bool:
     """Whether some force with ``c = 0`` on ``breaking`` and cones elsewhere balances the loads.
 
@@ -139,23 +209,13 @@ def admits_equilibrium(rel: EquilibriumRelaxation, breaking) -> bool:
     breaking : iterable of int
         0-based contact indices.
     """
-    from scipy.optimize import linprog
-
-    if rel.trivial:
-        return True
-    bounds = [(None, None)] * (2 * rel.n_contacts)
-    for i in breaking:
-        bounds[2 * i] = bounds[2 * i + 1] = (0.0, 0.0)
-    res = linprog(
-        np.zeros(rel.A_eq.shape[1]), A_ub=rel.A_ub, b_ub=rel.b_ub, A_eq=rel.A_eq, b_eq=rel.b_eq,
-        bounds=bounds, method="highs",
-    )  # fmt: skip
-    return res.status != 2  # 2: proven infeasible; anything else (solved, iteration limit) keeps the set
+    return _Programme(rel)(breaking)
 
 
 def _lp_chunk(job):
     rel, sets = job
-    return [admits_equilibrium(rel, s) for s in sets]
+    programme = _Programme(rel)
+    return [programme(s) for s in sets]
 
 
 def _breaking_range(n_c: int, dof: int) -> tuple[int, int]:
@@ -200,7 +260,7 @@ def feasible_breaking_sets(scene: Scene, tol: Tolerances = DEFAULT_TOLERANCES, *
     lo, hi = _breaking_range(n_c, dof)
     rel = equilibrium_relaxation(scene, tol)
     level, programmes, out = [()], 1, []
-    if not admits_equilibrium(rel, ()):
+    if not _Programme(rel)(()):
         return out, programmes
     for size in range(0, hi + 1):
         if size >= lo:
@@ -247,26 +307,102 @@ def _n_modes(n_c, dof, B) -> int:
     return comb(n_c - b, b + dof - n_c) if 0 <= b + dof - n_c <= n_c - b else 0
 
 
+def _rolling_sets(n_c: int, dof: int, B) -> tuple[np.ndarray, np.ndarray]:
+    """The contacts ``A`` outside ``B`` and every rolling set of a mode with breaking set ``B``, shape (m, r)."""
+    A = np.setdiff1d(np.arange(n_c), np.asarray(B, dtype=np.intp))
+    return A, A[_combinations(A.size, len(B) + dof - n_c)]
+
+
+def penetrates(pool, B, A, R, margin: float) -> np.ndarray:
+    """Modes (breaking set ``B``, rolling sets ``R``) whose breaking contacts surely penetrate (eq. 15).
+
+    With ``B`` fixed, ``v_n = 0`` at every other contact (eq. 13) leaves
+    ``x = [qdot; thetadot_I] = x0 + Z u`` with ``u`` of dimension ``p = |R|``; the rolling
+    contacts' ``v_t = 0`` fix ``u`` by a ``p x p`` solve instead of the ``dof x dof`` one of
+    eq. (24).  A mode is flagged only when that reduced system is well conditioned
+    (:data:`REDUCED_SINGULAR`) and some breaking contact has ``v_n < -margin``; the
+    reference then finds ``v_n < -tol.velocity`` there too (or ``P_AI`` singular).
+
+    Parameters
+    ----------
+    pool : ScenePool
+    B, A : ndarray of int
+        Breaking contacts and the others.
+    R : ndarray of int, shape (m, p)
+    margin : float
+        m/s, well above the rounding of the reduced solve.
+
+    Returns
+    -------
+    ndarray of bool, shape (m,)
+    """
+    n_c = pool.Wrows.shape[0] // 2
+    N, T = pool.M[:n_c], pool.M[n_c:]
+    dn, dt = pool.drive[:n_c], pool.drive[n_c:]
+    m = R.shape[0]
+    out = np.zeros(m, dtype=bool)
+    if len(B) == 0 or m == 0:
+        return out
+    NA = N[A]
+    U, sv, Vt = np.linalg.svd(NA)
+    if sv.size and sv[-1] < REDUCED_SINGULAR * sv[0]:
+        return out  # v_n = 0 at A is (nearly) dependent: leave these modes to the reference
+    x0 = Vt[: A.size].T @ ((U.T @ dn[A]) / sv)
+    Z = Vt[A.size :].T  # (dof, p)
+    TZ, tx = T @ Z, dt - T @ x0  # v_t = T x0 + TZ u - dt
+    NBZ, nbx = N[B] @ Z, N[B] @ x0 - dn[B]
+    for lo in range(0, m, REDUCED_CHUNK):
+        Rs = R[lo : lo + REDUCED_CHUNK]
+        G = TZ[Rs]  # (k, p, p)
+        good = hadamard_ratio(G) >= REDUCED_SINGULAR
+        G[~good] = np.eye(G.shape[1])
+        u = np.linalg.solve(G, tx[Rs][..., None])[..., 0]
+        vB = u @ NBZ.T + nbx  # (k, b)
+        out[lo : lo + REDUCED_CHUNK] = good & np.any(vB < -margin, axis=1)
+    return out
+
+
 def _test_chunk(job):
-    """Test every mode of some breaking sets with the batch stages; return (counts, solutions)."""
-    from .solver import test_codes
+    """Test the modes of some breaking sets: the reduced penetration test, then the batch stages.
+
+    Returns (counts, solutions)."""
+    from .solver import ScenePool, test_codes
 
     scene, tol, batch, residuals, sets = job
-    counts = dict.fromkeys(Status.ORDER, 0)
-    sols = []
-    start = 0
-    while start < len(sets):  # group sets into batches of about ``batch`` modes
-        stop, m = start, 0
-        while stop < len(sets) and (m == 0 or m + _n_modes(scene.n_contacts, scene.dof, sets[stop]) <= batch):
-            m += _n_modes(scene.n_contacts, scene.dof, sets[stop])
-            stop += 1
-        codes = codes_with_breaking_sets(scene.n_contacts, scene.dof, sets[start:stop])
-        for lo in range(0, codes.shape[0], batch):
-            status, found = test_codes(scene, codes[lo : lo + batch], tol, residuals)
-            sols.extend(found)
-            for code, cnt in enumerate(np.bincount(status, minlength=len(Status.ORDER))):
-                counts[Status.ORDER[code]] += int(cnt)
-        start = stop
+    n_c, dof = scene.n_contacts, scene.dof
+    pool = ScenePool(scene)
+    vscale = velocity_scale(scene)
+    vtol, margin = tol.velocity * vscale, PENETRATION_MARGIN * vscale
+    counts = dict.fromkeys((*Status.ORDER, PRUNED_KINEMATIC), 0)
+    sols, buf, held = [], [], 0
+
+    def flush():
+        nonlocal buf, held
+        codes = np.concatenate(buf)
+        buf, held = [], 0
+        status, found = test_codes(scene, codes, tol, residuals, pool=pool, vtol=vtol)
+        sols.extend(found)
+        for code, cnt in enumerate(np.bincount(status, minlength=len(Status.ORDER))):
+            counts[Status.ORDER[code]] += int(cnt)
+
+    for B in sets:
+        A, R = _rolling_sets(n_c, dof, B)
+        if A.size + R.shape[1] != dof:
+            continue
+        keep = ~penetrates(pool, np.asarray(B, dtype=np.intp), A, R, margin)
+        counts[PRUNED_KINEMATIC] += int(R.shape[0] - keep.sum())
+        R = R[keep]
+        for lo in range(0, R.shape[0], batch):
+            Rs = R[lo : lo + batch]
+            codes = np.zeros((Rs.shape[0], n_c), dtype=np.uint8)
+            codes[:, A] = 2
+            codes[np.arange(Rs.shape[0])[:, None], Rs] = 1
+            buf.append(codes)
+            held += Rs.shape[0]
+            if held >= batch:
+                flush()
+    if held:
+        flush()
     return counts, sols
 
 
@@ -292,7 +428,7 @@ def search_solve(scene: Scene, tol: Tolerances = DEFAULT_TOLERANCES, batch: int 
         bounds = [0, *(int(e) + 1 for e in edges), len(sets)]
         jobs = [(scene, tol, batch, residuals, sets[a:b]) for a, b in zip(bounds[:-1], bounds[1:]) if b > a]
         parts = map_chunks(_test_chunk, jobs, workers=workers, scheduler=scheduler)
-    counts = dict.fromkeys(Status.ORDER, 0)
+    counts = dict.fromkeys((*Status.ORDER, PRUNED_KINEMATIC), 0)
     sols = []
     for c, s in parts:
         for k, v in c.items():

@@ -1,0 +1,121 @@
+"""Benchmark: every contact mode at scale, exactly (Section 4.7's n_c = 12 ... 20), whole ``qsplan modes`` command.
+
+For each row a seeded planted scene (``mechanics.planted``, with a planted mode drawn
+uniformly from the eq. (49) modes) is written to JSON and ``qsplan modes FILE --json
+--stats`` is run as a subprocess (interpreter start, imports, JSON in and out) ``--repeat``
+times; the table gives the best wall-clock time, the modes found, whether the planted mode is
+among them (asserted), the modes tested and pruned, the peak memory reported by ``--stats``
+(``ru_maxrss`` of the command and its largest worker), and whether every reported mode is
+feasible by the one-mode reference ``check_mode`` (asserted).  For n_c <= ``--compare-upto``
+the plain batch path (``solve(search="all")``, every mode tested) is run too and its feasible
+set compared with the command's (asserted equal).
+
+The paper (Section 4.7) stopped at n_c = 12 (about 20 cpu minutes) and estimated 3 cpu months
+for n_c = 20.  Targets on the 2-core machine: n_c = 16 under 5 s, n_c = 20 under 60 s.
+
+Usage, from the repository root::
+
+    python3 benchmarks/bench_scale.py [--contacts 12 16 20] [--repeat 3] [--workers N] [--compare-upto 16]
+"""
+
+import argparse
+import json
+import os
+import re
+import subprocess
+import sys
+import tempfile
+import time
+from math import comb
+from pathlib import Path
+
+import numpy as np
+
+from mechanics import ContactMode, check_mode, count_modes, planted_scene, solve
+from mechanics.scene_io_write import scene_to_dict
+
+SEED = 1995
+ROOT = Path(__file__).resolve().parents[1]
+
+#: (n_c, |tau_I|) rows: dof = 3 + |tau_I| = n_c, the paper's hardest case for each n_c.
+DEFAULT_ROWS = ((12, 9), (16, 13), (20, 17))
+
+
+def uniform_mode(rng, n_c: int, dof: int) -> ContactMode:
+    """A mode drawn uniformly from the eq. (49) modes without listing them (377M at n_c = 20)."""
+    weights = np.array([comb(n_c, r) * comb(n_c - r, dof - 2 * r) if dof - 2 * r <= n_c - r else 0
+                        for r in range(dof // 2 + 1)], dtype=float)  # fmt: skip
+    r = int(rng.choice(weights.size, p=weights / weights.sum()))
+    perm = rng.permutation(n_c)
+    letters = ["B"] * n_c
+    for i in perm[:r]:
+        letters[i] = "R"
+    for i in perm[r : r + dof - 2 * r]:
+        letters[i] = "S"
+    return ContactMode("".join(letters))
+
+
+def bench_scene(n_c: int, n_effort: int, seed: int = SEED):
+    rng = np.random.default_rng([seed, n_c, n_effort])
+    mode = uniform_mode(rng, n_c, 3 + n_effort)
+    return planted_scene(rng, n_c, n_effort=n_effort, n_joints=n_effort + 2, mode=mode)
+
+
+def run_command(path: Path, workers):
+    """One ``qsplan modes PATH --json --stats`` run: (seconds, parsed JSON, stats line)."""
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join(filter(None, [str(ROOT), os.environ.get("PYTHONPATH")]))}
+    cmd = [sys.executable, "-m", "planner.cli", "modes", str(path), "--json", "--stats"]
+    if workers:
+        cmd += ["--workers", str(workers)]
+    t = time.perf_counter()
+    proc = subprocess.run(cmd, capture_output=True, text=True, cwd=ROOT, env=env)
+    elapsed = time.perf_counter() - t
+    if proc.returncode != 0:
+        raise SystemExit(f"qsplan modes exited {proc.returncode}: {proc.stderr.strip()[:300]}")
+    return elapsed, json.loads(proc.stdout), proc.stderr.strip()
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--contacts", type=int, nargs="+", help="n_c values (|tau_I| = n_c - 3); default 12 16 20")
+    ap.add_argument("--repeat", type=int, default=3)
+    ap.add_argument("--workers", type=int, default=None, help="passed to qsplan modes (default: all cores)")
+    ap.add_argument("--compare-upto", type=int, default=16, help="compare with solve(search='all') up to this n_c")
+    ap.add_argument("--seed", type=int, default=SEED)
+    args = ap.parse_args(argv)
+    rows = [(n, n - 3) for n in args.contacts] if args.contacts else DEFAULT_ROWS
+
+    print(f"qsplan modes FILE --json --stats (subprocess, best of {args.repeat}), planted scenes, seed {args.seed}, "
+          f"{os.cpu_count()} cores")  # fmt: skip
+    head = (f"{'n_c':>4} {'|tau_I|':>7} {'candidates':>12} {'best s':>8} {'found':>6} {'planted':>8} "
+            f"{'tested':>10} {'pruned':>12} {'peak MiB':>9} {'check_mode':>10} {'= all':>6}")  # fmt: skip
+    print(head)
+    for n_c, n_e in rows:
+        scene, planted = bench_scene(n_c, n_e, args.seed)
+        total = count_modes(n_c, 3 + n_e)
+        with tempfile.TemporaryDirectory() as tmp:
+            path = Path(tmp) / f"planted_{n_c}.json"
+            path.write_text(json.dumps(scene_to_dict(scene)))
+            runs = [run_command(path, args.workers) for _ in range(args.repeat)]
+        best, doc, stats = min(runs, key=lambda r: r[0])
+        assert doc["modes_tested"] == total, (doc["modes_tested"], total)
+        assert sum(doc["counts"].values()) == total, "per-status counts do not sum to eq. (49)"
+        found = [f["mode"] for f in doc["feasible"]]
+        verified = all(check_mode(scene, ContactMode(m)).feasible for m in found)
+        pruned = sum(v for k, v in doc["counts"].items() if k.startswith("pruned"))
+        peak = re.search(r"peak memory (\d+) MiB", stats)
+        same = "-"
+        if n_c <= args.compare_upto:
+            ref = solve(scene, search="all", workers=args.workers)
+            same = "yes" if ref.feasible_modes == found else "NO"
+        print(f"{n_c:>4} {n_e:>7} {total:>12} {best:>8.2f} {len(found):>6} {str(planted.letters in found):>8} "
+              f"{total - pruned:>10} {pruned:>12} {peak.group(1) if peak else '?':>9} {str(verified):>10} {same:>6}",
+              flush=True)  # fmt: skip
+        assert planted.letters in found, f"planted mode {planted.letters} not found for n_c = {n_c}"
+        assert verified, "a reported mode fails check_mode"
+        assert same != "NO", "pruned search and the plain batch path disagree"
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
