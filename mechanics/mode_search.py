@@ -43,6 +43,7 @@ programme further.
 
 from __future__ import annotations
 
+from functools import lru_cache
 from math import comb
 
 import numpy as np
@@ -279,6 +280,14 @@ def feasible_breaking_sets(scene: Scene, tol: Tolerances = DEFAULT_TOLERANCES, *
     return out, programmes
 
 
+def _codes(n_c: int, A: np.ndarray, R: np.ndarray) -> np.ndarray:
+    """Letter codes (0 B, 1 R, 2 S) of the modes with contacts ``A`` not breaking and rolling sets ``R`` (m, r)."""
+    codes = np.zeros((R.shape[0], n_c), dtype=np.uint8)
+    codes[:, A] = 2
+    codes[np.arange(R.shape[0])[:, None], R] = 1
+    return codes
+
+
 def codes_with_breaking_sets(n_c: int, dof: int, sets) -> np.ndarray:
     """Letter codes (0 B, 1 R, 2 S) of every mode with ``2 n_R + n_S = dof`` whose breaking set is in ``sets``.
 
@@ -289,16 +298,8 @@ def codes_with_breaking_sets(n_c: int, dof: int, sets) -> np.ndarray:
     """
     parts = []
     for B in sets:
-        b = len(B)
-        r = b + dof - n_c
-        if r < 0 or n_c - b - r < 0:
-            continue
-        A = np.setdiff1d(np.arange(n_c), np.asarray(B, dtype=np.intp))
-        R = A[_combinations(A.size, r)]  # (C(n_c - b, r), r)
-        codes = np.zeros((R.shape[0], n_c), dtype=np.uint8)
-        codes[:, A] = 2
-        codes[np.arange(R.shape[0])[:, None], R] = 1
-        parts.append(codes)
+        if 0 <= len(B) + dof - n_c <= n_c - len(B):
+            parts.append(_codes(n_c, *_rolling_sets(n_c, dof, B)))
     return np.concatenate(parts) if parts else np.zeros((0, n_c), dtype=np.uint8)
 
 
@@ -307,10 +308,18 @@ def _n_modes(n_c, dof, B) -> int:
     return comb(n_c - b, b + dof - n_c) if 0 <= b + dof - n_c <= n_c - b else 0
 
 
+@lru_cache(maxsize=64)
+def _positions(n: int, k: int) -> np.ndarray:
+    """:func:`mechanics.modes._combinations`, cached: every breaking set of one size reuses it."""
+    out = _combinations(n, k)
+    out.setflags(write=False)
+    return out
+
+
 def _rolling_sets(n_c: int, dof: int, B) -> tuple[np.ndarray, np.ndarray]:
     """The contacts ``A`` outside ``B`` and every rolling set of a mode with breaking set ``B``, shape (m, r)."""
     A = np.setdiff1d(np.arange(n_c), np.asarray(B, dtype=np.intp))
-    return A, A[_combinations(A.size, len(B) + dof - n_c)]
+    return A, A[_positions(A.size, len(B) + dof - n_c)]
 
 
 def penetrates(pool, B, A, R, margin: float) -> np.ndarray:
@@ -386,19 +395,15 @@ def _test_chunk(job):
             counts[Status.ORDER[code]] += int(cnt)
 
     for B in sets:
-        A, R = _rolling_sets(n_c, dof, B)
-        if A.size + R.shape[1] != dof:
+        if not 0 <= len(B) + dof - n_c <= n_c - len(B):
             continue
+        A, R = _rolling_sets(n_c, dof, B)
         keep = ~penetrates(pool, np.asarray(B, dtype=np.intp), A, R, margin)
         counts[PRUNED_KINEMATIC] += int(R.shape[0] - keep.sum())
         R = R[keep]
         for lo in range(0, R.shape[0], batch):
-            Rs = R[lo : lo + batch]
-            codes = np.zeros((Rs.shape[0], n_c), dtype=np.uint8)
-            codes[:, A] = 2
-            codes[np.arange(Rs.shape[0])[:, None], Rs] = 1
-            buf.append(codes)
-            held += Rs.shape[0]
+            buf.append(_codes(n_c, A, R[lo : lo + batch]))
+            held += buf[-1].shape[0]
             if held >= batch:
                 flush()
     if held:

@@ -1,0 +1,150 @@
+"""The pruned mode search against the plain batch solve (every mode tested) and the one-mode reference."""
+
+import json
+from itertools import combinations
+
+import numpy as np
+import pytest
+
+from hands.paper import eq37_scene, eq42_scene, rod_scene
+from mechanics import QsplanError, check_mode, count_modes, make_scene, planted_scene, scene_from_dict, solve
+from mechanics.mode_search import (
+    PRUNED,
+    PRUNED_KINEMATIC,
+    _Programme,
+    codes_with_breaking_sets,
+    equilibrium_relaxation,
+    feasible_breaking_sets,
+)
+from mechanics.modes import codes_to_letters, enumerate_modes, mode_order_key
+from mechanics.numerics import DEFAULT_TOLERANCES, Status
+
+SOLUTION_TOL = 1e-12  # both paths solve the same matrices: only the batch composition differs
+
+
+def _assert_same(scene, workers=1):
+    """Pruned and plain results agree mode by mode; returns the pruned result."""
+    plain = solve(scene, search="all", workers=1, keep_statuses=True)
+    pruned = solve(scene, search="prune", workers=workers)
+    assert pruned.feasible_modes == plain.feasible_modes
+    for a, b in zip(pruned.solutions, plain.solutions):
+        for f in ("qdot", "thetadot", "c_n", "c_t", "tau"):
+            np.testing.assert_allclose(getattr(a, f), getattr(b, f), rtol=0, atol=SOLUTION_TOL * (1 + np.abs(getattr(b, f)).max()))
+        assert a.on_boundary == b.on_boundary
+    total = count_modes(scene.n_contacts, scene.dof)
+    assert pruned.modes_tested == total and sum(pruned.counts.values()) == total  # eq. (49)
+    # every tested mode keeps the plain status; the pruned ones were all infeasible there
+    for status in Status.ORDER:
+        assert pruned.counts[status] <= plain.counts[status]
+    assert pruned.counts[Status.FEASIBLE] == plain.counts[Status.FEASIBLE]
+    pruned_kin = plain.counts[Status.BREAKING_VIOLATED] - pruned.counts[Status.BREAKING_VIOLATED]
+    assert pruned.counts[PRUNED_KINEMATIC] <= pruned_kin + plain.counts[Status.KINEMATICS_SINGULAR]
+    return pruned, plain
+
+
+def _planted(seed, n_c, n_e):
+    return planted_scene(np.random.default_rng([seed, n_c, n_e]), n_c, n_e)
+
+
+@pytest.mark.parametrize("n_c", range(3, 11))
+def test_pruned_search_matches_the_plain_solve_on_planted_scenes(n_c):
+    for n_e in sorted({0, max(0, n_c - 3), min(2 * n_c - 3, n_c)}):
+        for seed in range(3):
+            scene, planted = _planted(seed, n_c, n_e)
+            pruned, _ = _assert_same(scene)
+            assert planted.letters in pruned.feasible_modes
+
+
+def test_pruned_search_matches_on_n12_and_prunes_most_modes():
+    scene, planted = _planted(7, 12, 9)
+    pruned, plain = _assert_same(scene, workers=2)
+    assert planted.letters in pruned.feasible_modes
+    assert pruned.counts[PRUNED] > 0.5 * pruned.modes_tested  # the point of the search
+    for s in pruned.solutions:
+        assert check_mode(scene, s.mode).feasible
+
+
+@pytest.mark.parametrize("mu", [0.1, 0.3, 0.7])
+def test_paper_examples(mu):
+    for doc in (eq37_scene(mu), eq42_scene(mu), rod_scene(mu=(mu, 0.5 * mu))):
+        _assert_same(scene_from_dict(doc))
+
+
+def test_two_finger_hand_scenes():
+    from hands.segments import first_segment
+    from hands.two_finger import default_hand, hand_scene
+
+    hand = default_hand()
+    segment = first_segment(hand, duration=10.0)
+    for s in (0.0, 0.5, 1.0):
+        for effort_joint in ("left", "right"):
+            scene = hand_scene(hand, segment.pose(s)[0], effort_joint=effort_joint, velocity=0.1, effort=0.05)
+            _assert_same(scene)
+
+
+def test_degenerate_scenes_are_never_pruned_into_feasible():
+    # two supports that do not move (zero sliding speed) and coincident contacts (singular P_AI)
+    base = dict(
+        Wn=[[0, 0], [1, 1], [-1, 1]], Wt=[[-1, -1], [0, 0], [0, 0]],
+        Jn=[[0.0], [0.0]], Jt=[[-0.1], [0.1]], mu=[0.3, 0.3], g_obj=[0, -1, 0], joint_velocity=[1.0],
+    )  # fmt: skip
+    for kw in ({}, {"Jt": [[0.0], [0.0]]}, {"Wn": [[0, 0], [1, 1], [0, 0]]}):
+        _assert_same(make_scene(**{**base, **kw}))
+
+
+def test_zero_loads_prune_nothing():
+    scene, _ = _planted(1, 6, 2)
+    free = make_scene(scene.Wn, scene.Wt, scene.Jn, scene.Jt, scene.mu, np.zeros(3), g_man=np.zeros(scene.n_joints),
+                      effort_controlled=scene.effort_controlled, joint_velocity=scene.joint_velocity,
+                      joint_effort=np.where(scene.effort_controlled, 0.0, np.nan))  # fmt: skip
+    pruned, _ = _assert_same(free)
+    assert pruned.counts[PRUNED] == 0
+
+
+def test_breaking_sets_partition_the_modes_in_enumeration_order():
+    n_c, dof = 7, 6
+    all_sets = [B for b in range(n_c + 1) for B in combinations(range(n_c), b)]
+    codes = codes_with_breaking_sets(n_c, dof, all_sets)
+    letters = sorted((codes_to_letters(c) for c in codes), key=mode_order_key)
+    assert letters == [m.letters for m in enumerate_modes(n_c, dof)]
+
+
+def test_pruned_breaking_sets_are_monotone_and_checked_by_both_programmes():
+    scene, _ = _planted(3, 8, 4)
+    rel = equilibrium_relaxation(scene, DEFAULT_TOLERANCES)
+    fast, slow = _Programme(rel), _Programme(rel)
+    slow.highs = None  # scipy.optimize.linprog path
+    sets = [B for b in range(5) for B in combinations(range(8), b)]
+    verdict = {B: fast(B) for B in sets}
+    assert verdict == {B: slow(B) for B in sets}
+    assert not all(verdict.values())  # something is pruned on this scene
+    for B, ok in verdict.items():  # a superset of an infeasible set is infeasible
+        if not ok:
+            assert not any(verdict.get(tuple(sorted(B + (i,)))) for i in range(8) if i not in B)
+    found, _ = feasible_breaking_sets(scene)
+    assert set(found) == {B for B, ok in verdict.items() if ok and len(B) >= max(0, 8 - scene.dof)}
+
+
+def test_bad_search_argument():
+    scene, _ = _planted(0, 3, 0)
+    with pytest.raises(QsplanError, match="search"):
+        solve(scene, search="fast")
+
+
+def test_cli_stats_and_search(tmp_path, capsys):
+    from mechanics.scene_io_write import scene_to_dict
+    from planner.cli import main
+
+    scene, planted = _planted(5, 9, 6)
+    path = tmp_path / "s.json"
+    path.write_text(json.dumps(scene_to_dict(scene)))
+    docs = {}
+    for search in ("all", "prune"):
+        assert main(["modes", str(path), "--json", "--stats", "--workers", "1", "--search", search]) == 0
+        out, err = capsys.readouterr()
+        docs[search] = json.loads(out)
+        assert "peak memory" in err and "tested" in err and "\n" == err[-1] and err.count("\n") == 1
+    assert [f["mode"] for f in docs["all"]["feasible"]] == [f["mode"] for f in docs["prune"]["feasible"]]
+    assert planted.letters in [f["mode"] for f in docs["prune"]["feasible"]]
+    assert main(["modes", str(path), "--search", "fast"]) == 2
+    assert "--search" in capsys.readouterr().err
