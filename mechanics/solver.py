@@ -38,10 +38,11 @@ __all__ = [
 ]
 
 #: Fewest modes (eq. 49) for which ``search="auto"`` prunes breaking sets
-#: (:mod:`mechanics.mode_search`): below it one programme per breaking set costs
-#: more than testing every mode (benchmarks/bench_scale.py: n_c = 12, 73,789 modes,
-#: is about even).
-SEARCH_MIN_MODES = 200_000
+#: (:mod:`mechanics.mode_search`).  Measured on planted scenes with dof = n_c, one core:
+#: even at ~5,000 modes (n_c = 9-10), 3x faster at 25,653 (n_c = 11: 0.04 s vs 0.13 s),
+#: 7x at 212,941 (n_c = 13).  Small scenes, solved in loops by mu-space maps and bands,
+#: keep the plain path and its full per-status counts.
+SEARCH_MIN_MODES = 20_000
 
 #: Modes per batch.  Memory per batch is about ``batch * k * (k + n_j) * 8`` bytes
 #: several times over; 8192 keeps it to a few MB for k <= 20 and amortises numpy's

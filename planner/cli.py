@@ -49,7 +49,7 @@ def build_parser() -> argparse.ArgumentParser:
     add_parallel_options(m)
     m.add_argument("--search", choices=("auto", "prune", "all"), default="auto",
                    help="prune: skip modes whose breaking set admits no equilibrium (same result); all: test "
-                        "every mode; auto (default): prune from 200,000 modes on")  # fmt: skip
+                        "every mode; auto (default): prune from 20,000 modes on")  # fmt: skip
     m.add_argument("--stats", action="store_true", help="time, modes tested/pruned and peak memory on stderr")
 
     c = sub.add_parser("count", help="number of contact modes tested (eq. 49, Table 1)")
