@@ -8,14 +8,8 @@ import pytest
 
 from hands.paper import eq37_scene, eq42_scene, rod_scene
 from mechanics import QsplanError, check_mode, count_modes, make_scene, planted_scene, scene_from_dict, solve
-from mechanics.mode_search import (
-    PRUNED,
-    PRUNED_KINEMATIC,
-    _Programme,
-    codes_with_breaking_sets,
-    equilibrium_relaxation,
-    feasible_breaking_sets,
-)
+from mechanics.breaking_sets import _Programme, equilibrium_relaxation, feasible_breaking_sets
+from mechanics.mode_search import PRUNED, PRUNED_KINEMATIC, codes_with_breaking_sets
 from mechanics.modes import codes_to_letters, enumerate_modes, mode_order_key
 from mechanics.numerics import DEFAULT_TOLERANCES, Status
 
