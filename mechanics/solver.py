@@ -7,6 +7,9 @@ solved at once, the kinematic checks (breaking contacts, sliding directions)
 reject most modes, and only the survivors get their ``Q_AI`` built and solved.
 Each mode gets exactly the status the one-mode reference
 :func:`mechanics.feasibility.check_mode` gives it, which the tests verify.
+From :data:`SEARCH_MIN_MODES` modes on, :func:`solve` by default tests only the
+modes that survive the exact pruning of :mod:`mechanics.mode_search` (same
+solutions; ``search="all"`` tests every mode).
 """
 
 from __future__ import annotations
@@ -66,6 +69,8 @@ class SolveResult:
     counts : dict[str, int]
         Number of modes per :class:`~mechanics.numerics.Status`; degenerate cases
         (singular matrices, zero speeds) are counted here and never reported feasible.
+        A pruned search (``solve(search="prune")``) adds the untested modes under
+        ``mode_search.PRUNED`` and ``mode_search.PRUNED_KINEMATIC``; the sum is still eq. (49).
     tolerances : Tolerances
     statuses : tuple of str or None
         Status of every tested mode in enumeration order, when ``solve(..., keep_statuses=True)``.
