@@ -14,7 +14,7 @@ in three steps, each exact:
    ``p x p`` solve, and modes whose breaking contacts clearly penetrate go
    (:func:`penetrates`), without the ``dof x dof`` solve of eq. (24).
 3. The rest are tested by the plain batch stages
-   (:func:`mechanics.solver.test_codes`), so every reported solution is exactly
+   (:func:`mechanics.solver.solve_batch`), so every reported solution is exactly
    the reference's.
 
 Modes of steps 1 and 2 are counted under :data:`PRUNED` and
@@ -165,7 +165,7 @@ def _test_chunk(job):
     """Test the modes of some breaking sets: the reduced penetration test, then the batch stages.
 
     Returns (counts, solutions)."""
-    from .solver import ScenePool, test_codes
+    from .solver import ScenePool, solve_batch
 
     scene, tol, batch, residuals, sets = job
     n_c, dof = scene.n_contacts, scene.dof
@@ -179,7 +179,7 @@ def _test_chunk(job):
         nonlocal buf, held
         codes = np.concatenate(buf)
         buf, held = [], 0
-        status, found = test_codes(scene, codes, tol, residuals, pool=pool, vtol=vtol)
+        status, found = solve_batch(scene, codes, tol, residuals, pool=pool, vtol=vtol)
         sols.extend(found)
         for code, cnt in enumerate(np.bincount(status, minlength=len(Status.ORDER))):
             counts[Status.ORDER[code]] += int(cnt)

@@ -36,7 +36,7 @@ __all__ = [
     "check_mode_fits",
     "equilibrium_stage",
     "ScenePool",
-    "test_codes",
+    "solve_batch",
     "SEARCH_MIN_MODES",
 ]
 
@@ -335,7 +335,7 @@ def equilibrium_stage(scene: Scene, pool: "ScenePool", kin: Kinematics, mu: np.n
     return status, c_n, c_t, tau, worst <= ftol
 
 
-def test_codes(scene: Scene, codes: np.ndarray, tol: Tolerances = DEFAULT_TOLERANCES, residuals: bool = True,
+def solve_batch(scene: Scene, codes: np.ndarray, tol: Tolerances = DEFAULT_TOLERANCES, residuals: bool = True,
                *, pool: "ScenePool | None" = None, vtol: float | None = None):  # fmt: skip
     """Test a batch of modes: kinematics (24-25, 16), then equilibrium and Coulomb (26-28) for the survivors.
 
@@ -444,7 +444,7 @@ def solve(
     kept: list = []
     pool = ScenePool(scene)
     for codes in islice(iter_mode_batches(n_c, dof, batch), *(batches or (None,))):
-        status, found = test_codes(scene, codes, tol, residuals, pool=pool, vtol=vtol)
+        status, found = solve_batch(scene, codes, tol, residuals, pool=pool, vtol=vtol)
         sols.extend(found)
         for code, cnt in enumerate(np.bincount(status, minlength=len(_STATUS))):
             counts[_STATUS[code]] += int(cnt)
