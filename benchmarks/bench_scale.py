@@ -26,11 +26,11 @@ import subprocess
 import sys
 import tempfile
 import time
-from math import comb
 from pathlib import Path
 
 import numpy as np
 
+from mechanics.modes import random_mode
 from mechanics import ContactMode, check_mode, count_modes, planted_scene, solve
 from mechanics.scene_io_write import scene_to_dict
 
@@ -41,23 +41,9 @@ ROOT = Path(__file__).resolve().parents[1]
 DEFAULT_ROWS = ((12, 9), (16, 13), (20, 17))
 
 
-def uniform_mode(rng, n_c: int, dof: int) -> ContactMode:
-    """A mode drawn uniformly from the eq. (49) modes without listing them (377M at n_c = 20)."""
-    weights = np.array([comb(n_c, r) * comb(n_c - r, dof - 2 * r) if dof - 2 * r <= n_c - r else 0
-                        for r in range(dof // 2 + 1)], dtype=float)  # fmt: skip
-    r = int(rng.choice(weights.size, p=weights / weights.sum()))
-    perm = rng.permutation(n_c)
-    letters = ["B"] * n_c
-    for i in perm[:r]:
-        letters[i] = "R"
-    for i in perm[r : r + dof - 2 * r]:
-        letters[i] = "S"
-    return ContactMode("".join(letters))
-
-
 def bench_scene(n_c: int, n_effort: int, seed: int = SEED):
     rng = np.random.default_rng([seed, n_c, n_effort])
-    mode = uniform_mode(rng, n_c, 3 + n_effort)
+    mode = random_mode(rng, n_c, 3 + n_effort)
     return planted_scene(rng, n_c, n_effort=n_effort, n_joints=n_effort + 2, mode=mode)
 
 

@@ -23,6 +23,7 @@ import numpy as np
 from .errors import ModeError
 
 __all__ = [
+    "random_mode",
     "ContactMode",
     "mode_from_letters",
     "enumerate_modes",
@@ -226,3 +227,26 @@ def mode_order_key(letters: str) -> tuple:
     the sliding set, lexicographically (0-based indices)."""
     R = tuple(i for i, c in enumerate(letters) if c == "R")
     return len(R), R, tuple(i for i, c in enumerate(letters) if c == "S")
+
+
+def random_mode(rng: np.random.Generator, n_contacts: int, dof: int) -> ContactMode:
+    """A mode drawn uniformly from the eq. (49) set without listing it (377,379,369 members at n_c = dof = 20).
+
+    Draws the number of rolling contacts ``r`` with weight ``C(n_c, r) C(n_c - r, dof - 2r)``
+    (the eq. (49) terms), then which contacts roll and slide by a random permutation.
+
+    Raises
+    ------
+    ModeError
+        When no mode has ``dof`` constraints with ``n_contacts`` contacts.
+    """
+    weights = np.array([comb(n_contacts, r) * comb(n_contacts - r, dof - 2 * r) if dof - 2 * r <= n_contacts - r
+                        else 0 for r in range(dof // 2 + 1)], dtype=float)  # fmt: skip
+    if dof < 0 or weights.sum() == 0:
+        raise ModeError(f"no mode has {dof} constraints with {n_contacts} contacts (eq. 49)")
+    r = int(rng.choice(weights.size, p=weights / weights.sum()))
+    perm = rng.permutation(n_contacts)
+    letters = np.full(n_contacts, "B")
+    letters[perm[:r]] = "R"
+    letters[perm[r : dof - r]] = "S"
+    return ContactMode("".join(letters))

@@ -15,7 +15,7 @@ from __future__ import annotations
 import numpy as np
 
 from .contact import wrench_matrices
-from .modes import ContactMode, codes_to_letters, count_modes, mode_index_array
+from .modes import ContactMode, random_mode
 from .scene import Scene, make_scene
 
 __all__ = ["planted_scene"]
@@ -56,10 +56,7 @@ def planted_scene(
         raise ValueError("n_joints: need at least one velocity-controlled joint to drive the motion")
     dof = 3 + n_effort
     if mode is None:
-        total = count_modes(n_contacts, dof)
-        if total == 0:
-            raise ValueError(f"no mode has {dof} constraints with {n_contacts} contacts (eq. 49)")
-        mode = ContactMode(codes_to_letters(mode_index_array(n_contacts, dof)[int(rng.integers(total))]))
+        mode = random_mode(rng, n_contacts, dof)  # uniform over eq. (49) without listing it
     r = rng.uniform(-1, 1, size=(n_contacts, 2))
     ang = rng.uniform(0, 2 * np.pi, size=n_contacts)
     Wn, Wt = wrench_matrices(r, np.column_stack([np.cos(ang), np.sin(ang)]))
