@@ -160,8 +160,10 @@ def failure_report(task, name, x0, x1, effort, direction, competitors, result=No
         widths = np.array([p.width if np.isfinite(p.width) else -1.0 for p in closed])
         narrowest = closed[int(np.argmin(widths))]
         if narrowest.reason.startswith(("band", "no guaranteed band")):
-            lo_e, hi_e = _edge_corners(task, narrowest.x, effort, direction)
-            narrowest = replace(narrowest, mu_lower_edge=lo_e, mu_upper_edge=hi_e)
+            # box corners of the edges mean nothing where the mode is degenerate (Q_AI singular inside the box)
+            if "degenerate" not in narrowest.reason:
+                lo_e, hi_e = _edge_corners(task, narrowest.x, effort, direction)
+                narrowest = replace(narrowest, mu_lower_edge=lo_e, mu_upper_edge=hi_e)
             mu_closes = _mu_closes(task, narrowest.x, effort, direction, competitors)
     status = "not run (start or goal invalid)" if result is None else result.status
     return FailureReport(name, float(x0), float(x1), effort, task.torque_resolution, task.mu_range, status,

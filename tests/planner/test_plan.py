@@ -154,3 +154,15 @@ def test_too_wide_friction_fails_with_a_report():
     assert r.mu_closes is not None and 0.0 < r.mu_closes < 0.5
     assert r.narrowest.mu_lower_edge is not None
     assert r.as_dict()["message"] == str(info.value)
+
+
+@pytest.mark.ompl
+def test_degenerate_closure_is_named_without_meaningless_edge_corners():
+    from planner.plan import PlanFailure, plan_task
+
+    task = load_task(task_paths()["pentagon_task"])
+    with pytest.raises(PlanFailure) as info:
+        plan_task(make_task(task.hand, 0.0, [0.02], mu_range=(0.0, 0.6), torque_resolution=0.01))
+    r = info.value.report
+    assert "degenerate" in r.narrowest.reason and "edges attained" not in r.message
+    assert r.narrowest.mu_lower_edge is None and 0.0 < r.mu_closes < 0.6
