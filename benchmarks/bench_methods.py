@@ -36,9 +36,9 @@ from pathlib import Path
 
 import numpy as np
 
-from mechanics.modes import random_mode
-from mechanics import count_modes, planted_scene, solve
-from mechanics.lcp import solve_lcp
+from qsplan.mechanics.modes.contact_mode import random_mode
+from qsplan.mechanics import count_modes, planted_scene, solve
+from qsplan.mechanics.crosscheck.lcp import solve_lcp
 
 SEED = 1995
 CHARTS = Path(__file__).resolve().parent / "charts"

@@ -27,8 +27,8 @@ from pathlib import Path
 
 import numpy as np
 
-from mechanics import count_modes, planted_scene, solve
-from mechanics.scene_io_write import scene_to_dict
+from qsplan.mechanics import count_modes, planted_scene, solve
+from qsplan.mechanics.model.scene_io_write import scene_to_dict
 
 SEED = 1995
 ROOT = Path(__file__).resolve().parents[1]
@@ -69,7 +69,7 @@ def time_command(scene):
         path.write_text(json.dumps(scene_to_dict(scene)))
         t = time.perf_counter()
         proc = subprocess.run(
-            [sys.executable, "-m", "planner.cli", "modes", str(path), "--json"],
+            [sys.executable, "-m", "qsplan.planner.cli", "modes", str(path), "--json"],
             capture_output=True, text=True, cwd=ROOT, env=env,
         )  # fmt: skip
         elapsed = time.perf_counter() - t

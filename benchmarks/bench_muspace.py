@@ -15,9 +15,9 @@ import time
 
 import numpy as np
 
-from hands.paper import eq42_scene
-from mechanics import scene_from_dict, solve
-from mechanics.muspace import boundary_agreement, feasibility_map, grid_points, mu_slice, polynomial_map
+from qsplan.hands.paper import eq42_scene
+from qsplan.mechanics import scene_from_dict, solve
+from qsplan.mechanics.muspace.maps import boundary_agreement, feasibility_map, grid_points, mu_slice, polynomial_map
 
 SEED = 42
 REPEAT = 3

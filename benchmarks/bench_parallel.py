@@ -19,14 +19,14 @@ import inspect
 import numpy as np
 from bench_muspace import best_of  # the script's own folder is on sys.path
 
-from hands.paper import eq42_scene
-from hands.segments import first_segment, sample_segment
-from hands.two_finger import default_hand
-from mechanics import scene_from_dict, solve
-from mechanics.muspace import feasibility_map, grid_points, mu_slice
-from mechanics.parallel import first_difference
-from mechanics.planted import planted_scene
-from planner.bands_sweep import segment_bands
+from qsplan.hands.paper import eq42_scene
+from qsplan.hands.segments import first_segment, sample_segment
+from qsplan.hands.two_finger import default_hand
+from qsplan.mechanics import scene_from_dict, solve
+from qsplan.mechanics.muspace.maps import feasibility_map, grid_points, mu_slice
+from qsplan.mechanics.parallel import first_difference
+from qsplan.mechanics.modes.planted import planted_scene
+from qsplan.planner.torque.sweep import segment_bands
 
 SEED = 1995
 

@@ -5,8 +5,8 @@ Run: ``python3 benchmarks/bench_plan.py`` (the bundled tasks; about a minute).
 
 import time
 
-from planner.plan import plan_task
-from planner.task import load_task, task_paths
+from qsplan.planner.planning.plan import plan_task
+from qsplan.planner.planning.task import load_task, task_paths
 
 
 def main():

@@ -30,9 +30,9 @@ from pathlib import Path
 
 import numpy as np
 
-from mechanics.modes import random_mode
-from mechanics import ContactMode, check_mode, count_modes, planted_scene, solve
-from mechanics.scene_io_write import scene_to_dict
+from qsplan.mechanics.modes.contact_mode import random_mode
+from qsplan.mechanics import ContactMode, check_mode, count_modes, planted_scene, solve
+from qsplan.mechanics.model.scene_io_write import scene_to_dict
 
 SEED = 1995
 ROOT = Path(__file__).resolve().parents[1]
@@ -50,7 +50,7 @@ def bench_scene(n_c: int, n_effort: int, seed: int = SEED):
 def run_command(path: Path, workers):
     """One ``qsplan modes PATH --json --stats`` run: (seconds, parsed JSON, stats line)."""
     env = {**os.environ, "PYTHONPATH": os.pathsep.join(filter(None, [str(ROOT), os.environ.get("PYTHONPATH")]))}
-    cmd = [sys.executable, "-m", "planner.cli", "modes", str(path), "--json", "--stats"]
+    cmd = [sys.executable, "-m", "qsplan.planner.cli", "modes", str(path), "--json", "--stats"]
     if workers:
         cmd += ["--workers", str(workers)]
     t = time.perf_counter()

@@ -46,13 +46,13 @@ from pathlib import Path
 
 import numpy as np
 
-from mechanics import make_scene, solve
-from mechanics.exact import exact_feasible_modes
-from mechanics.feasibility import velocity_scale
-from mechanics.lcp import solve_lcp
-from mechanics.modes import mode_index_array
-from mechanics.numerics import DEFAULT_TOLERANCES, Status, hadamard_ratio
-from mechanics.solver import ScenePool, equilibrium_matrix, kinematics_stage
+from qsplan.mechanics import make_scene, solve
+from qsplan.mechanics.crosscheck.exact import exact_feasible_modes
+from qsplan.mechanics.modes.reference import velocity_scale
+from qsplan.mechanics.crosscheck.lcp import solve_lcp
+from qsplan.mechanics.modes.contact_mode import mode_index_array
+from qsplan.mechanics.numerics import DEFAULT_TOLERANCES, Status, hadamard_ratio
+from qsplan.mechanics.solver.batch import ScenePool, equilibrium_matrix, kinematics_stage
 
 CHARTS = Path(__file__).resolve().parent / "charts"
 FAMILIES = ("concurrent", "parallel", "slip", "cone", "mu")

@@ -30,13 +30,13 @@ from pathlib import Path
 
 import numpy as np
 
-from hands.segments import first_segment, sample_segment
-from hands.two_finger import default_hand
-from mechanics import solve
-from planner.band_plots import plot_guaranteed, segment_band_figures
-from planner.bands_sweep import narrowest, segment_bands
-from planner.export import export_schedule
-from planner.plots import new_axes, save_figure
+from qsplan.hands.segments import first_segment, sample_segment
+from qsplan.hands.two_finger import default_hand
+from qsplan.mechanics import solve
+from qsplan.planner.plotting.bands import plot_guaranteed, segment_band_figures
+from qsplan.planner.torque.sweep import narrowest, segment_bands
+from qsplan.planner.export.schedule import export_schedule
+from qsplan.planner.plotting.style import new_axes, save_figure
 
 SEED = 1995
 MU_RANGE = (0.0, 0.2)

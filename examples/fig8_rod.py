@@ -15,11 +15,11 @@ from pathlib import Path
 
 import numpy as np
 
-from hands.paper import rod_scene
-from mechanics import scene_from_dict, solve
-from mechanics.muspace import boundary_agreement, mu_slice
-from planner.muspace_plots import plot_mu_map
-from planner.plots import new_axes
+from qsplan.hands.paper import rod_scene
+from qsplan.mechanics import scene_from_dict, solve
+from qsplan.mechanics.muspace.maps import boundary_agreement, mu_slice
+from qsplan.planner.plotting.muspace import plot_mu_map
+from qsplan.planner.plotting.style import new_axes
 
 SEED = 8
 L1, L2 = 1.0, 0.6

@@ -14,12 +14,12 @@ import sys
 from dataclasses import replace
 from pathlib import Path
 
-from hands.two_finger import make_two_finger_hand
-from planner.plan import PlanFailure, plan_task
-from planner.plan_export import export_plan
-from planner.plan_plots import plan_figures
-from planner.plots import save_figure
-from planner.task import make_task
+from qsplan.hands.two_finger import make_two_finger_hand
+from qsplan.planner.planning.plan import PlanFailure, plan_task
+from qsplan.planner.export.plan_files import export_plan
+from qsplan.planner.plotting.plan import plan_figures
+from qsplan.planner.plotting.style import save_figure
+from qsplan.planner.planning.task import make_task
 
 
 def pentagon_task(mu_range=(0.0, 0.2)):

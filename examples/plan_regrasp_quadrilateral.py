@@ -12,12 +12,12 @@ vectors drawn from the task's interval.  Public API only::
 import sys
 from pathlib import Path
 
-from planner.plan import plan_task
-from planner.plan_export import export_plan, read_plan_csv
-from planner.plan_plots import plan_figures
-from planner.plots import save_figure
-from planner.replay import friction_samples, replay_plan
-from planner.task import demo_task_path, load_task
+from qsplan.planner.planning.plan import plan_task
+from qsplan.planner.export.plan_files import export_plan, read_plan_csv
+from qsplan.planner.plotting.plan import plan_figures
+from qsplan.planner.plotting.style import save_figure
+from qsplan.planner.planning.replay import friction_samples, replay_plan
+from qsplan.planner.planning.task import demo_task_path, load_task
 
 
 def main(out="out/examples/quadrilateral"):

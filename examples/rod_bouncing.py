@@ -23,8 +23,8 @@ from pathlib import Path
 
 import numpy as np
 
-from hands.rod import rod_closed_form, simulate_rod
-from planner.motion_plots import rod_motion_figure
+from qsplan.hands.rod import rod_closed_form, simulate_rod
+from qsplan.planner.plotting.motion import rod_motion_figure
 
 SEED = 20250105
 

@@ -9,41 +9,45 @@
 Submodules are imported on first use so that ``import hands`` stays light.
 """
 
+if __name__ != "qsplan.hands":  # the repository root on sys.path must not load a second copy
+    raise ImportError(f"this folder installs as qsplan.hands; import qsplan.hands (after `pip install .`), not {__name__}")
+
+
 _LAZY = {
-    "eq37_scene": "paper",
-    "eq42_scene": "paper",
-    "rod_scene": "paper",
-    "PAPER_SCENES": "paper",
-    "RodOnSupports": "rod",
-    "make_rod_system": "rod",
-    "rod_initial_state": "rod",
-    "rod_distances": "rod",
-    "simulate_rod": "rod",
-    "RodSegment": "rod",
-    "RodClosedForm": "rod",
-    "rod_closed_form": "rod",
-    "check_rod_inputs": "rod",
-    "PushedPolygon": "pushing",
-    "make_pushed_polygon": "pushing",
-    "tilted_box_example": "pushing",
-    "polygon_world": "pushing",
-    "TwoFingerHand": "two_finger",
-    "make_two_finger_hand": "two_finger",
-    "default_hand": "two_finger",
-    "DEFAULT_WORKPIECE": "two_finger",
-    "finger_angles": "two_finger",
-    "finger_angle_rates": "two_finger",
-    "hand_scene": "two_finger",
-    "hand_geometric_scene": "two_finger",
-    "hand_contacts": "two_finger",
-    "hand_polygons": "two_finger",
-    "workpiece_world": "two_finger",
-    "ManipulationSegment": "segments",
-    "SegmentSamples": "segments",
-    "first_segment": "segments",
-    "sample_segment": "segments",
-    "flush_angle": "segments",
-    "FLUSH_CLEARANCE": "segments",
+    "eq37_scene": "qsplan.hands.paper",
+    "eq42_scene": "qsplan.hands.paper",
+    "rod_scene": "qsplan.hands.paper",
+    "PAPER_SCENES": "qsplan.hands.paper",
+    "RodOnSupports": "qsplan.hands.rod",
+    "make_rod_system": "qsplan.hands.rod",
+    "rod_initial_state": "qsplan.hands.rod",
+    "rod_distances": "qsplan.hands.rod",
+    "simulate_rod": "qsplan.hands.rod",
+    "RodSegment": "qsplan.hands.rod",
+    "RodClosedForm": "qsplan.hands.rod",
+    "rod_closed_form": "qsplan.hands.rod",
+    "check_rod_inputs": "qsplan.hands.rod",
+    "PushedPolygon": "qsplan.hands.pushing",
+    "make_pushed_polygon": "qsplan.hands.pushing",
+    "tilted_box_example": "qsplan.hands.pushing",
+    "polygon_world": "qsplan.hands.pushing",
+    "TwoFingerHand": "qsplan.hands.two_finger",
+    "make_two_finger_hand": "qsplan.hands.two_finger",
+    "default_hand": "qsplan.hands.two_finger",
+    "DEFAULT_WORKPIECE": "qsplan.hands.two_finger",
+    "finger_angles": "qsplan.hands.two_finger",
+    "finger_angle_rates": "qsplan.hands.two_finger",
+    "hand_scene": "qsplan.hands.two_finger",
+    "hand_geometric_scene": "qsplan.hands.two_finger",
+    "hand_contacts": "qsplan.hands.two_finger",
+    "hand_polygons": "qsplan.hands.two_finger",
+    "workpiece_world": "qsplan.hands.two_finger",
+    "ManipulationSegment": "qsplan.hands.segments",
+    "SegmentSamples": "qsplan.hands.segments",
+    "first_segment": "qsplan.hands.segments",
+    "sample_segment": "qsplan.hands.segments",
+    "flush_angle": "qsplan.hands.segments",
+    "FLUSH_CLEARANCE": "qsplan.hands.segments",
 }
 
 __all__ = list(_LAZY)
@@ -53,7 +57,7 @@ def __getattr__(name):
     if name in _LAZY:
         import importlib
 
-        value = getattr(importlib.import_module(f".{_LAZY[name]}", __name__), name)
+        value = getattr(importlib.import_module(_LAZY[name]), name)
         globals()[name] = value
         return value
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

@@ -27,8 +27,8 @@ from typing import ClassVar
 
 import numpy as np
 
-from mechanics import QsplanError, Scene, point_wrench
-from mechanics.motion import Friction, make_friction, rigid_body_rates
+from qsplan.mechanics import QsplanError, Scene, point_wrench
+from qsplan.mechanics.motion.simulator import Friction, make_friction, rigid_body_rates
 
 __all__ = ["PushedPolygon", "make_pushed_polygon", "tilted_box_example", "polygon_world"]
 

@@ -74,8 +74,8 @@ from typing import ClassVar
 
 import numpy as np
 
-from mechanics import QsplanError, Scene, point_wrench
-from mechanics.motion import Friction, MotionOptions, make_friction, rigid_body_rates, simulate
+from qsplan.mechanics import QsplanError, Scene, point_wrench
+from qsplan.mechanics.motion.simulator import Friction, MotionOptions, make_friction, rigid_body_rates, simulate
 
 __all__ = [
     "RodOnSupports",

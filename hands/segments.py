@@ -21,9 +21,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from mechanics.errors import SceneError
+from qsplan.mechanics.errors import SceneError
 
-from .two_finger import (
+from qsplan.hands.two_finger import (
     JOINT_NAMES,
     TwoFingerHand,
     finger_angle_rates,

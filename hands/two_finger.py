@@ -28,7 +28,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from mechanics.errors import SceneError
+from qsplan.mechanics.errors import SceneError
 
 __all__ = [
     "CONTACT_ROLES",
@@ -166,7 +166,7 @@ def make_two_finger_hand(
     """
     from shapely.geometry import Polygon
 
-    from mechanics.geometry import check_polygon
+    from qsplan.mechanics.model.geometry import check_polygon
 
     V = check_polygon(workpiece, "workpiece")
     poly = Polygon(V)
@@ -322,7 +322,7 @@ def finger_angle_rates(hand: TwoFingerHand, pose, pose_rate) -> np.ndarray:
 
 def hand_manipulator(hand: TwoFingerHand):
     """The two fingers as a :class:`mechanics.Manipulator` (joints "left", "right"; palm as the base)."""
-    from mechanics.manipulator import make_joint, make_manipulator
+    from qsplan.mechanics.model.manipulator import make_joint, make_manipulator
 
     L, w = hand.finger_length, 0.5 * hand.finger_width
     shape = [(0.0, -w), (L, -w), (L, w), (0.0, w)]
@@ -353,8 +353,8 @@ def hand_geometric_scene(hand: TwoFingerHand, pose, q=None, effort_joint="right"
     mu : float, optional
         Friction of every contact; default ``hand.mu``.
     """
-    from mechanics.geometric_scene import GeometricScene
-    from mechanics.geometry import CONTACT_TOL
+    from qsplan.mechanics.model.geometric_scene import GeometricScene
+    from qsplan.mechanics.model.geometry import CONTACT_TOL
 
     e = _effort_mask(effort_joint)
     pose = np.asarray(pose, dtype=float)
@@ -390,7 +390,7 @@ def hand_contacts(gs) -> list:
         When the geometry gives another contact set (e.g. a finger flush with an
         edge, which gives two contacts on it): the hand's segments end before that.
     """
-    from mechanics.geometric_scene import find_scene_contacts
+    from qsplan.mechanics.model.geometric_scene import find_scene_contacts
 
     found = find_scene_contacts(gs)
     bodies = [c.body for c in found]
@@ -412,7 +412,7 @@ def hand_scene(hand: TwoFingerHand, pose, q=None, effort_joint="right", velocity
     Scene
         Four contacts ``palm:0, palm:1, left:2, right:3``; joints ``left, right``.
     """
-    from mechanics.geometric_scene import scene_from_geometric_scene
+    from qsplan.mechanics.model.geometric_scene import scene_from_geometric_scene
 
     gs = hand_geometric_scene(hand, pose, q, effort_joint, velocity, effort, mu)
     return scene_from_geometric_scene(gs, hand_contacts(gs))
@@ -420,7 +420,7 @@ def hand_scene(hand: TwoFingerHand, pose, q=None, effort_joint="right", velocity
 
 def hand_polygons(hand: TwoFingerHand, pose, q=None) -> dict:
     """World polygons (m) for drawing: ``{"palm", "left", "right", "workpiece"}`` -> ndarray (k, 2)."""
-    from mechanics.manipulator import link_polygons
+    from qsplan.mechanics.model.manipulator import link_polygons
 
     pose = np.asarray(pose, dtype=float)
     q = finger_angles(hand, pose)[0] if q is None else np.asarray(q, dtype=float)

@@ -22,24 +22,28 @@ Public API (everything else is private):
 * errors: :class:`QsplanError`, :class:`SceneError`, :class:`ModeError`
 """
 
-from .contact import cross2, point_wrench, shift_wrenches, tangent_from_normal, wrench_matrices, wrench_matrix
-from .errors import ModeError, QsplanError, SceneError
-from .feasibility import ModeCheck, check_mode
-from .bands import Band, effort_band, effort_bands, guaranteed_band_box, guaranteed_band_shared, possible_band_box, sampled_band
-from .graphical import GraphicalTest, graphical_test, graphical_test_mode
-from .modes import ContactMode, count_modes, enumerate_modes, iter_mode_batches, mode_from_letters
-from .multilinear import Multilinear
-from .muspace import MuMap, MuSlice, boundary_agreement, feasibility_map, grid_points, mu_slice, polynomial_map
-from .parallel import map_chunks
-from .partition import Partition, effort_partitions, partition_table
-from .regions import MuRegion, appendix_a, appendix_b, mode_kinematics, mode_region, region_3s, region_rs
-from .numerics import DEFAULT_TOLERANCES, Status, Tolerances
-from .planted import planted_scene
-from .scene import Scene, make_scene
-from .scene_io import load_scene, scene_from_dict
-from .scene_io_write import scene_to_dict
-from .solution import ModeSolution, model_residuals, relative_velocity
-from .solver import SolveResult, solve
+if __name__ != "qsplan.mechanics":  # the repository root on sys.path must not load a second copy
+    raise ImportError(f"this folder installs as qsplan.mechanics; import qsplan.mechanics (after `pip install .`), not {__name__}")
+
+
+from qsplan.mechanics.model.contact import cross2, point_wrench, shift_wrenches, tangent_from_normal, wrench_matrices, wrench_matrix
+from qsplan.mechanics.errors import ModeError, QsplanError, SceneError
+from qsplan.mechanics.modes.reference import ModeCheck, check_mode
+from qsplan.mechanics.bands.effort import Band, effort_band, effort_bands, guaranteed_band_box, guaranteed_band_shared, possible_band_box, sampled_band
+from qsplan.mechanics.muspace.graphical import GraphicalTest, graphical_test, graphical_test_mode
+from qsplan.mechanics.modes.contact_mode import ContactMode, count_modes, enumerate_modes, iter_mode_batches, mode_from_letters
+from qsplan.mechanics.muspace.multilinear import Multilinear
+from qsplan.mechanics.muspace.maps import MuMap, MuSlice, boundary_agreement, feasibility_map, grid_points, mu_slice, polynomial_map
+from qsplan.mechanics.parallel import map_chunks
+from qsplan.mechanics.modes.partition import Partition, effort_partitions, partition_table
+from qsplan.mechanics.muspace.regions import MuRegion, appendix_a, appendix_b, mode_kinematics, mode_region, region_3s, region_rs
+from qsplan.mechanics.numerics import DEFAULT_TOLERANCES, Status, Tolerances
+from qsplan.mechanics.modes.planted import planted_scene
+from qsplan.mechanics.model.scene import Scene, make_scene
+from qsplan.mechanics.model.scene_io import load_scene, scene_from_dict
+from qsplan.mechanics.model.scene_io_write import scene_to_dict
+from qsplan.mechanics.modes.solution import ModeSolution, model_residuals, relative_velocity
+from qsplan.mechanics.solver.batch import SolveResult, solve
 
 __all__ = [
     "cross2",
@@ -122,38 +126,38 @@ __all__ = [
 # Geometry needs shapely and the simulator scipy; load those modules on first use so that ``import mechanics``
 # (and the CLI's solver path) stays light.
 _LAZY = {
-    "LPCheck": "lp_check",
-    "lp_mode_feasible": "lp_check",
-    "simulate": "motion",
-    "Motion": "motion",
-    "MotionOptions": "motion",
-    "MotionSystem": "motion",
-    "Segment": "motion",
-    "Stop": "motion",
-    "Event": "motion",
-    "Friction": "motion",
-    "make_friction": "motion",
-    "pose_rate": "motion",
-    "rigid_body_rates": "motion",
-    "FrozenScene": "motion",
-    "frozen_scene_system": "motion",
-    "STOP_KINDS": "motion",
-    "GeometricScene": "geometric_scene",
-    "geometric_scene_from_dict": "geometric_scene",
-    "scene_from_geometric_scene": "geometric_scene",
-    "scene_from_geometry": "geometric_scene",
-    "CONTACT_TOL": "geometry",
-    "FoundContact": "geometry",
-    "find_contacts": "geometry",
-    "Joint": "manipulator",
-    "Manipulator": "manipulator",
-    "contact_jacobian": "manipulator",
-    "gravity_efforts": "manipulator",
-    "link_polygons": "manipulator",
-    "link_poses": "manipulator",
-    "make_joint": "manipulator",
-    "make_manipulator": "manipulator",
-    "point_jacobian": "manipulator",
+    "LPCheck": "qsplan.mechanics.crosscheck.lp_check",
+    "lp_mode_feasible": "qsplan.mechanics.crosscheck.lp_check",
+    "simulate": "qsplan.mechanics.motion.simulator",
+    "Motion": "qsplan.mechanics.motion.simulator",
+    "MotionOptions": "qsplan.mechanics.motion.simulator",
+    "MotionSystem": "qsplan.mechanics.motion.simulator",
+    "Segment": "qsplan.mechanics.motion.simulator",
+    "Stop": "qsplan.mechanics.motion.simulator",
+    "Event": "qsplan.mechanics.motion.simulator",
+    "Friction": "qsplan.mechanics.motion.simulator",
+    "make_friction": "qsplan.mechanics.motion.simulator",
+    "pose_rate": "qsplan.mechanics.motion.simulator",
+    "rigid_body_rates": "qsplan.mechanics.motion.simulator",
+    "FrozenScene": "qsplan.mechanics.motion.simulator",
+    "frozen_scene_system": "qsplan.mechanics.motion.simulator",
+    "STOP_KINDS": "qsplan.mechanics.motion.simulator",
+    "GeometricScene": "qsplan.mechanics.model.geometric_scene",
+    "geometric_scene_from_dict": "qsplan.mechanics.model.geometric_scene",
+    "scene_from_geometric_scene": "qsplan.mechanics.model.geometric_scene",
+    "scene_from_geometry": "qsplan.mechanics.model.geometric_scene",
+    "CONTACT_TOL": "qsplan.mechanics.model.geometry",
+    "FoundContact": "qsplan.mechanics.model.geometry",
+    "find_contacts": "qsplan.mechanics.model.geometry",
+    "Joint": "qsplan.mechanics.model.manipulator",
+    "Manipulator": "qsplan.mechanics.model.manipulator",
+    "contact_jacobian": "qsplan.mechanics.model.manipulator",
+    "gravity_efforts": "qsplan.mechanics.model.manipulator",
+    "link_polygons": "qsplan.mechanics.model.manipulator",
+    "link_poses": "qsplan.mechanics.model.manipulator",
+    "make_joint": "qsplan.mechanics.model.manipulator",
+    "make_manipulator": "qsplan.mechanics.model.manipulator",
+    "point_jacobian": "qsplan.mechanics.model.manipulator",
 }
 
 
@@ -164,7 +168,7 @@ def __getattr__(name):
     if name in _LAZY:
         import importlib
 
-        value = getattr(importlib.import_module(f".{_LAZY[name]}", __name__), name)
+        value = getattr(importlib.import_module(_LAZY[name]), name)
         globals()[name] = value
         return value
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

@@ -25,7 +25,7 @@ import threading
 from concurrent.futures import ProcessPoolExecutor
 from functools import partial
 
-from .errors import QsplanError
+from qsplan.mechanics.errors import QsplanError
 
 __all__ = [
     "map_chunks",

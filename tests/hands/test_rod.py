@@ -3,8 +3,8 @@
 import numpy as np
 import pytest
 
-from hands.paper import rod_scene
-from hands.rod import (
+from qsplan.hands.paper import rod_scene
+from qsplan.hands.rod import (
     check_rod_inputs,
     make_rod_system,
     rod_closed_form,
@@ -12,8 +12,8 @@ from hands.rod import (
     rod_initial_state,
     simulate_rod,
 )
-from mechanics import QsplanError, scene_from_dict, solve
-from mechanics.motion import MotionOptions
+from qsplan.mechanics import QsplanError, scene_from_dict, solve
+from qsplan.mechanics.motion.simulator import MotionOptions
 
 ACCEPT = 1e-6  # the bound on switch times and positions
 

@@ -7,8 +7,8 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from hands.segments import FLUSH_CLEARANCE, first_segment, flush_angle, sample_segment
-from hands.two_finger import (
+from qsplan.hands.segments import FLUSH_CLEARANCE, first_segment, flush_angle, sample_segment
+from qsplan.hands.two_finger import (
     CONTACT_ROLES,
     DEFAULT_WORKPIECE,
     default_hand,
@@ -21,8 +21,8 @@ from hands.two_finger import (
     make_two_finger_hand,
     workpiece_world,
 )
-from mechanics import ContactMode, SceneError, check_mode, solve
-from mechanics.bands import effort_band, effort_bands, guaranteed_band_box
+from qsplan.mechanics import ContactMode, SceneError, check_mode, solve
+from qsplan.mechanics.bands.effort import effort_band, effort_bands, guaranteed_band_box
 
 EDGE = 1e-6  # efforts this close to a band edge are not judged (the edge itself is feasible, eq. 28's >=)
 SSSS, BSRS = ContactMode("SSSS"), ContactMode("BSRS")

@@ -3,8 +3,8 @@
 import numpy as np
 import pytest
 
-from mechanics import SceneError, check_mode, planted_scene
-from mechanics.bands import (
+from qsplan.mechanics import SceneError, check_mode, planted_scene
+from qsplan.mechanics.bands.effort import (
     effort_band,
     effort_bands,
     guaranteed_band_box,

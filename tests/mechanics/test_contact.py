@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from mechanics import SceneError, cross2, shift_wrenches, tangent_from_normal, wrench_matrices, wrench_matrix
+from qsplan.mechanics import SceneError, cross2, shift_wrenches, tangent_from_normal, wrench_matrices, wrench_matrix
 
 
 def test_cross2_is_planar_cross_product():

@@ -5,12 +5,12 @@ from fractions import Fraction
 import numpy as np
 import pytest
 
-from hands.paper import PAPER_SCENES
-from mechanics import check_mode, make_scene, planted_scene, scene_from_dict, solve
-from mechanics.contact import wrench_matrices
-from mechanics.exact import exact_check_mode, exact_feasible_modes, solve_exact
-from mechanics.modes import ContactMode
-from mechanics.numerics import Status
+from qsplan.hands.paper import PAPER_SCENES
+from qsplan.mechanics import check_mode, make_scene, planted_scene, scene_from_dict, solve
+from qsplan.mechanics.model.contact import wrench_matrices
+from qsplan.mechanics.crosscheck.exact import exact_check_mode, exact_feasible_modes, solve_exact
+from qsplan.mechanics.modes.contact_mode import ContactMode
+from qsplan.mechanics.numerics import Status
 
 
 @pytest.mark.parametrize("n_c, seed", [(n, s) for n in (3, 4, 5) for s in range(6)])
@@ -57,7 +57,7 @@ def test_concurrent_normals_are_exactly_singular():
 
 
 def test_ill_conditioned_verdict_names_measure_and_threshold():
-    from mechanics.numerics import DEFAULT_TOLERANCES, conditioning_verdict
+    from qsplan.mechanics.numerics import DEFAULT_TOLERANCES, conditioning_verdict
 
     r = np.array([[1.0, 0.0], [0.0, 1.0], [-1.0, -1.0]])
     n = np.array([[-1.0, 0.0], [0.0, -1.0], [1.0, 1.0]])

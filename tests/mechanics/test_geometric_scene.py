@@ -6,14 +6,14 @@ import json
 import numpy as np
 import pytest
 
-from mechanics import SceneError, load_scene, scene_from_dict
-from mechanics.geometric_scene import (
+from qsplan.mechanics import SceneError, load_scene, scene_from_dict
+from qsplan.mechanics.model.geometric_scene import (
     find_scene_contacts,
     geometric_scene_from_dict,
     scene_from_geometric_scene,
     scene_from_geometry,
 )
-from mechanics.manipulator import link_poses
+from qsplan.mechanics.model.manipulator import link_poses
 
 # A pointed finger along its link frame's x axis, tip at (1, 0).
 TIP = [[0, -0.05], [0.9, -0.05], [1.0, 0], [0.9, 0.05], [0, 0.05]]

@@ -4,8 +4,8 @@ import numpy as np
 import pytest
 from shapely.geometry import Polygon, box
 
-from mechanics import SceneError
-from mechanics.geometry import CONTACT_TOL, check_polygon, find_contacts
+from qsplan.mechanics import SceneError
+from qsplan.mechanics.model.geometry import CONTACT_TOL, check_polygon, find_contacts
 
 UNIT = Polygon([(0, 0), (1, 0), (1, 1), (0, 1)])  # ordering starts at (0, 0); shapely.box starts at (1, 0)
 PALM = box(-2, -1, 3, 0)

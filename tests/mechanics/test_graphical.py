@@ -5,17 +5,17 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from hands.paper import eq37_scene, eq42_scene, rod_scene
-from mechanics import ModeError, QsplanError, enumerate_modes, scene_from_dict, wrench_matrices
-from mechanics.graphical import (
+from qsplan.hands.paper import eq37_scene, eq42_scene, rod_scene
+from qsplan.mechanics import ModeError, QsplanError, enumerate_modes, scene_from_dict, wrench_matrices
+from qsplan.mechanics.muspace.graphical import (
     active_wrenches,
     contact_points,
     graphical_test,
     graphical_test_mode,
     line_of_action,
 )
-from mechanics.numerics import Status
-from mechanics.regions import appendix_a, appendix_b, region_3s, region_rs
+from qsplan.mechanics.numerics import Status
+from qsplan.mechanics.muspace.regions import appendix_a, appendix_b, region_3s, region_rs
 
 CONFIGS = 1500
 

@@ -3,10 +3,10 @@
 import numpy as np
 import pytest
 
-from hands.paper import PAPER_SCENES
-from mechanics import planted_scene, scene_from_dict, solve
-from mechanics.lcp import LcpStatus, quasistatic_lcp, solve_lcp
-from mechanics.solution import relative_velocity
+from qsplan.hands.paper import PAPER_SCENES
+from qsplan.mechanics import planted_scene, scene_from_dict, solve
+from qsplan.mechanics.crosscheck.lcp import LcpStatus, quasistatic_lcp, solve_lcp
+from qsplan.mechanics.modes.solution import relative_velocity
 
 
 def lcp_point(scene, sol):
@@ -100,7 +100,7 @@ def test_iteration_cap_reported():
 def test_cli_modes_method_lcp(tmp_path, capsys):
     import json
 
-    from planner.cli import main
+    from qsplan.planner.cli.main import main
 
     path = tmp_path / "eq42.json"
     path.write_text(json.dumps(PAPER_SCENES["eq42"](mu=0.5)))

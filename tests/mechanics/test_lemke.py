@@ -5,7 +5,7 @@ from itertools import product
 import numpy as np
 import pytest
 
-from mechanics.lemke import LemkeStatus, lemke
+from qsplan.mechanics.crosscheck.lemke import LemkeStatus, lemke
 
 
 def assert_lcp_solution(M, q, res, tol=1e-9):

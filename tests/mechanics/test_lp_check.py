@@ -3,9 +3,9 @@
 import numpy as np
 import pytest
 
-from mechanics import ContactMode, ModeError, Status, check_mode, enumerate_modes, make_scene, planted_scene
-from mechanics.contact import wrench_matrices
-from mechanics.lp_check import LP_TOL, lp_mode_feasible
+from qsplan.mechanics import ContactMode, ModeError, Status, check_mode, enumerate_modes, make_scene, planted_scene
+from qsplan.mechanics.model.contact import wrench_matrices
+from qsplan.mechanics.crosscheck.lp_check import LP_TOL, lp_mode_feasible
 
 N_SCENES = 200
 BOUNDARY = 1e-7  # |margin| below this: the verdict is a matter of tolerance, skipped and counted

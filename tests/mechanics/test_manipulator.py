@@ -3,8 +3,8 @@
 import numpy as np
 import pytest
 
-from mechanics import SceneError
-from mechanics.manipulator import (
+from qsplan.mechanics import SceneError
+from qsplan.mechanics.model.manipulator import (
     Joint,
     base_polygon,
     contact_jacobian,

@@ -6,12 +6,12 @@ from itertools import combinations
 import numpy as np
 import pytest
 
-from hands.paper import eq37_scene, eq42_scene, rod_scene
-from mechanics import ContactMode, QsplanError, check_mode, count_modes, make_scene, planted_scene, scene_from_dict, solve
-from mechanics.breaking_sets import _Programme, equilibrium_relaxation, feasible_breaking_sets
-from mechanics.mode_search import PRUNED, PRUNED_KINEMATIC, codes_with_breaking_sets
-from mechanics.modes import codes_to_letters, enumerate_modes, mode_order_key
-from mechanics.numerics import DEFAULT_TOLERANCES, Status
+from qsplan.hands.paper import eq37_scene, eq42_scene, rod_scene
+from qsplan.mechanics import ContactMode, QsplanError, check_mode, count_modes, make_scene, planted_scene, scene_from_dict, solve
+from qsplan.mechanics.solver.breaking_sets import _Programme, equilibrium_relaxation, feasible_breaking_sets
+from qsplan.mechanics.solver.search import PRUNED, PRUNED_KINEMATIC, codes_with_breaking_sets
+from qsplan.mechanics.modes.contact_mode import codes_to_letters, enumerate_modes, mode_order_key
+from qsplan.mechanics.numerics import DEFAULT_TOLERANCES, Status
 
 SOLUTION_TOL = 1e-12  # both paths solve the same matrices: only the batch composition differs
 
@@ -65,8 +65,8 @@ def test_paper_examples(mu):
 
 
 def test_two_finger_hand_scenes():
-    from hands.segments import first_segment
-    from hands.two_finger import default_hand, hand_scene
+    from qsplan.hands.segments import first_segment
+    from qsplan.hands.two_finger import default_hand, hand_scene
 
     hand = default_hand()
     segment = first_segment(hand, duration=10.0)
@@ -126,8 +126,8 @@ def test_bad_search_argument():
 
 
 def test_cli_stats_and_search(tmp_path, capsys):
-    from mechanics.scene_io_write import scene_to_dict
-    from planner.cli import main
+    from qsplan.mechanics.model.scene_io_write import scene_to_dict
+    from qsplan.planner.cli.main import main
 
     scene, planted = _planted(5, 9, 6)
     path = tmp_path / "s.json"
@@ -145,9 +145,9 @@ def test_cli_stats_and_search(tmp_path, capsys):
 
 
 def test_reduced_penetration_flags_only_modes_the_reference_rejects():
-    from mechanics.feasibility import velocity_scale
-    from mechanics.mode_search import PENETRATION_MARGIN, _codes, _rolling_sets, penetrates
-    from mechanics.solver import ScenePool
+    from qsplan.mechanics.modes.reference import velocity_scale
+    from qsplan.mechanics.solver.search import PENETRATION_MARGIN, _codes, _rolling_sets, penetrates
+    from qsplan.mechanics.solver.batch import ScenePool
 
     flagged_any = 0
     for seed in range(4):

@@ -2,8 +2,8 @@
 
 import pytest
 
-from mechanics import ContactMode, ModeError, count_modes, enumerate_modes, iter_mode_batches, mode_from_letters
-from mechanics.modes import codes_to_letters, mode_index_array
+from qsplan.mechanics import ContactMode, ModeError, count_modes, enumerate_modes, iter_mode_batches, mode_from_letters
+from qsplan.mechanics.modes.contact_mode import codes_to_letters, mode_index_array
 
 TABLE1 = {  # the paper's Table 1, n_c = 3..8
     -1: [6, 16, 45, 126, 357, 1016],

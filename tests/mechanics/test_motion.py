@@ -3,12 +3,12 @@
 import numpy as np
 import pytest
 
-from hands.paper import eq37_scene, eq42_scene
-from hands.pushing import make_pushed_polygon, tilted_box_example
-from hands.rod import make_rod_system, rod_initial_state
-from mechanics import ContactMode, QsplanError, Status, check_mode, enumerate_modes, planted_scene, scene_from_dict
-from mechanics.events import mode_values, rk4_step, signed_hadamard
-from mechanics.motion import (
+from qsplan.hands.paper import eq37_scene, eq42_scene
+from qsplan.hands.pushing import make_pushed_polygon, tilted_box_example
+from qsplan.hands.rod import make_rod_system, rod_initial_state
+from qsplan.mechanics import ContactMode, QsplanError, Status, check_mode, enumerate_modes, planted_scene, scene_from_dict
+from qsplan.mechanics.motion.events import mode_values, rk4_step, signed_hadamard
+from qsplan.mechanics.motion.simulator import (
     STOP_KINDS,
     MotionOptions,
     frozen_scene_system,
@@ -288,7 +288,7 @@ def test_the_current_mode_is_kept_while_feasible():
 
 def test_pushed_scene_matches_the_shared_geometric_scene(pushed):
     """Cross-check against mechanics.geometry.find_contacts / geometric_scene along the motion."""
-    from mechanics import scene_from_dict
+    from qsplan.mechanics import scene_from_dict
 
     system, _, motion = pushed
     checked = 0
@@ -311,7 +311,7 @@ def test_pushed_scene_matches_the_shared_geometric_scene(pushed):
 
 def test_rod_on_a_table_with_one_contact_has_no_quasistatic_solution():
     """Section 2.2: a rod touching a table at one point off its centre of mass."""
-    from mechanics import make_scene, wrench_matrices
+    from qsplan.mechanics import make_scene, wrench_matrices
 
     Wn, Wt = wrench_matrices([[0.5, 0.0]], [[0.0, 1.0]])
     scene = make_scene(Wn, Wt, np.zeros((1, 1)), np.zeros((1, 1)), [0.5], [0.0, -1.0, 0.0], joint_velocity=[0.0])

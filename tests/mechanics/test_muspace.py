@@ -3,9 +3,9 @@
 import numpy as np
 import pytest
 
-from hands.paper import eq42_scene
-from mechanics import SceneError, planted_scene, scene_from_dict, solve
-from mechanics.muspace import feasibility_map, grid_points
+from qsplan.hands.paper import eq42_scene
+from qsplan.mechanics import SceneError, planted_scene, scene_from_dict, solve
+from qsplan.mechanics.muspace.maps import feasibility_map, grid_points
 
 
 def test_map_equals_solver_at_every_point():

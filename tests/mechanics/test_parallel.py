@@ -10,18 +10,20 @@ from functools import partial
 import numpy as np
 import pytest
 
-from hands.paper import eq42_scene
-from hands.segments import first_segment, sample_segment
-from hands.two_finger import default_hand
-from mechanics import QsplanError, scene_from_dict, solve
-from mechanics import mode_chunks, muspace, parallel
-from mechanics.muspace import feasibility_map, grid_points, mu_slice
-from mechanics.numerics import DEFAULT_TOLERANCES
-from mechanics.parallel import chunk_count, first_difference, map_chunks, split_range
-from mechanics.planted import planted_scene
-from planner import bands_sweep
-from planner.bands_sweep import segment_bands
-from planner.cli import main
+from qsplan.hands.paper import eq42_scene
+from qsplan.hands.segments import first_segment, sample_segment
+from qsplan.hands.two_finger import default_hand
+from qsplan.mechanics import QsplanError, scene_from_dict, solve
+from qsplan.mechanics import parallel
+from qsplan.mechanics.muspace import maps as muspace
+from qsplan.mechanics.solver import chunks as mode_chunks
+from qsplan.mechanics.muspace.maps import feasibility_map, grid_points, mu_slice
+from qsplan.mechanics.numerics import DEFAULT_TOLERANCES
+from qsplan.mechanics.parallel import chunk_count, first_difference, map_chunks, split_range
+from qsplan.mechanics.modes.planted import planted_scene
+from qsplan.planner.torque import sweep as bands_sweep
+from qsplan.planner.torque.sweep import segment_bands
+from qsplan.planner.cli.main import main
 
 #: Seconds to wait for the test's own cluster, and for the unreachable one.
 CLUSTER_TIMEOUT = 30

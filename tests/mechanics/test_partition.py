@@ -3,8 +3,8 @@
 import numpy as np
 import pytest
 
-from mechanics import ContactMode, ModeError, check_mode, planted_scene, solve
-from mechanics.partition import effort_partitions, partition_table
+from qsplan.mechanics import ContactMode, ModeError, check_mode, planted_scene, solve
+from qsplan.mechanics.modes.partition import effort_partitions, partition_table
 
 
 def test_scene_partition_admits_its_planted_mode_and_is_ranked():

@@ -3,9 +3,9 @@
 import numpy as np
 import pytest
 
-from hands.paper import eq37_scene, eq42_scene, rod_scene
-from mechanics import ContactMode, ModeError, QsplanError, SceneError, enumerate_modes, planted_scene, scene_from_dict, solve
-from mechanics.multilinear import (
+from qsplan.hands.paper import eq37_scene, eq42_scene, rod_scene
+from qsplan.mechanics import ContactMode, ModeError, QsplanError, SceneError, enumerate_modes, planted_scene, scene_from_dict, solve
+from qsplan.mechanics.muspace.multilinear import (
     Multilinear,
     adjugate,
     bilinear_zero_set,
@@ -15,9 +15,9 @@ from mechanics.multilinear import (
     monomials,
     restrict_coef,
 )
-from mechanics.muspace import boundary_agreement, feasibility_map, mu_slice, polynomial_map
-from mechanics.numerics import Status
-from mechanics.regions import (
+from qsplan.mechanics.muspace.maps import boundary_agreement, feasibility_map, mu_slice, polynomial_map
+from qsplan.mechanics.numerics import Status
+from qsplan.mechanics.muspace.regions import (
     MuRegion,
     appendix_a,
     appendix_b,

@@ -6,8 +6,8 @@ import json
 import numpy as np
 import pytest
 
-from hands.paper import eq42_scene, rod_scene
-from mechanics import SceneError, load_scene, scene_from_dict, solve
+from qsplan.hands.paper import eq42_scene, rod_scene
+from qsplan.mechanics import SceneError, load_scene, scene_from_dict, solve
 
 RAW = {
     "g_obj": [0.0, -1.0, 0.0],

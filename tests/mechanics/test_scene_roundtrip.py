@@ -5,9 +5,9 @@ import json
 import numpy as np
 import pytest
 
-from hands.paper import eq37_scene, eq42_scene
-from mechanics import SceneError, make_scene, planted_scene, scene_from_dict, solve
-from mechanics.scene_io_write import scene_to_dict
+from qsplan.hands.paper import eq37_scene, eq42_scene
+from qsplan.mechanics import SceneError, make_scene, planted_scene, scene_from_dict, solve
+from qsplan.mechanics.model.scene_io_write import scene_to_dict
 
 FIELDS = ("Wn", "Wt", "Jn", "Jt", "mu", "g_obj", "g_man", "effort_controlled", "joint_velocity", "joint_effort")
 

@@ -3,8 +3,8 @@
 import numpy as np
 import pytest
 
-from hands.paper import eq37_scene, eq42_scene, rod_scene
-from mechanics import (
+from qsplan.hands.paper import eq37_scene, eq42_scene, rod_scene
+from qsplan.mechanics import (
     ContactMode,
     Status,
     check_mode,
@@ -15,7 +15,7 @@ from mechanics import (
     scene_from_dict,
     solve,
 )
-from mechanics.muspace import feasibility_map
+from qsplan.mechanics.muspace.maps import feasibility_map
 
 RESIDUAL_TOL = 1e-9  # the acceptance bound on eqs. 2-11
 
@@ -198,7 +198,7 @@ def test_singular_equilibrium_is_degenerate():
     # 3S where the three friction-cone edges meet in a point: W_Amu singular (eq. 31) though W_A is not
     n = np.array([[0.0, 1.0], [np.sin(2.0), np.cos(2.0)], [np.sin(-2.0), np.cos(-2.0)]])
     r = np.array([[0.0, -1.0], -n[1], -n[2]])
-    from mechanics import wrench_matrices
+    from qsplan.mechanics import wrench_matrices
 
     Wn, Wt = wrench_matrices(r, n)  # normals all through the origin
     scene = make_scene(Wn, Wt, [[0.0], [0.0], [0.0]], [[1.0], [1.0], [1.0]], [0.0, 0.0, 0.0], [0, 0, 1.0], joint_velocity=[1.0])
@@ -224,8 +224,8 @@ def test_mode_must_fit_the_partition():
 def test_frictionless_rolling_contact_cannot_pull():
     # eq. (9): c_n >= 0 at a rolling contact even when mu = 0 (the cone rows of eq. 7 then say only c_t = 0).
     # Block on a floor, weight outside the supports: RS would need the floor to pull (c_n1 = -0.5).
-    from mechanics import wrench_matrices
-    from mechanics.regions import region_rs
+    from qsplan.mechanics import wrench_matrices
+    from qsplan.mechanics.muspace.regions import region_rs
 
     Wn, Wt = wrench_matrices([[-1, 0], [1, 0]], [[0, 1], [0, 1]])
     scene = make_scene(Wn, Wt, [[0.0], [0.0]], [[-1.0], [0.0]], [0.0, 0.0], [0, -1, -2], joint_velocity=[1.0])

@@ -3,12 +3,12 @@
 import numpy as np
 import pytest
 
-from hands.segments import first_segment, sample_segment
-from hands.two_finger import default_hand
-from mechanics import ModeError, QsplanError, SceneError, planted_scene, solve
-from mechanics.bands import band_kinematics, effort_bands
-from mechanics.modes import enumerate_modes
-from planner.bands_sweep import (
+from qsplan.hands.segments import first_segment, sample_segment
+from qsplan.hands.two_finger import default_hand
+from qsplan.mechanics import ModeError, QsplanError, SceneError, planted_scene, solve
+from qsplan.mechanics.bands.effort import band_kinematics, effort_bands
+from qsplan.mechanics.modes.contact_mode import enumerate_modes
+from qsplan.planner.torque.sweep import (
     _subtract,
     competing_modes,
     guaranteed_sweep,
@@ -17,8 +17,8 @@ from planner.bands_sweep import (
     sampled_guaranteed_sweep,
     segment_bands,
 )
-from planner.command import choose_command
-from planner.preclusion import competitor_torques
+from qsplan.planner.torque.command import choose_command
+from qsplan.mechanics.bands.preclusion import competitor_torques
 
 N = 21  # samples along the segment: every 0.5 s
 

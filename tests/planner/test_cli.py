@@ -7,10 +7,10 @@ import sys
 import numpy as np
 import pytest
 
-from hands.paper import eq42_scene, rod_scene
-from mechanics import planted_scene, solve
-from mechanics.scene_io_write import scene_to_dict
-from planner.cli import main
+from qsplan.hands.paper import eq42_scene, rod_scene
+from qsplan.mechanics import planted_scene, solve
+from qsplan.mechanics.model.scene_io_write import scene_to_dict
+from qsplan.planner.cli.main import main
 
 
 def run(args, capsys):
@@ -109,9 +109,9 @@ def test_bad_input_one_line_exit_2(tmp_path, eq42_file, capsys, args, match):
 def test_console_script_subprocess_no_traceback(tmp_path):
     p = tmp_path / "rod.json"
     p.write_text(json.dumps(rod_scene(l1=1.0, l2=0.5, mu=(0.3, 0.3))))
-    ok = subprocess.run([sys.executable, "-m", "planner.cli", "modes", str(p), "--json"], capture_output=True, text=True)
+    ok = subprocess.run([sys.executable, "-m", "qsplan.planner.cli", "modes", str(p), "--json"], capture_output=True, text=True)
     assert ok.returncode == 0 and [f["name"] for f in json.loads(ok.stdout)["feasible"]] == ["R2S1"]
-    bad = subprocess.run([sys.executable, "-m", "planner.cli", "modes", str(p), "--mu", "-1"], capture_output=True, text=True)
+    bad = subprocess.run([sys.executable, "-m", "qsplan.planner.cli", "modes", str(p), "--mu", "-1"], capture_output=True, text=True)
     assert bad.returncode == 2 and bad.stdout == "" and len(bad.stderr.splitlines()) == 1
 
 
@@ -153,10 +153,10 @@ def test_geometric_scene_file(capsys):
 
 
 def test_no_feasible_mode_with_undecided_modes_is_not_called_a_jam():
-    from mechanics import SolveResult
-    from mechanics.scene_io import scene_from_dict
-    from mechanics.numerics import Status
-    from planner.report import format_solve_result
+    from qsplan.mechanics import SolveResult
+    from qsplan.mechanics.model.scene_io import scene_from_dict
+    from qsplan.mechanics.numerics import Status
+    from qsplan.planner.reports.solve_report import format_solve_result
 
     scene = scene_from_dict(eq42_scene(0.5))
     counts = dict.fromkeys(Status.ORDER, 0)

@@ -8,10 +8,10 @@ import sys
 import numpy as np
 import pytest
 
-from hands.paper import eq42_scene, rod_scene
-from mechanics import enumerate_modes, scene_from_dict, solve
-from mechanics.muspace import mu_slice
-from planner.cli import main
+from qsplan.hands.paper import eq42_scene, rod_scene
+from qsplan.mechanics import enumerate_modes, scene_from_dict, solve
+from qsplan.mechanics.muspace.maps import mu_slice
+from qsplan.planner.cli.main import main
 
 LEGEND = ["3S", "R1S2", "R1S3", "R2S1", "R2S3", "R3S1", "R3S2"]
 
@@ -145,17 +145,17 @@ def test_bad_scene_and_unwritable_out(tmp_path, eq42_file, capsys):
 
 
 def test_console_subprocess(eq42_file):
-    ok = subprocess.run([sys.executable, "-m", "planner.cli", "muspace", str(eq42_file), "--x", "mu1", "--y", "mu2",
+    ok = subprocess.run([sys.executable, "-m", "qsplan.planner.cli", "muspace", str(eq42_file), "--x", "mu1", "--y", "mu2",
                          "--range", "0", "1.5", "--n", "40", "--json"], capture_output=True, text=True)  # fmt: skip
     assert ok.returncode == 0 and ok.stderr == ""
     assert len(json.loads(ok.stdout)["cells"]) == 40
-    bad = subprocess.run([sys.executable, "-m", "planner.cli", "muspace", str(eq42_file), "--x", "mu9", "--y", "mu2",
+    bad = subprocess.run([sys.executable, "-m", "qsplan.planner.cli", "muspace", str(eq42_file), "--x", "mu9", "--y", "mu2",
                           "--range", "0", "1", "--n", "4"], capture_output=True, text=True)  # fmt: skip
     assert bad.returncode == 2 and bad.stdout == "" and len(bad.stderr.splitlines()) == 1
 
 
 def test_plots_return_axes():
-    from planner.muspace_plots import plot_contact_scene, plot_mu_map
+    from qsplan.planner.plotting.muspace import plot_contact_scene, plot_mu_map
 
     scene = scene_from_dict(eq42_scene())
     xs = np.linspace(0, 1.5, 30)

@@ -4,8 +4,8 @@ import json
 
 import pytest
 
-from planner.cli import main
-from planner.plan_export import read_plan_csv
+from qsplan.planner.cli.main import main
+from qsplan.planner.export.plan_files import read_plan_csv
 
 SMALL_TASK = """
 name = "small"

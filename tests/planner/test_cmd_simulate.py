@@ -6,8 +6,8 @@ import sys
 
 import pytest
 
-from hands.rod import rod_closed_form
-from planner.cli import main
+from qsplan.hands.rod import rod_closed_form
+from qsplan.planner.cli.main import main
 
 BASE = ["simulate", "rod", "--l1", "1.0", "--l2", "0.6", "--speed", "0.1"]
 KEYS = ("mode", "t_start", "t_end", "l1_start", "l2_start", "l1_end", "l2_end")
@@ -120,7 +120,7 @@ def test_usage_errors_exit_2(capsys):
 
 def test_console_entry_point_subprocess():
     proc = subprocess.run(
-        [sys.executable, "-m", "planner.cli", *BASE, "--mu-static", "0.5", "0.5", "--mu-kinetic", "0.6", "0.4",
+        [sys.executable, "-m", "qsplan.planner.cli", *BASE, "--mu-static", "0.5", "0.5", "--mu-kinetic", "0.6", "0.4",
          "--duration", "1", "--json"],  # fmt: skip
         capture_output=True, text=True, timeout=120,
     )  # fmt: skip

@@ -6,7 +6,7 @@ import sys
 
 import pytest
 
-from planner.cli import main
+from qsplan.planner.cli.main import main
 
 FAST = ["sweep", "--samples", "11", "--no-plots"]
 
@@ -70,7 +70,7 @@ def test_bad_arguments_exit_2_with_one_line(tmp_path, capsys, extra, match):
 
 
 def test_console_entry_point(tmp_path):
-    r = subprocess.run([sys.executable, "-m", "planner.cli"] + FAST + ["--out", str(tmp_path), "--json", "--samples", "5"],
+    r = subprocess.run([sys.executable, "-m", "qsplan.planner.cli"] + FAST + ["--out", str(tmp_path), "--json", "--samples", "5"],
                        capture_output=True, text=True, check=False)  # fmt: skip
     assert r.returncode == 0, r.stderr
     assert json.loads(r.stdout)["samples"] == 5

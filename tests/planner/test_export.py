@@ -7,11 +7,11 @@ import math
 import numpy as np
 import pytest
 
-from hands.segments import first_segment, sample_segment
-from hands.two_finger import default_hand
-from mechanics import QsplanError
-from planner.bands_sweep import segment_bands
-from planner.export import (
+from qsplan.hands.segments import first_segment, sample_segment
+from qsplan.hands.two_finger import default_hand
+from qsplan.mechanics import QsplanError
+from qsplan.planner.torque.sweep import segment_bands
+from qsplan.planner.export.schedule import (
     FORMAT,
     export_schedule,
     schedule_columns,

@@ -5,15 +5,15 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from hands.two_finger import default_hand, finger_angles, hand_scene
-from mechanics import QsplanError
-from mechanics.bands import guaranteed_band_box
-from mechanics.modes import ContactMode
-from planner.plan_export import export_plan, read_plan_csv
-from mechanics.solver import solve
-from planner.plan import check_free_state
-from planner.replay import friction_samples, replay_plan
-from planner.task import demo_task_path, load_task, make_task, task_paths
+from qsplan.hands.two_finger import default_hand, finger_angles, hand_scene
+from qsplan.mechanics import QsplanError
+from qsplan.mechanics.bands.effort import guaranteed_band_box
+from qsplan.mechanics.modes.contact_mode import ContactMode
+from qsplan.planner.export.plan_files import export_plan, read_plan_csv
+from qsplan.mechanics.solver.batch import solve
+from qsplan.planner.planning.plan import check_free_state
+from qsplan.planner.planning.replay import friction_samples, replay_plan
+from qsplan.planner.planning.task import demo_task_path, load_task, make_task, task_paths
 
 
 def test_bundled_tasks_load():
@@ -45,7 +45,7 @@ def test_task_validation_names_the_field(tmp_path, text, match):
 @pytest.fixture(scope="module")
 def demo_files(tmp_path_factory):
     """The bundled demo task planned once, exported, and read back from the file."""
-    from planner.plan import plan_task
+    from qsplan.planner.planning.plan import plan_task
 
     plan = plan_task(load_task(demo_task_path()))
     out = tmp_path_factory.mktemp("demo")
@@ -144,7 +144,7 @@ def test_plan_counts_and_checks(demo_files):
 
 @pytest.mark.ompl
 def test_too_wide_friction_fails_with_a_report():
-    from planner.plan import PlanFailure, plan_task
+    from qsplan.planner.planning.plan import PlanFailure, plan_task
 
     task = make_task(default_hand(), 0.0, [-0.04], mu_range=(0.0, 0.5), torque_resolution=0.05)
     with pytest.raises(PlanFailure, match="band closes at x in") as info:
@@ -158,7 +158,7 @@ def test_too_wide_friction_fails_with_a_report():
 
 @pytest.mark.ompl
 def test_degenerate_closure_is_named_without_meaningless_edge_corners():
-    from planner.plan import PlanFailure, plan_task
+    from qsplan.planner.planning.plan import PlanFailure, plan_task
 
     task = load_task(task_paths()["pentagon_task"])
     with pytest.raises(PlanFailure) as info:

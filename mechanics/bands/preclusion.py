@@ -1,0 +1,330 @@
+"""Precluding a competing contact mode over uncertain friction (Section 5.2, Figs. 12-13).
+
+To guarantee a desired mode the effort must keep it feasible for every friction
+coefficient in the uncertainty set (:func:`mechanics.guaranteed_band_box`,
+:func:`mechanics.guaranteed_band_shared`) **and** make every competing mode
+infeasible for every one of them.  :func:`competitor_torques` finds, inside a
+given effort interval ``G``, the hull ``[lower, upper]`` of the efforts for which
+a competing mode is feasible for *some* friction in the set; subtracting it from
+``G`` precludes the mode.
+
+Method (branch and bound over friction cells, exact to a tolerance):
+
+* A competing mode's Coulomb rows are ``s_r = N_r(mu, tau) / det Q_AI(mu)`` with
+  ``N_r`` and ``det Q_AI`` multilinear in the mu's (box) or polynomials of degree
+  ``n_S + 1`` in one shared mu, and ``N_r`` affine in the effort (eqs. 26-28).
+* On a cell (a sub-box, or a sub-interval of the shared coefficient) the range of
+  a multilinear function lies between its vertex values, and that of a polynomial
+  between its Bernstein coefficients.  Where ``det`` keeps its sign, row ``r`` can
+  hold somewhere in the cell only for efforts where some control value of
+  ``sgn(det) N_r`` is nonnegative: a union of half-lines; the cell's possible
+  efforts lie in the intersection over rows.  Where ``det`` changes sign (the
+  mode is singular inside the cell), a pair of rows whose numerators keep
+  opposite signs on the whole cell still excludes the effort.
+* Cells are bisected best-first.  Every evaluated friction point gives a truly
+  feasible effort (an incumbent); cells whose bound cannot beat the incumbent by
+  more than the tolerance are dropped.  The reported end is the smallest bound
+  left, so it never lies inside the competitor's true set: the result is exact
+  to ``tol`` when the search finishes, and conservative (wider) when it runs out
+  of its cell budget, which is said in the result.
+
+The hull may contain efforts where the competitor is infeasible (if its feasible
+efforts are not an interval): precluding the hull is then conservative.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from math import comb
+
+import numpy as np
+
+from qsplan.mechanics.bands.effort import band_kinematics, band_rows
+from qsplan.mechanics.errors import SceneError
+from qsplan.mechanics.modes.contact_mode import ContactMode
+from qsplan.mechanics.numerics import DEFAULT_TOLERANCES, Tolerances
+
+__all__ = ["MAX_CELLS", "PRECLUSION_RTOL", "CompetitorTorques", "competitor_torques"]
+
+#: Relative tolerance of the branch and bound (of the effort interval's largest finite
+#: edge, or 1 N m): the search stops when no cell can lower the bound by more.  The
+#: reported edge is always on the safe side, so the tolerance only costs band width;
+#: 1e-6 of the torque scale is far below any torque controller's resolution.
+PRECLUSION_RTOL = 1e-6
+
+#: Cells evaluated per search before it stops with a conservative answer.  The default
+#: hand's competitors resolve in one or two cells (their extremes sit at vertices of the
+#: friction box); random scenes take up to a few hundred; near a singular set of the
+#: competitor (``det Q_AI`` changing sign) cells never resolve, and the budget bounds the time.
+MAX_CELLS = 4000
+
+
+@dataclass(frozen=True, slots=True)
+class CompetitorTorques:
+    """Efforts inside ``G`` for which a competing mode may be feasible (N m or N).
+
+    Attributes
+    ----------
+    mode : str
+    lower, upper : float
+        Hull of the competitor's possibly-feasible efforts inside ``G``; NaN when it
+        is infeasible for every effort in ``G`` and every friction in the set.
+    empty : bool
+        The competitor is precluded on the whole of ``G``.
+    exact : bool
+        Both ends were found to the tolerance (False: budget exhausted, the hull is wider).
+    reason : str or None
+        ``"kinematics: ..."`` when the mode fails kinematically (never feasible), or why
+        the answer is conservative.
+    cells : int
+        Friction cells evaluated.
+    """
+
+    mode: str
+    lower: float
+    upper: float
+    empty: bool
+    exact: bool
+    reason: str | None = None
+    cells: int = 0
+
+
+class _Cells:
+    """Control values of the competitor's rows on friction cells (box vertices or Bernstein coefficients)."""
+
+    def __init__(self, scene, mk, lo, hi, shared, tol):
+        self.scene, self.mk, self.tol = scene, mk, tol
+        self.shared = shared
+        n_c = scene.n_contacts
+        self.n_c = n_c
+        if shared:
+            self.deg = len(mk.mode.sliding) + 1
+            nodes = 0.5 * (lo + hi) + 0.5 * (hi - lo) * np.cos(np.pi * (np.arange(self.deg + 1) + 0.5) / (self.deg + 1))
+            s0, s1, det, _ = band_rows(scene, mk, np.repeat(nodes[:, None], n_c, axis=1))
+            V = np.vander(nodes, self.deg + 1, increasing=True)
+            self.cdet = np.linalg.solve(V, det)  # (deg+1,) power-basis coefficients in mu
+            self.cN0 = np.linalg.solve(V, s0 * det[:, None])  # (deg+1, R)
+            self.cN1 = np.linalg.solve(V, s1 * det[:, None])
+            self.root = (np.array([[lo]]), np.array([[hi]]))
+        else:
+            self.free = [c for c in range(n_c) if mk.mode.letters[c] != "B" and hi[c] > lo[c]]
+            self.base = lo.copy()
+            self.root = (lo[self.free][None], hi[self.free][None])
+
+    def evaluate(self, clo, chi):
+        """Control values and point bands of cells ``[clo, chi]`` (m, d).
+
+        Returns det (m, K), N0 (m, K, R), N1 (m, K, R), and the bands at actual
+        friction points: pl, pu (m, P), pok (m, P).
+        """
+        m = clo.shape[0]
+        if self.shared:
+            return self._bernstein(clo[:, 0], chi[:, 0])
+        d = len(self.free)
+        bits = ((np.arange(2**d)[:, None] >> np.arange(d)[None]) & 1).astype(bool)  # (K, d)
+        verts = np.where(bits[None], chi[:, None, :], clo[:, None, :])  # (m, K, d)
+        mu = np.broadcast_to(self.base, (m, 2**d, self.n_c)).copy()
+        mu[:, :, self.free] = verts
+        s0, s1, det, scale = band_rows(self.scene, self.mk, mu.reshape(-1, self.n_c))
+        R = s0.shape[1]
+        N0 = (s0 * det[:, None]).reshape(m, 2**d, R)
+        N1 = (s1 * det[:, None]).reshape(m, 2**d, R)
+        pl, pu, pok = _point_bands(s0, s1, scale, self.tol)
+        K = 2**d
+        return det.reshape(m, K), N0, N1, pl.reshape(m, K), pu.reshape(m, K), pok.reshape(m, K)
+
+    def _bernstein(self, a, b):
+        n = self.deg
+        h = b - a
+        P = np.polynomial.polynomial
+        # T[m, j, i]: coefficient of t^i in (a + h t)^j
+        j = np.arange(n + 1)
+        C = np.array([[comb(jj, ii) for ii in range(n + 1)] for jj in range(n + 1)], dtype=float)
+        expo = j[:, None] - j[None, :]
+        T = C[None] * np.where(expo[None] >= 0, a[:, None, None] ** np.maximum(expo, 0)[None], 0.0) * h[:, None, None] ** j[None, None, :]
+        # Bernstein: beta_k = sum_{i<=k} C(k,i)/C(n,i) d_i
+        Bm = np.array([[comb(k, i) / comb(n, i) if i <= k else 0.0 for i in range(n + 1)] for k in range(n + 1)])
+        M = np.einsum("ki,mji->mkj", Bm, T)  # (m, K, j): control value k from power coefficient j
+        det = M @ self.cdet
+        N0 = M @ self.cN0
+        N1 = M @ self.cN1
+        pts = np.stack([a, 0.5 * (a + b), b], axis=1)  # (m, 3)
+        dv = P.polyval(pts, self.cdet)
+        n0 = np.moveaxis(P.polyval(pts, self.cN0), 0, -1)  # (m, 3, R)
+        n1 = np.moveaxis(P.polyval(pts, self.cN1), 0, -1)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            s0 = (n0 / dv[..., None]).reshape(-1, n0.shape[-1])
+            s1 = (n1 / dv[..., None]).reshape(-1, n1.shape[-1])
+        scale = np.maximum(np.nanmax(np.abs(s0), axis=1), 1e-300)
+        pl, pu, pok = _point_bands(s0, s1, scale, self.tol)
+        m = a.size
+        return det, N0, N1, pl.reshape(m, 3), pu.reshape(m, 3), pok.reshape(m, 3)
+
+    @staticmethod
+    def split(clo, chi):
+        """Bisect each cell along its widest side."""
+        k = np.argmax(chi - clo, axis=1)
+        rows = np.arange(clo.shape[0])
+        mid = 0.5 * (clo[rows, k] + chi[rows, k])
+        lo2, hi1 = clo.copy(), chi.copy()
+        hi1[rows, k] = mid
+        lo2[rows, k] = mid
+        return np.vstack([clo, lo2]), np.vstack([hi1, chi])
+
+
+def _point_bands(s0, s1, scale, tol: Tolerances):
+    """Band of each friction point from its rows ``s0 + tau s1 >= 0``: lower, upper, ok (n,)."""
+    big = np.max(np.abs(s1), axis=1, keepdims=True)
+    flat = np.abs(s1) <= tol.force * big
+    ftol = tol.force * scale[:, None]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        edge = -s0 / s1
+    lower = np.max(np.where(~flat & (s1 > 0), edge, -np.inf), axis=1)
+    upper = np.min(np.where(~flat & (s1 < 0), edge, np.inf), axis=1)
+    ok = np.all(~flat | (s0 >= -ftol), axis=1) & (lower <= upper) & np.all(np.isfinite(s0), axis=1)
+    return lower, upper, ok
+
+
+def _lower_bounds(det, N0, N1, g_lo, g_hi, tol: Tolerances):
+    """Smallest effort in ``[g_lo, g_hi]`` each cell may admit (inf: none), shape (m,)."""
+    m, _, R = N0.shape
+    finite = np.all(np.isfinite(det), axis=1) & np.all(np.isfinite(N0), axis=(1, 2)) & np.all(np.isfinite(N1), axis=(1, 2))
+    pos, neg = np.all(det > 0, axis=1), np.all(det < 0, axis=1)
+    steady = finite & (pos | neg)
+    e = tol.force * np.nanmax(np.abs(np.where(np.isfinite(N0), N0, 0.0)), axis=(1, 2))[:, None, None]  # (m,1,1)
+    e = np.maximum(e, 1e-300)
+    bscale = np.nanmax(np.abs(np.where(np.isfinite(N1), N1, 0.0)), axis=(1, 2))[:, None, None]
+    out = np.full(m, np.inf)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        # --- det keeps its sign: per-row union of half-lines
+        sg = np.where(neg, -1.0, 1.0)[:, None, None]
+        a, b = sg * N0, sg * N1
+        flat = np.abs(b) <= tol.force * bscale
+        start = np.where(~flat & (b > 0), (-e - a) / b, np.inf)  # [start, inf)
+        end = np.where(~flat & (b < 0), (-e - a) / b, -np.inf)  # (-inf, end]
+        lo_r = start.min(axis=1)  # (m, R)
+        up_r = end.max(axis=1)
+        whole = np.any(flat & (a >= -e), axis=1) | (up_r >= lo_r)
+        cand = np.concatenate([np.full((m, 1), g_lo), lo_r], axis=1)  # (m, R+1)
+        inside = whole[:, None, :] | (cand[:, :, None] <= up_r[:, None, :]) | (cand[:, :, None] >= lo_r[:, None, :])
+        valid = np.all(inside, axis=2) & (cand >= g_lo) & (cand <= g_hi)
+        steady_lb = np.min(np.where(valid, cand, np.inf), axis=1)
+        # --- det changes sign: rows r, q with N_r > 0 and N_q < 0 on the whole cell exclude the effort
+        a, b = N0, N1
+        flat = np.abs(b) <= tol.force * bscale
+        up_pos = ~flat & (b > 0)
+        dn_pos = ~flat & (b < 0)
+        hi_k = (e - a) / b  # a + tau b > e: tau above it where b > 0, below where b < 0
+        p_lo = np.max(np.where(up_pos, hi_k, -np.inf), axis=1)  # (m, R)
+        p_up = np.min(np.where(dn_pos, hi_k, np.inf), axis=1)
+        p_up = np.where(np.any(flat & (a <= e), axis=1), -np.inf, p_up)
+        lo_k = (-e - a) / b  # a + tau b < -e: tau below it where b > 0, above where b < 0
+        n_lo = np.max(np.where(dn_pos, lo_k, -np.inf), axis=1)
+        n_up = np.min(np.where(up_pos, lo_k, np.inf), axis=1)
+        n_up = np.where(np.any(flat & (a >= -e), axis=1), -np.inf, n_up)
+        E_lo = np.maximum(p_lo[:, :, None], n_lo[:, None, :])  # (m, R, R): Pos_r & Neg_q
+        E_up = np.minimum(p_up[:, :, None], n_up[:, None, :])
+        offdiag = ~np.eye(R, dtype=bool)[None]
+        live = offdiag & (E_lo < E_up)
+        E_lo = np.where(live, E_lo, np.nan).reshape(m, -1)
+        E_up = np.where(live, E_up, np.nan).reshape(m, -1)
+        cand = np.concatenate([np.full((m, 1), g_lo), np.nan_to_num(E_up, nan=np.inf)], axis=1)
+        strictly = (cand[:, :, None] > E_lo[:, None, :]) & (cand[:, :, None] < E_up[:, None, :])
+        valid = ~np.any(strictly, axis=2) & (cand >= g_lo) & (cand <= g_hi)
+        straddle_lb = np.min(np.where(valid, cand, np.inf), axis=1)
+    out = np.where(steady, steady_lb, np.where(finite, straddle_lb, g_lo))
+    return out, steady
+
+
+def _search(cells: _Cells, lo_, hi_, flip, atol, budget, tol):
+    """Smallest effort of ``[lo_, hi_]`` possibly feasible; with ``flip`` the efforts are negated
+    (pass ``-hi, -lo`` to find the largest).  Returns (value or NaN, exact, cells used, met a singular cell)."""
+    sign = -1.0 if flip else 1.0
+    clo, chi = cells.root
+    incumbent, floor, used, exact, straddling = np.inf, np.inf, 0, True, False
+    while clo.shape[0]:
+        det, N0, N1, pl, pu, pok = cells.evaluate(clo, chi)
+        used += clo.shape[0]
+        if flip:
+            pl, pu = -pu, -pl
+        # a friction point whose band reaches the interval (to atol) is a feasible effort: an incumbent
+        feas = pok & (np.maximum(pl, lo_) <= np.minimum(pu, hi_) + atol)
+        if feas.any():
+            incumbent = min(incumbent, float(np.min(np.where(feas, np.clip(pl, lo_, hi_), np.inf))))
+        lb, steady = _lower_bounds(det, N0, sign * N1, lo_, hi_, tol)
+        straddling |= bool(np.any(~steady & np.isfinite(lb)))
+        # a cell that cannot beat the incumbent, or the interval's far end, by more than atol is resolved
+        done = lb >= min(incumbent, hi_) - atol
+        floor = min(floor, float(np.min(np.where(done & np.isfinite(lb), lb, np.inf), initial=np.inf)))
+        keep = ~done & np.isfinite(lb)
+        clo, chi = clo[keep], chi[keep]
+        if not clo.shape[0]:
+            break
+        if used + 2 * clo.shape[0] > budget:
+            floor = min(floor, float(np.min(lb[keep])))
+            exact = False
+            break
+        clo, chi = cells.split(clo, chi)
+    value = min(incumbent, floor)
+    return (sign * value if np.isfinite(value) else np.nan), exact, used, straddling
+
+
+def competitor_torques(scene, mode, lo, hi, g_lo, g_hi, shared=False, tol: Tolerances = DEFAULT_TOLERANCES,
+                       rtol: float = PRECLUSION_RTOL, max_cells: int = MAX_CELLS) -> CompetitorTorques:  # fmt: skip
+    """Efforts in ``[g_lo, g_hi]`` for which ``mode`` is feasible for some friction in the set.
+
+    Parameters
+    ----------
+    scene : Scene
+        Exactly one effort-controlled joint.
+    mode : ContactMode or str
+        The competing mode.
+    lo, hi : float or array-like, shape (n_c,)
+        The friction set: independent coefficients ``lo_i <= mu_i <= hi_i`` (a box), or with
+        ``shared=True`` one coefficient ``lo <= mu <= hi`` for every contact (floats).
+    g_lo, g_hi : float
+        The effort interval of interest (N m or N); ``-inf`` / ``inf`` allowed.
+    shared : bool
+    tol : Tolerances
+    rtol : float
+        :data:`PRECLUSION_RTOL`.
+    max_cells : int
+        :data:`MAX_CELLS`.
+
+    Returns
+    -------
+    CompetitorTorques
+    """
+    mode = mode if isinstance(mode, ContactMode) else ContactMode(str(mode).upper())
+    n_c = scene.n_contacts
+    if shared:
+        lo_a, hi_a = float(lo), float(hi)
+        if not (np.isfinite(lo_a) and np.isfinite(hi_a)) or lo_a < 0 or lo_a > hi_a:
+            raise SceneError(f"mu range: expected 0 <= lo <= hi, finite; got {lo}, {hi}")
+    else:
+        lo_a = np.broadcast_to(np.asarray(lo, float), (n_c,)).copy()
+        hi_a = np.broadcast_to(np.asarray(hi, float), (n_c,)).copy()
+        if np.any(lo_a > hi_a) or np.any(lo_a < 0) or not (np.all(np.isfinite(lo_a)) and np.all(np.isfinite(hi_a))):
+            raise SceneError(f"mu range: expected 0 <= lo <= hi, finite; got lo={lo_a.tolist()}, hi={hi_a.tolist()}")
+    if not g_lo <= g_hi:
+        raise SceneError(f"effort interval: expected g_lo <= g_hi; got {g_lo}, {g_hi}")
+    mk = band_kinematics(scene, mode, tol)
+    if not mk.ok:
+        return CompetitorTorques(mode.letters, np.nan, np.nan, True, True, f"kinematics: {mk.status}")
+    if shared and hi_a == lo_a:
+        shared, lo_a, hi_a = False, np.full(n_c, lo_a), np.full(n_c, hi_a)
+    cells = _Cells(scene, mk, lo_a, hi_a, shared, tol)
+    finite = [abs(x) for x in (g_lo, g_hi) if np.isfinite(x)]
+    atol = rtol * max(finite + [1.0])
+    low, ex1, n1, st1 = _search(cells, g_lo, g_hi, False, atol, max_cells, tol)
+    if np.isnan(low):
+        return CompetitorTorques(mode.letters, np.nan, np.nan, True, ex1, None if ex1 else "cell budget exhausted", n1)
+    # the largest possibly-feasible effort, searched above the smallest one only
+    up, ex2, n2, st2 = _search(cells, -g_hi, -low, True, atol, max_cells, tol)
+    if np.isnan(up):  # nothing above low within atol: the set is (numerically) the point low
+        up = low
+    exact = ex1 and ex2
+    reason = None
+    if not exact:
+        reason = "cell budget exhausted" + ("; the mode is singular (det Q_AI changes sign) inside the friction set" if st1 or st2 else "")
+    return CompetitorTorques(mode.letters, float(low), float(max(up, low)), False, exact, reason, n1 + n2)

@@ -1,0 +1,238 @@
+"""Breaking sets that admit equilibrium: the relaxation that prunes contact modes (eqs. 17, 26, 28).
+
+A mode's breaking set ``B`` carries no force: ``c_n = c_t = 0`` there, and
+every other contact's force lies in its friction cone (eq. 28; a sliding force
+is on the edge of the cone, eq. 17).  So if no force ``c`` with ``c_B = 0`` and
+every other ``c_i`` in its (slightly widened) cone satisfies the equilibrium
+rows of eq. (26),
+
+    [W_n; J_nI^T] c_n + [W_t; J_tI^T] c_t = [-g_obj; tau_I - g_I],
+
+no mode with breaking set ``B`` passes the Coulomb test (28), and nor does a
+mode whose breaking set contains ``B`` (the constraint set only shrinks).  This
+*equilibrium relaxation* is one small linear programme per breaking set.
+:func:`feasible_breaking_sets` visits the sets level by level (``|B| = 0, 1,
+...``), as in the Apriori algorithm: a set is a candidate only when every subset
+one smaller admits equilibrium, so most infeasible sets go without a programme.
+
+Tolerances: the reference accepts a Coulomb slack down to ``-tol.force * F``,
+``F`` the largest load or force of the mode.  The programme widens every cone
+inequality by ``CONE_WIDENING * max(1, mu) * tol.force * FORCE_RATIO`` times the
+largest load, which contains every force the reference accepts whose largest
+component is at most ``FORCE_RATIO`` times the largest load (2 in the widening
+covers a sliding contact at ``c_n = -ftol``, the rest is margin for rounding).
+A mode could only be lost if the reference accepted it *because of* its
+tolerance (``on_boundary``) with forces over ``FORCE_RATIO`` times the loads,
+that is with ``Q_AI`` (eq. 26) within a factor ``1 / FORCE_RATIO`` of
+singular.  (The tolerance relative to ``F`` is not a convex condition: a
+programme with ``F`` as a variable can always make ``F`` large enough to accept
+anything, so some cap is needed.)  HiGHS's own tolerances only loosen the
+programme further.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from qsplan.mechanics.numerics import DEFAULT_TOLERANCES, Tolerances
+from qsplan.mechanics.parallel import chunk_count, map_chunks, split_range
+from qsplan.mechanics.model.scene import Scene
+
+__all__ = [
+    "CONE_WIDENING",
+    "FORCE_RATIO",
+    "MIN_LP_CHUNK",
+    "EquilibriumRelaxation",
+    "equilibrium_relaxation",
+    "admits_equilibrium",
+    "feasible_breaking_sets",
+    "breaking_set_sizes",
+]
+
+#: Factor on ``max(1, mu) * tol.force``: 2 covers a sliding contact whose ``c_n`` is
+#: ``-ftol`` (both cone rows then lose ``2 mu ftol``); 4 leaves a margin for rounding.
+CONE_WIDENING = 4.0
+
+#: Largest ratio of a mode's forces to its loads up to which the widened cones contain
+#: every force the reference accepts: 1e6 is far beyond well-posed grasps (forces within
+#: a few orders of the loads) and keeps the widening (4e-3 of the loads at mu <= 1) small.
+FORCE_RATIO = 1e6
+
+#: Fewest candidate breaking sets (one programme of ~0.5 ms each with highspy) worth a chunk in
+#: another process (~0.1 s of work, several times a local pool's start-up).
+MIN_LP_CHUNK = 200
+
+
+class EquilibriumRelaxation:
+    """The equilibrium relaxation of one scene (rows of eq. 26 over all contacts, cones of eq. 28).
+
+    Variables are ``(c_n[0], c_t[0], ..., c_n[n_c-1], c_t[n_c-1])``; a breaking set
+    only fixes its contacts' forces to zero through the bounds.
+
+    Attributes
+    ----------
+    A_eq : ndarray, shape (dof, 2 n_c)
+    b_eq : ndarray, shape (dof,)
+        ``[-g_obj; tau_I - g_I]`` divided by its largest magnitude.
+    A_ub : ndarray, shape (3 n_c, 2 n_c)
+    b_ub : ndarray, shape (3 n_c,)
+        Widened cone rows ``-mu c_n -+ c_t <= w``, ``-c_n <= w`` (eqs. 28, 9).
+    trivial : bool
+        The loads vanish: ``c = 0`` balances them, so no breaking set can be pruned.
+    """
+
+    def __init__(self, scene: Scene, tol: Tolerances):
+        n = scene.n_contacts
+        E = scene.effort_joints
+        rhs = np.concatenate([-scene.g_obj, np.nan_to_num(scene.joint_effort)[E] - scene.g_man[E]])
+        scale = float(np.max(np.abs(rhs))) if rhs.size else 0.0
+        self.n_contacts = n
+        self.trivial = not scale > 0
+        self.A_eq = np.zeros((rhs.size, 2 * n))
+        self.A_eq[:, 0::2] = np.vstack([scene.Wn, scene.Jn[:, E].T])  # columns of Q_AI for c_n (eq. 26)
+        self.A_eq[:, 1::2] = np.vstack([scene.Wt, scene.Jt[:, E].T])
+        self.b_eq = rhs / scale if scale > 0 else rhs
+        rows = np.zeros((n, 3, 2 * n))
+        i = np.arange(n)
+        rows[i, 0, 2 * i], rows[i, 0, 2 * i + 1] = -scene.mu, 1.0
+        rows[i, 1, 2 * i], rows[i, 1, 2 * i + 1] = -scene.mu, -1.0
+        rows[i, 2, 2 * i] = -1.0
+        self.A_ub = rows.reshape(3 * n, 2 * n)
+        w = CONE_WIDENING * max(1.0, float(np.max(scene.mu, initial=0.0))) * tol.force * FORCE_RATIO
+        self.b_ub = np.full(3 * n, w)
+
+
+def equilibrium_relaxation(scene: Scene, tol: Tolerances = DEFAULT_TOLERANCES) -> EquilibriumRelaxation:
+    """The equilibrium relaxation of ``scene`` (see :class:`EquilibriumRelaxation`)."""
+    return EquilibriumRelaxation(scene, tol)
+
+
+class _Programme:
+    """The relaxation as a reusable linear programme: HiGHS through ``highspy`` when installed
+    (one model, only the bounds change, warm-started: ~0.5 ms a set), else ``scipy.optimize.linprog``
+    (~5 ms a set, mostly its input checks)."""
+
+    def __init__(self, rel: EquilibriumRelaxation):
+        self.rel = rel
+        self.n_vars = rel.A_eq.shape[1]
+        try:
+            import highspy
+        except ImportError:
+            self.highs = None
+            return
+        from scipy.sparse import csr_matrix
+
+        h = highspy.Highs()
+        h.setOptionValue("output_flag", False)
+        h.setOptionValue("simplex_strategy", 1)  # dual simplex: the bounds change, the last basis stays dual feasible
+        inf = highspy.kHighsInf
+        h.addVars(self.n_vars, np.full(self.n_vars, -inf), np.full(self.n_vars, inf))
+        A = csr_matrix(np.vstack([rel.A_eq, rel.A_ub]))
+        lower = np.concatenate([rel.b_eq, np.full(rel.b_ub.size, -inf)])
+        upper = np.concatenate([rel.b_eq, rel.b_ub])
+        h.addRows(A.shape[0], lower, upper, A.nnz, A.indptr[:-1].astype(np.int32), A.indices.astype(np.int32), A.data)
+        self.highs, self.infeasible, self.inf = h, highspy.HighsModelStatus.kInfeasible, inf
+        self.cols = np.arange(self.n_vars, dtype=np.int32)
+
+    def __call__(self, breaking) -> bool:
+        if self.rel.trivial:
+            return True
+        fixed = [j for i in breaking for j in (2 * i, 2 * i + 1)]
+        if self.highs is None:
+            from scipy.optimize import linprog
+
+            bounds = [(None, None)] * self.n_vars
+            for j in fixed:
+                bounds[j] = (0.0, 0.0)
+            res = linprog(
+                np.zeros(self.n_vars), A_ub=self.rel.A_ub, b_ub=self.rel.b_ub, A_eq=self.rel.A_eq,
+                b_eq=self.rel.b_eq, bounds=bounds, method="highs",
+            )  # fmt: skip
+            return res.status != 2  # 2: proven infeasible; anything else keeps the set
+        lower = np.full(self.n_vars, -self.inf)
+        upper = np.full(self.n_vars, self.inf)
+        lower[fixed] = upper[fixed] = 0.0
+        self.highs.changeColsBounds(self.n_vars, self.cols, lower, upper)
+        self.highs.run()
+        return self.highs.getModelStatus() != self.infeasible  # only a proof of infeasibility prunes
+
+
+def admits_equilibrium(rel: EquilibriumRelaxation, breaking) -> bool:
+    """Whether some force with ``c = 0`` on ``breaking`` and cones elsewhere balances the loads.
+
+    False proves that no mode whose breaking set contains ``breaking`` passes eq. (28).
+
+    Parameters
+    ----------
+    rel : EquilibriumRelaxation
+    breaking : iterable of int
+        0-based contact indices.
+    """
+    return _Programme(rel)(breaking)
+
+
+def _lp_chunk(job):
+    rel, sets = job
+    programme = _Programme(rel)
+    return [programme(s) for s in sets]
+
+
+def breaking_set_sizes(n_c: int, dof: int) -> tuple[int, int]:
+    """Sizes of the breaking sets of modes with ``2 n_R + n_S = dof`` (eq. 29): ``n_R = |B| + dof - n_c``."""
+    return max(0, n_c - dof), (2 * n_c - dof) // 2
+
+
+def _candidates(level: list[tuple], feasible: set) -> list[tuple]:
+    """Sets one larger whose every subset one smaller is in ``feasible`` (Apriori join), sorted."""
+    out = []
+    for a in range(len(level)):
+        pa = level[a]
+        for b in range(a + 1, len(level)):
+            pb = level[b]
+            if pa[:-1] != pb[:-1]:
+                break  # level is sorted: sets sharing a prefix are consecutive
+            cand = pa + (pb[-1],)
+            if all(cand[:j] + cand[j + 1 :] in feasible for j in range(len(cand) - 2)):
+                out.append(cand)
+    return out
+
+
+def _check_sets(rel, sets, workers, scheduler) -> list[bool]:
+    n_chunks = chunk_count(len(sets), MIN_LP_CHUNK, workers=workers, scheduler=scheduler)
+    if n_chunks == 1 and scheduler is None:
+        return _lp_chunk((rel, sets))
+    jobs = [(rel, sets[lo:hi]) for lo, hi in split_range(len(sets), n_chunks)]
+    return [ok for part in map_chunks(_lp_chunk, jobs, workers=workers, scheduler=scheduler) for ok in part]
+
+
+def feasible_breaking_sets(scene: Scene, tol: Tolerances = DEFAULT_TOLERANCES, *, workers=1, scheduler=None):
+    """Breaking sets of the scene's modes that admit equilibrium, level by level (Apriori).
+
+    Returns
+    -------
+    sets : list of tuple of int
+        Sorted 0-based breaking sets with sizes of the scene's modes (eq. 29) that admit equilibrium.
+    programmes : int
+        Linear programmes solved.
+    """
+    n_c, dof = scene.n_contacts, scene.dof
+    lo, hi = breaking_set_sizes(n_c, dof)
+    rel = equilibrium_relaxation(scene, tol)
+    level, programmes, out = [()], 1, []
+    if not _Programme(rel)(()):
+        return out, programmes
+    for size in range(0, hi + 1):
+        if size >= lo:
+            out.extend(level)
+        if size == hi:
+            break
+        if size == 0:
+            cands = [(i,) for i in range(n_c)]
+        else:
+            cands = _candidates(level, set(level))
+        if not cands:
+            break
+        ok = _check_sets(rel, cands, workers, scheduler)
+        programmes += len(cands)
+        level = [c for c, good in zip(cands, ok) if good]
+    return out, programmes

@@ -1,0 +1,214 @@
+"""Export a segment's torque schedule for a robot controller: CSV, and the same as JSON with units and metadata.
+
+One row per sample of the segment, columns in this order:
+
+=====================  =======  ======================================================================
+column                 unit     meaning
+=====================  =======  ======================================================================
+``t``                  s        time from the segment's start
+``q_<joint>``          rad      every joint's angle (m for a prismatic joint)
+``qd_<joint>``         rad/s    velocity command of each velocity-controlled joint
+``tau_<joint>``        N m      torque command of each effort-controlled joint (N: prismatic)
+``tau_<joint>_min``    N m      lower edge of its guaranteed band
+``tau_<joint>_max``    N m      upper edge of its guaranteed band
+``mode``               -        the contact mode the command guarantees (letters, one per contact)
+``margin``             N m      distance from the command to the nearest band edge
+=====================  =======  ======================================================================
+
+CSV: a header line with the column names, then numbers written in full
+precision (``repr``); an unbounded band side is ``-inf`` / ``inf``; a sample
+with no guaranteed band has ``nan`` in ``tau_*`` and ``margin``.  JSON: an object
+``{"format", "version", "columns", "units", "data", "metadata"}`` with ``data``
+holding one list per column; JSON has no infinity, so non-finite numbers are
+``null`` (in ``tau_<joint>_min``: unbounded below; ``tau_<joint>_max``: unbounded
+above; elsewhere: no guaranteed band).
+
+Files are never overwritten unless asked (``force=True``): a controller file
+silently replaced is worse than an error.
+"""
+
+from __future__ import annotations
+
+import csv
+import json
+import math
+from pathlib import Path
+
+from qsplan.mechanics.errors import QsplanError
+
+__all__ = ["FORMAT", "VERSION", "export_schedule", "schedule_columns", "schedule_metadata", "write_csv", "write_json"]
+
+FORMAT = "qsplan.torque_schedule"
+VERSION = 1
+
+
+def schedule_columns(bands) -> tuple:
+    """The schedule as ordered columns and their units.
+
+    Parameters
+    ----------
+    bands : planner.bands_sweep.SegmentBands
+
+    Returns
+    -------
+    columns : dict of str to list
+        Column name -> values (floats, or str for ``mode``), one per sample.
+    units : dict of str to (str or None)
+    """
+    S = bands.samples
+    scene = S.scenes[0]
+    names = scene.joint_names
+    e = scene.effort_controlled
+    band = bands.guaranteed.band
+    cols, units = {"t": S.t.tolist()}, {"t": "s"}
+    for j, name in enumerate(names):
+        cols[f"q_{name}"] = S.q[:, j].tolist()
+        units[f"q_{name}"] = "rad"
+    for j, name in enumerate(names):
+        if not e[j]:
+            cols[f"qd_{name}"] = S.qd[:, j].tolist()
+            units[f"qd_{name}"] = "rad/s"
+    for j, name in enumerate(names):
+        if e[j]:
+            cols[f"tau_{name}"] = bands.command.tolist()
+            cols[f"tau_{name}_min"] = band.lower.tolist()
+            cols[f"tau_{name}_max"] = band.upper.tolist()
+            for c in ("", "_min", "_max"):
+                units[f"tau_{name}{c}"] = "N m"
+    cols["mode"] = [band.mode] * len(S)
+    units["mode"] = None
+    cols["margin"] = bands.margin.tolist()
+    units["margin"] = "N m"
+    return cols, units
+
+
+def schedule_metadata(bands) -> dict:
+    """What a controller engineer needs to trust the schedule (all SI)."""
+    from qsplan.mechanics.modes.contact_mode import ContactMode
+
+    from qsplan.planner.torque.sweep import narrowest
+    from qsplan.mechanics.bands.preclusion import PRECLUSION_RTOL
+
+    S = bands.samples
+    seg = S.segment
+    hand = seg.hand
+    g = bands.guaranteed
+    band = g.band
+    scene = S.scenes[0]
+    k, w = narrowest(band)
+    no_band = ~band.feasible
+    mode = ContactMode(band.mode)
+    return {
+        "source": "qsplan: Trinkle & Zeng (1995), Section 5.2, Figs. 9-13",
+        "segment": {"name": seg.name, "duration_s": seg.duration, "samples": len(S),
+                    "pose_start": seg.pose_start.tolist(), "pose_end": seg.pose_end.tolist(),
+                    "pose_units": ["m", "m", "rad"]},
+        "mode": {"letters": mode.letters, "name": mode.name, "kind": mode.kind},
+        "contacts": list(scene.contact_names),
+        "joints": {name: ("effort" if scene.effort_controlled[j] else "velocity") for j, name in enumerate(scene.joint_names)},
+        "friction": {"range": list(g.mu_range), "model": "one coefficient shared by all contacts" if g.shared
+                     else "each contact's coefficient independently in the range"},
+        "band": {
+            "method": band.method + " + competitor preclusion (branch and bound)",
+            "exact_points": int((band.exact & band.feasible).sum()),
+            "conservative_points": int((~band.exact & band.feasible).sum()),
+            "points_without_band": int(no_band.sum()),
+            "split_points": int(g.split.sum()),
+            "competitors": list(g.competitors),
+            "tolerance_relative": PRECLUSION_RTOL,
+            "narrowest": None if k is None else {"t_s": float(S.t[k]), "width_N_m": w, "lower_N_m": float(band.lower[k]),
+                                                 "upper_N_m": float(band.upper[k])},
+        },
+        "command": {
+            "rule": "midpoint of a bounded band (lower + max_margin if the band is wider than twice max_margin); "
+                    "lower + safety_margin when unbounded above (upper - safety_margin when unbounded below); "
+                    "0 when unbounded on both sides",
+            "safety_margin_N_m": bands.safety_margin,
+            "max_margin_N_m": bands.max_margin,
+        },
+        "hand": {
+            "workpiece_vertices_m": hand.workpiece.tolist(), "workpiece_mass_kg": hand.workpiece_mass,
+            "finger_base_m": hand.finger_base, "finger_length_m": hand.finger_length,
+            "finger_width_m": hand.finger_width, "finger_mass_kg": hand.finger_mass,
+            "palm_halfwidth_m": hand.palm_halfwidth, "gravity_m_s2": hand.gravity,
+        },
+    }  # fmt: skip
+
+
+def _check_free(paths, force: bool):
+    for p in paths:
+        if p.exists() and not force:
+            raise QsplanError(f"--out: {str(p)!r} exists; pass --force to overwrite it or choose another directory")
+        if p.exists() and p.is_dir():
+            raise QsplanError(f"--out: {str(p)!r} is a directory; cannot write the schedule there")
+
+
+def _cell(v):
+    if isinstance(v, str):
+        return v
+    return repr(float(v))
+
+
+def write_csv(bands, path, force: bool = False) -> Path:
+    """Write the schedule as CSV (see the module docstring); returns the path."""
+    path = Path(path)
+    _check_free([path], force)
+    cols, _ = schedule_columns(bands)
+    names = list(cols)
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        with open(path, "w", newline="") as f:
+            w = csv.writer(f, lineterminator="\n")
+            w.writerow(names)
+            for row in zip(*(cols[n] for n in names)):
+                w.writerow([_cell(v) for v in row])
+    except OSError as exc:
+        raise QsplanError(f"--out: cannot write {str(path)!r}: {exc.strerror or exc}") from None
+    return path
+
+
+def _json_value(v):
+    if isinstance(v, float) and not math.isfinite(v):
+        return None
+    return v
+
+
+def write_json(bands, path, force: bool = False) -> Path:
+    """Write the schedule as JSON with units and metadata (see the module docstring); returns the path."""
+    path = Path(path)
+    _check_free([path], force)
+    cols, units = schedule_columns(bands)
+    doc = {
+        "format": FORMAT,
+        "version": VERSION,
+        "columns": list(cols),
+        "units": units,
+        "data": {k: [_json_value(v) for v in vals] for k, vals in cols.items()},
+        "metadata": schedule_metadata(bands),
+        "null": "tau_<joint>_min: unbounded below; tau_<joint>_max: unbounded above; elsewhere: no guaranteed band",
+    }
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        with open(path, "w") as f:
+            json.dump(doc, f, indent=1, allow_nan=False)
+            f.write("\n")
+    except OSError as exc:
+        raise QsplanError(f"--out: cannot write {str(path)!r}: {exc.strerror or exc}") from None
+    return path
+
+
+def export_schedule(bands, out_dir, stem: str = "segment1", force: bool = False) -> list:
+    """Write ``<stem>.csv`` and ``<stem>.json`` into ``out_dir``; refuse to overwrite unless ``force``.
+
+    Both files are checked before either is written, so a refusal leaves nothing half done.
+
+    Returns
+    -------
+    list of pathlib.Path
+    """
+    out = Path(out_dir)
+    if out.exists() and not out.is_dir():
+        raise QsplanError(f"--out: {str(out)!r} is a file; expected a directory")
+    paths = [out / f"{stem}.csv", out / f"{stem}.json"]
+    _check_free(paths, force)
+    return [write_csv(bands, paths[0], force=True), write_json(bands, paths[1], force=True)]

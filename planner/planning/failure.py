@@ -1,0 +1,190 @@
+"""Why a segment has no plan: where the guaranteed band closes, what closes it, at which friction.
+
+:func:`failure_report` samples the straight line between a segment's start and
+goal (the only route in its one configuration variable) and judges each
+configuration with :func:`planner.plan.check_contact_state`.  Where the band is
+narrower than the torque resolution it names the cause: the desired mode's own
+guaranteed band (then the friction values at the box corners where its lower
+and upper edges are attained), or a competing mode possible inside it (eq. 28);
+and, at the narrowest point, the friction upper bound at which the band shrinks
+to the resolution (bisection on the range's upper end).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, replace
+from itertools import product
+
+import numpy as np
+
+__all__ = ["ClosedPoint", "FailureReport", "failure_report"]
+
+#: Configurations sampled along the straight line of a failed segment.
+REPORT_SAMPLES = 21
+
+
+@dataclass(frozen=True, slots=True)
+class ClosedPoint:
+    """A configuration where the segment's state is not valid.
+
+    Attributes
+    ----------
+    x : float
+        Workpiece x (m).
+    reason : str
+    width : float
+        Guaranteed band width (N m), competitors precluded; NaN without a band.
+    desired_width : float
+        Width of the desired mode's guaranteed band before preclusion (N m).
+    competitors : tuple of str
+        Competing modes possible inside the desired mode's band.
+    mu_lower_edge, mu_upper_edge : tuple of float or None
+        Per-contact friction (a corner of the box) where the desired band's lower / upper edge is attained.
+    """
+
+    x: float
+    reason: str
+    width: float
+    desired_width: float
+    competitors: tuple
+    mu_lower_edge: tuple | None = None
+    mu_upper_edge: tuple | None = None
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class FailureReport:
+    """Why a segment has no plan.
+
+    Attributes
+    ----------
+    segment : str
+    x_start, x_goal : float
+        m.
+    effort_joint : str
+    resolution : float
+        N m.
+    mu_range : (float, float)
+    planner_status : str
+        OMPL's status ("not run" when the start or goal was invalid).
+    closed : tuple of ClosedPoint
+        Every invalid configuration on the straight line, in order.
+    narrowest : ClosedPoint or None
+        The narrowest one.
+    mu_closes : float or None
+        At the narrowest point: the upper end of the friction range at which the band is exactly the resolution
+        (None if it is narrower even for the range's lower end alone, or the cause is not the band).
+    """
+
+    segment: str
+    x_start: float
+    x_goal: float
+    effort_joint: str
+    resolution: float
+    mu_range: tuple
+    planner_status: str
+    closed: tuple
+    narrowest: ClosedPoint | None
+    mu_closes: float | None
+
+    @property
+    def message(self) -> str:
+        n = self.narrowest
+        head = f"no plan: {self.segment}"
+        if n is None:
+            return f"{head}: OMPL found no path ({self.planner_status}) though the straight line is valid"
+        xs = [p.x for p in self.closed]
+        where = f"x in [{min(xs):.4g}, {max(xs):.4g}] m ({len(xs)} of {REPORT_SAMPLES} configurations)"
+        why = n.reason
+        if n.competitors:
+            why += f"; closed by competing mode {', '.join(n.competitors)}"
+        elif np.isfinite(n.desired_width) and n.desired_width < self.resolution:
+            why += "; closed by the 4S band itself"
+        if n.mu_lower_edge is not None:
+            why += f" (edges attained at mu = {list(n.mu_lower_edge)} and {list(n.mu_upper_edge)})"
+        if self.mu_closes is not None:
+            why += f"; with mu in [{self.mu_range[0]:g}, {self.mu_closes:.4g}] the band there is {self.resolution:g} N m wide, narrower above"
+        return f"{head}: band closes at {where}; narrowest at x = {n.x:.4g} m: {why}"
+
+    def as_dict(self) -> dict:
+        def point(p):
+            return None if p is None else {"x_m": p.x, "reason": p.reason, "width_N_m": _num(p.width),
+                                           "desired_width_N_m": _num(p.desired_width), "competitors": list(p.competitors),
+                                           "mu_lower_edge": p.mu_lower_edge, "mu_upper_edge": p.mu_upper_edge}  # fmt: skip
+
+        return {"segment": self.segment, "x_start_m": self.x_start, "x_goal_m": self.x_goal,
+                "effort_joint": self.effort_joint, "resolution_N_m": self.resolution, "mu_range": list(self.mu_range),
+                "planner_status": self.planner_status, "closed": [point(p) for p in self.closed],
+                "narrowest": point(self.narrowest), "mu_closes": self.mu_closes, "message": self.message}  # fmt: skip
+
+
+def _num(v):
+    return float(v) if np.isfinite(v) else None
+
+
+def _edge_corners(task, x, effort, direction):
+    """Box corners where the desired band's lower and upper edges are attained (vertex theory)."""
+    from qsplan.mechanics.bands.effort import effort_bands
+    from qsplan.mechanics.modes.contact_mode import ContactMode
+
+    from qsplan.planner.planning.plan import MODE, contact_samples
+
+    lo, hi = task.mu_range
+    scene = contact_samples(task, [x], effort, direction * task.workpiece_speed).scenes[0]
+    n = scene.n_contacts
+    rows = np.array([[lo] * n, [hi] * n]) if task.shared_mu else np.array(list(product((lo, hi), repeat=n)))
+    low, up, ok = effort_bands(scene, ContactMode(MODE), rows)
+    if not np.any(ok):
+        return None, None
+    i = int(np.nanargmax(np.where(ok, low, -np.inf)))
+    j = int(np.nanargmin(np.where(ok, up, np.inf)))
+    return tuple(float(m) for m in rows[i]), tuple(float(m) for m in rows[j])
+
+
+def failure_report(task, name, x0, x1, effort, direction, competitors, result=None, xs=None) -> FailureReport:
+    """The report for a segment from ``x0`` to ``x1`` (m) with no plan (see the module docstring)."""
+    from qsplan.planner.planning.plan import check_contact_state
+
+    xs = np.linspace(x0, x1, REPORT_SAMPLES) if xs is None else np.asarray(xs, float)
+    if xs.size > REPORT_SAMPLES:
+        xs = xs[np.linspace(0, xs.size - 1, REPORT_SAMPLES).astype(int)]
+    checks = [check_contact_state(task, x, effort, direction, None, competitors) for x in xs]
+    closed = []
+    for c in checks:
+        if c.ok:
+            continue
+        dw = c.desired_upper - c.desired_lower
+        closed.append(ClosedPoint(c.x, c.reason, c.width, float(dw) if np.isfinite(dw) or dw == np.inf else np.nan,
+                                  c.competitors))  # fmt: skip
+    narrowest, mu_closes = None, None
+    if closed:
+        widths = np.array([p.width if np.isfinite(p.width) else -1.0 for p in closed])
+        narrowest = closed[int(np.argmin(widths))]
+        if narrowest.reason.startswith(("band", "no guaranteed band")):
+            # box corners of the edges mean nothing where the mode is degenerate (Q_AI singular inside the box)
+            if "degenerate" not in narrowest.reason:
+                lo_e, hi_e = _edge_corners(task, narrowest.x, effort, direction)
+                narrowest = replace(narrowest, mu_lower_edge=lo_e, mu_upper_edge=hi_e)
+            mu_closes = _mu_closes(task, narrowest.x, effort, direction, competitors)
+    status = "not run (start or goal invalid)" if result is None else result.status
+    return FailureReport(name, float(x0), float(x1), effort, task.torque_resolution, task.mu_range, status,
+                         tuple(closed), narrowest, mu_closes)  # fmt: skip
+
+
+def _mu_closes(task, x, effort, direction, competitors, iterations=30):
+    """The friction upper bound at which the band at ``x`` shrinks to the resolution (bisection), or None."""
+    from dataclasses import replace as dc_replace
+
+    from qsplan.planner.planning.plan import check_contact_state
+
+    lo, hi = task.mu_range
+
+    def ok(m):
+        return check_contact_state(dc_replace(task, mu_range=(lo, m)), x, effort, direction, None, competitors).ok
+
+    if not ok(lo) or ok(hi):
+        return None
+    a, b = lo, hi
+    for _ in range(iterations):
+        m = 0.5 * (a + b)
+        a, b = (m, b) if ok(m) else (a, m)
+    return float(a)

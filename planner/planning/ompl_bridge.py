@@ -1,0 +1,255 @@
+"""The bridge to OMPL (PyPI ``ompl`` 2.x, nanobind bindings): plan over a box of real variables.
+
+Everything OMPL-specific lives here, behind plain numpy in and out:
+:func:`plan_path` takes the bounds, start, goal, a state validity predicate on
+numpy vectors and optional per-state costs, and returns a :class:`PlanResult`
+with the path as an array.  It follows the verified recipes of
+``shared/notes/ompl2_python_cookbook.md``:
+
+* the RNG is seeded before any space or planner is created, and planners are
+  stopped by an iteration budget when ``deterministic`` is asked for (a time
+  budget makes anytime planners differ from run to run);
+* OMPL's console output is silenced unless ``verbose``;
+* the validity checker returns a real Python ``bool``;
+* paths are copied to numpy at once and no OMPL object outlives the call
+  (nanobind keeps some of them alive through cycles otherwise);
+* ``ss.solve`` gets a termination condition object, not a float (a float >= 1
+  starts a watchdog thread per call).
+
+A motion (edge) is valid when every state along it at the stated resolution is
+valid: OMPL's discrete motion validator with ``validity_resolution`` as the
+fraction of the space's extent between checks.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+from typing import Callable
+
+import numpy as np
+
+from qsplan.mechanics import QsplanError
+
+__all__ = ["PlannerOptions", "PlanResult", "plan_path", "PLANNERS", "ompl_available"]
+
+#: Geometric planners offered (all bound in ompl 2.0.1).
+PLANNERS = ("RRTConnect", "RRT", "RRTstar", "BITstar", "PRM", "KPIECE1")
+
+
+def ompl_available() -> bool:
+    """Whether the OMPL Python bindings import."""
+    try:
+        import ompl  # noqa: F401
+    except ImportError:
+        return False
+    return True
+
+
+@dataclass(frozen=True, slots=True)
+class PlannerOptions:
+    """Options of :func:`plan_path`.
+
+    Attributes
+    ----------
+    planner : str
+        One of :data:`PLANNERS`.
+    time_limit : float
+        Seconds; the planner stops when it runs out (with ``deterministic`` it stops
+        at the iteration budget or the time limit, whichever comes first).
+    iterations : int
+        Iteration budget (calls of the termination check) when ``deterministic``.
+    deterministic : bool
+        Seeded and stopped by iterations, so that the same inputs give the same path.
+    seed : int
+        OMPL's global RNG seed.
+    validity_resolution : float
+        Fraction of the space's maximum extent between validity checks along a motion.
+    simplify : bool
+        Shortcut and smooth the path (OMPL's simplifyMax, deterministic).  Skipped when a
+        ``state_cost`` is given: the shortcuts minimise length and would undo the cost.
+    interpolate : int
+        Number of states of the returned path (0: as planned); states are added
+        along the path, each checked again.
+    verbose : bool
+        Let OMPL print its log (warnings and above).
+    """
+
+    planner: str = "RRTConnect"
+    time_limit: float = 5.0
+    iterations: int = 20_000
+    deterministic: bool = True
+    seed: int = 1
+    validity_resolution: float = 0.005
+    simplify: bool = True
+    interpolate: int = 0
+    verbose: bool = False
+
+    def __post_init__(self):
+        if self.planner not in PLANNERS:
+            raise QsplanError(f"planner: expected one of {', '.join(PLANNERS)}; got {self.planner!r}")
+        if not (self.time_limit > 0):
+            raise QsplanError(f"time_limit: expected a positive number of seconds; got {self.time_limit}")
+        if self.iterations < 1:
+            raise QsplanError(f"iterations: expected a positive integer; got {self.iterations}")
+        if not (0 < self.validity_resolution < 1):
+            raise QsplanError(f"validity_resolution: expected a fraction in (0, 1); got {self.validity_resolution}")
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class PlanResult:
+    """Outcome of :func:`plan_path`.
+
+    Attributes
+    ----------
+    path : ndarray, shape (N, d) or (0, d)
+        The states, start first; empty when nothing was found.
+    exact : bool
+        The path reaches the goal (OMPL's EXACT_SOLUTION).
+    status : str
+        OMPL's status text.
+    validity_checks : int
+        Calls of the validity predicate.
+    seconds : float
+        Wall-clock planning time.
+    """
+
+    path: np.ndarray
+    exact: bool
+    status: str
+    validity_checks: int
+    seconds: float
+    options: PlannerOptions = field(default_factory=PlannerOptions)
+
+    @property
+    def checks_per_second(self) -> float:
+        return self.validity_checks / self.seconds if self.seconds > 0 else float("nan")
+
+
+def _planner(og, si, name):
+    return getattr(og, name)(si)
+
+
+def plan_path(
+    low,
+    high,
+    start,
+    goal,
+    is_valid: Callable[[np.ndarray], bool],
+    options: PlannerOptions = PlannerOptions(),
+    state_cost: Callable[[np.ndarray], float] | None = None,
+) -> PlanResult:
+    """Plan a path from ``start`` to ``goal`` in the box ``[low, high]`` of R^d.
+
+    Parameters
+    ----------
+    low, high : array-like, shape (d,)
+        Bounds of the configuration variables (SI units of each variable).
+    start, goal : array-like, shape (d,)
+    is_valid : callable
+        ``is_valid(x) -> bool`` for a state ``x`` of shape (d,).
+    options : PlannerOptions
+    state_cost : callable, optional
+        ``state_cost(x) -> float >= 0``: an optimization objective integrating this cost
+        along the path (trapezoid rule) is set, so optimizing planners prefer
+        low-cost states (e.g. ``1 / margin`` to prefer wide effort bands).  Use an
+        optimizing planner (``BITstar`` is fastest here, ``RRTstar``); Python cost calls
+        make ``RRTstar`` slow.
+
+    Returns
+    -------
+    PlanResult
+
+    Raises
+    ------
+    QsplanError
+        On malformed bounds or a start/goal outside them or invalid.
+    """
+    try:
+        from ompl import base as ob
+        from ompl import geometric as og
+        from ompl import util as ou
+    except ImportError as exc:  # pragma: no cover - ompl is a dependency
+        raise QsplanError(f"ompl: the OMPL Python bindings are not installed ({exc})") from None
+
+    low, high = np.asarray(low, float), np.asarray(high, float)
+    start, goal = np.asarray(start, float), np.asarray(goal, float)
+    d = low.size
+    if high.shape != (d,) or start.shape != (d,) or goal.shape != (d,) or not np.all(high > low):
+        raise QsplanError(f"bounds: expected low < high, and start and goal of {d} values")
+    for name, x in (("start", start), ("goal", goal)):
+        if np.any(x < low) or np.any(x > high):
+            raise QsplanError(f"{name}: outside the planning bounds: {x.tolist()}")
+        if not is_valid(x):
+            raise QsplanError(f"{name}: the state is not valid: {x.tolist()}")
+
+    ou.setLogLevel(ou.LOG_WARN if options.verbose else ou.LOG_NONE)
+    ou.RNG.setSeed(int(options.seed))
+    calls = [0]
+
+    def to_np(s):
+        return np.array([s[i] for i in range(d)])
+
+    def checker(s):
+        calls[0] += 1
+        return bool(is_valid(to_np(s)))
+
+    space = ob.RealVectorStateSpace(d)
+    bounds = ob.RealVectorBounds(d)
+    for i in range(d):
+        bounds.setLow(i, float(low[i]))
+        bounds.setHigh(i, float(high[i]))
+    space.setBounds(bounds)
+    ss = og.SimpleSetup(space)
+    si = ss.getSpaceInformation()
+    ss.setStateValidityChecker(checker)
+    si.setStateValidityCheckingResolution(options.validity_resolution)
+    s0, s1 = si.allocState(), si.allocState()
+    for i in range(d):
+        s0[i] = float(start[i])
+        s1[i] = float(goal[i])
+    ss.setStartAndGoalStates(s0, s1)
+    if state_cost is not None:
+
+        class _Cost(ob.OptimizationObjective):
+            def __init__(self, info):
+                super().__init__(info)
+                self.info = info
+
+            def stateCost(self, s):
+                return ob.Cost(float(state_cost(to_np(s))))
+
+            def motionCost(self, a, b):
+                c = 0.5 * (self.stateCost(a).value() + self.stateCost(b).value())
+                return ob.Cost(c * self.info.distance(a, b))
+
+        ss.setOptimizationObjective(_Cost(si))
+    ss.setPlanner(_planner(og, si, options.planner))
+
+    t0 = time.perf_counter()
+    if options.deterministic:
+        count = [0]
+        deadline = t0 + options.time_limit
+
+        def done():
+            count[0] += 1
+            return count[0] > options.iterations or time.perf_counter() > deadline
+
+        ptc = ob.PlannerTerminationCondition(done)
+    else:
+        ptc = ob.timedPlannerTerminationCondition(options.time_limit)
+    status = ss.solve(ptc)
+    exact = status.getStatus() == ob.PlannerStatus.EXACT_SOLUTION
+    path = np.zeros((0, d))
+    if exact:
+        if options.simplify and state_cost is None:
+            ss.simplifySolution()
+        geo = og.PathGeometric(ss.getSolutionPath())  # a copy: nothing dangles after ss goes
+        if options.interpolate:
+            geo.interpolate(int(options.interpolate))
+        path = np.array([to_np(s) for s in geo.getStates()])
+        del geo
+    seconds = time.perf_counter() - t0
+    text = str(status)
+    del ss, si, space
+    return PlanResult(path, exact, text, calls[0], seconds, options)

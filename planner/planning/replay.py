@@ -1,0 +1,272 @@
+"""Re-simulate an exported two-finger plan with the finite-motion simulator (Section 5.1).
+
+A plan promises that, for every friction coefficient in the task's interval, the
+commands of its torque file make the workpiece slide in the planned mode (4S) along
+each in-contact segment.  :func:`replay_plan` checks the promise the hard way: it
+reads the commands back from the exported columns (:func:`planner.plan_export.read_plan_csv`),
+drives the hand with them through :func:`mechanics.motion.simulate` at a friction
+vector, and compares the simulated mode sequence and workpiece path with the plan's.
+
+Nothing of the planner's band computation is used: the simulator chooses the mode
+at every instant from the full model (every mode checked, eqs. 13-28), locates
+mode changes as events and stops when the mode becomes ambiguous or jams.
+
+The simulated system (:class:`ReplaySystem`) has the state
+``[x, y, theta, q_left, q_right, t]`` (m, m, rad, rad, rad, s): the workpiece pose,
+the finger angles and the plan's clock, which indexes the commands.  The
+velocity-controlled finger follows the plan's joint-velocity column and the
+effort-controlled finger's torque column, both interpolated linearly in time
+between rows.  Between segments the plan's regrasp puts both fingers back on the
+workpiece where it is (tangency, :func:`hands.two_finger.finger_angles`), so each
+segment starts from the simulated end of the previous one: errors carry over.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from qsplan.mechanics.errors import QsplanError
+
+__all__ = ["ReplaySystem", "SegmentReplay", "Replay", "replay_plan", "replay_segments", "friction_samples", "REPLAY_STEP"]
+
+#: Step of the replay (s).  Mode changes are located by root finding, not by the step; 0.05 s is
+#: 0.5 mm of workpiece travel at the default 1 cm/s, the spacing of the plan's rows (its band sweep),
+#: so each step spans about one row of the linearly interpolated commands.
+REPLAY_STEP = 0.05
+
+
+def _default_options():
+    from qsplan.mechanics.motion.simulator import MotionOptions
+
+    # max_switches = 0: the first mode change already leaves the plan, so the run stops there
+    # (all four contacts are still touching at that instant; nothing beyond it is modelled).
+    return MotionOptions(max_step=REPLAY_STEP, max_switches=0)
+
+
+def _stop_message(motion, planned) -> str | None:
+    s = motion.stopped
+    if s is None:
+        return None
+    if s.kind == "max_switches":
+        return f"at t = {s.time:.6g} s the mode changes from {planned} to {s.candidates[0]}"
+    return s.message
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class ReplaySystem:
+    """The two-finger hand driven by one in-contact segment's commands (a :class:`mechanics.motion.MotionSystem`).
+
+    Attributes
+    ----------
+    hand : hands.two_finger.TwoFingerHand
+    effort_joint : str
+        ``"left"`` or ``"right"``: torque-controlled; the other finger is velocity-controlled.
+    t, velocity, effort : ndarray, shape (n,)
+        Command rows: time (s), the velocity-controlled joint's speed (rad/s), the effort (N m).
+    friction : mechanics.motion.Friction
+        Of the four potential contacts (palm, palm, left finger, right finger).
+    """
+
+    hand: object
+    effort_joint: str
+    t: np.ndarray
+    velocity: np.ndarray
+    effort: np.ndarray
+    friction: object
+
+    state_names = ("x (m)", "y (m)", "theta (rad)", "q_left (rad)", "q_right (rad)", "t (s)")
+    contact_names = ("palm:0", "palm:1", "left", "right")
+
+    def commands(self, t) -> tuple:
+        """``(velocity, effort)`` at plan time ``t`` (s), linear between rows, held beyond the ends."""
+        return float(np.interp(t, self.t, self.velocity)), float(np.interp(t, self.t, self.effort))
+
+    def scene(self, x, contacts):
+        from qsplan.hands.two_finger import hand_scene
+
+        if tuple(contacts) != (0, 1, 2, 3):
+            raise QsplanError(f"contacts: the replay keeps all four contacts; got {tuple(contacts)}")
+        velocity, effort = self.commands(x[5])
+        return hand_scene(self.hand, x[:3], x[3:5], self.effort_joint, velocity=velocity, effort=effort)
+
+    def rates(self, x, qdot, thetadot) -> np.ndarray:
+        from qsplan.mechanics.motion.simulator import pose_rate
+
+        return np.concatenate([pose_rate(x[:3], qdot), np.asarray(thetadot, float), [1.0]])
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class SegmentReplay:
+    """One in-contact segment re-simulated.
+
+    Attributes
+    ----------
+    phase : int
+        The plan's phase index (the ``phase`` column).
+    planned_mode : str
+    labels : tuple of str
+        Mode labels of the simulated stretches, in order (``("SSSS",)`` when followed).
+    stop : str or None
+        The simulator's stop message, None when it reached the segment's end.
+    x_error : float
+        Largest distance (m) between the simulated and the planned workpiece x at the plan's rows.
+    x_end : float
+        Simulated workpiece x at the end (m).
+    motion : mechanics.motion.Motion or None
+        None when the segment could not start in its planned mode.
+    """
+
+    phase: int
+    planned_mode: str
+    labels: tuple
+    stop: str | None
+    x_error: float
+    x_end: float
+    motion: object
+
+    @property
+    def followed(self) -> bool:
+        """The simulated motion stayed in the planned mode for the whole segment."""
+        return self.stop is None and self.labels == (self.planned_mode,)
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class Replay:
+    """A plan re-simulated at one friction vector.
+
+    Attributes
+    ----------
+    mu : ndarray, shape (4,)
+        Coefficients of the contacts palm:0, palm:1, left, right.
+    segments : tuple of SegmentReplay
+        Up to and including the first segment that left the plan.
+    """
+
+    mu: np.ndarray
+    segments: tuple
+
+    @property
+    def followed(self) -> bool:
+        return all(s.followed for s in self.segments)
+
+    @property
+    def x_error(self) -> float:
+        return max((s.x_error for s in self.segments), default=0.0)
+
+    def summary(self) -> str:
+        """One line: friction, followed or where it left the plan."""
+        mu = ", ".join(f"{m:.3g}" for m in self.mu)
+        if self.followed:
+            return f"mu = ({mu}): followed {' '.join(s.planned_mode for s in self.segments)}; x error {self.x_error:.2g} m"
+        bad = next(s for s in self.segments if not s.followed)
+        why = bad.stop or f"modes {' -> '.join(bad.labels)}"
+        return f"mu = ({mu}): left the plan in phase {bad.phase} ({bad.planned_mode} planned): {why}"
+
+
+def _start_modes(system, x0, mu) -> tuple:
+    """Letters of every mode feasible at ``x0`` (the full solver, eqs. 13-28): the planned one alone, or the plan fails."""
+    from dataclasses import replace
+
+    from qsplan.mechanics.solver.batch import solve
+
+    scene = replace(system.scene(x0, (0, 1, 2, 3)), mu=np.asarray(mu, float))
+    return tuple(solve(scene, residuals=False).feasible_modes)
+
+
+def friction_samples(mu_range, n, seed=1, shared=False) -> list:
+    """``n`` friction vectors (4,) from ``mu_range``: all at ``lo``, all at ``hi``, then seeded uniform draws
+    (one value for all four contacts when ``shared``)."""
+    lo, hi = mu_range
+    rng = np.random.default_rng(seed)
+    draws = [np.full(4, rng.uniform(lo, hi)) if shared else rng.uniform(lo, hi, 4) for _ in range(max(n - 2, 0))]
+    return ([np.full(4, float(lo)), np.full(4, float(hi))] + draws)[:n]
+
+
+def replay_segments(columns) -> list:
+    """Split plan columns (:func:`planner.plan_export.read_plan_csv`) into in-contact segments.
+
+    Returns
+    -------
+    list of dict
+        Per segment: ``phase``, ``rows`` (indices), ``mode``, ``effort_joint``.
+    """
+    for key in ("t", "phase", "mode", "effort_joint", "x_workpiece", "q_left", "q_right"):
+        if key not in columns:
+            raise QsplanError(f"plan: column {key!r} missing; expected the columns of planner.plan_export")
+    phases = np.asarray(columns["phase"], float).astype(int)
+    out = []
+    for p in np.unique(phases):
+        rows = np.flatnonzero(phases == p)
+        mode = str(columns["mode"][rows[0]])
+        if mode == "free":
+            continue
+        out.append(dict(phase=int(p), rows=rows, mode=mode, effort_joint=str(columns["effort_joint"][rows[0]])))
+    return out
+
+
+def replay_plan(columns, hand, mu, options=None) -> Replay:
+    """Re-simulate every in-contact segment of an exported plan at the friction vector ``mu``.
+
+    Parameters
+    ----------
+    columns : dict
+        The plan's columns as read by :func:`planner.plan_export.read_plan_csv`.
+    hand : hands.two_finger.TwoFingerHand
+        The task's hand.
+    mu : float or array-like, shape (4,)
+        Friction of the contacts palm:0, palm:1, left, right (static = kinetic).
+    options : mechanics.motion.MotionOptions, optional
+        Default ``max_step`` :data:`REPLAY_STEP` and ``max_switches = 0`` (stop at the first mode change).
+
+    Returns
+    -------
+    Replay
+    """
+    from qsplan.hands.two_finger import finger_angles
+    from qsplan.mechanics.motion.simulator import make_friction, simulate
+
+    options = options or _default_options()
+    mu = np.broadcast_to(np.asarray(mu, float), (4,)).copy()
+    if np.any(~np.isfinite(mu)) or np.any(mu < 0):
+        raise QsplanError(f"mu: expected four nonnegative friction coefficients; got {mu.tolist()}")
+    friction = make_friction(mu, mu)
+    out, x_prev = [], None
+    for seg in replay_segments(columns):
+        rows, e = seg["rows"], seg["effort_joint"]
+        v = "left" if e == "right" else "right"
+        t = np.asarray(columns["t"], float)[rows]
+        system = ReplaySystem(hand, e, t, np.asarray(columns[f"qd_{v}"], float)[rows],
+                              np.asarray(columns[f"tau_{e}"], float)[rows], friction)  # fmt: skip
+        k = rows[0]
+        pose = np.array([columns["x_workpiece"][k], columns["y_workpiece"][k], columns["theta_workpiece"][k]], float)
+        if x_prev is not None:
+            pose = x_prev[:3]  # the regrasp leaves the workpiece where the simulation put it
+        q = finger_angles(hand, pose)[0]  # both fingers on the workpiece (the grasp)
+        x0 = np.concatenate([pose, q, [t[0]]])
+        start = _start_modes(system, x0, mu)
+        if start != (seg["mode"],):
+            why = f"at t = {t[0]:.6g} s the feasible modes are {', '.join(start) or 'none (jam)'}"
+            out.append(SegmentReplay(seg["phase"], seg["mode"], start, why, np.nan, float(pose[0]), None))
+            break
+        try:
+            motion = simulate(system, x0, float(t[-1] - t[0]), options)
+        except QsplanError as exc:  # the geometry left the four-contact grasp between events
+            out.append(SegmentReplay(seg["phase"], seg["mode"], (), f"the simulation failed: {exc}", np.nan,
+                                     float(pose[0]), None))  # fmt: skip
+            break
+        states = motion.states
+        planned = np.asarray(columns["x_workpiece"], float)[rows]
+        if states.shape[0]:
+            reached = t <= states[-1, 5]
+            err = float(np.max(np.abs(np.interp(t[reached], states[:, 5], states[:, 0]) - planned[reached])))
+            end = states[-1]
+        else:  # stopped at the segment's start
+            err, end = np.nan, np.concatenate([pose, q, [t[0]]])
+        stop = _stop_message(motion, seg["mode"])
+        out.append(SegmentReplay(seg["phase"], seg["mode"], tuple(motion.labels), stop, err, float(end[0]), motion))
+        if not out[-1].followed:
+            break  # the rest of the plan starts from a state the plan did not foresee
+        x_prev = end
+    return Replay(mu, tuple(out))
