@@ -1,0 +1,186 @@
+"""The architecture of qsplan, asserted: one package, layered modules, public names between modules.
+
+An AST walk over the source (no import of the code under test):
+
+* the import graph between the project's modules, *including imports inside functions*, has no cycle
+  (a cycle hidden by a function-level import is still a cycle);
+* no name starting with ``_`` is imported from another module;
+* no module is longer than :data:`MAX_MODULE_LINES`;
+* code, tests, examples and benchmarks import the project only as ``qsplan.*``, and examples and
+  benchmarks import no private name;
+* every folder with an ``__init__.py`` is a package that ``pyproject.toml`` installs.
+"""
+
+from __future__ import annotations
+
+import ast
+import tomllib
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parent.parent
+#: The user's top-level folders and the subpackage of ``qsplan`` each installs as.
+FOLDERS = {"mechanics": "qsplan.mechanics", "hands": "qsplan.hands", "planner": "qsplan.planner"}
+#: One concept per module: past this a module is split (STYLE.md, point 10).
+MAX_MODULE_LINES = 400
+
+
+def _modules() -> dict[str, Path]:
+    """``{qualified module name: path}`` for every module of the package."""
+    mods = {"qsplan": ROOT / "src" / "qsplan" / "__init__.py"}
+    for folder, package in FOLDERS.items():
+        for path in sorted((ROOT / folder).rglob("*.py")):
+            parts = list(path.relative_to(ROOT / folder).with_suffix("").parts)
+            if parts[-1] == "__init__":
+                parts = parts[:-1]
+            mods[".".join([package, *parts])] = path
+    return mods
+
+
+MODULES = _modules()
+
+
+def _imports(name: str, path: Path):
+    """``(target module, imported names)`` for every import of a project module in one file."""
+    tree = ast.parse(path.read_text(), filename=str(path))
+    package = name if path.name == "__init__.py" else name.rpartition(".")[0]
+    for node in ast.walk(tree):
+        if isinstance(node, ast.ImportFrom):
+            if node.level:
+                base = package.split(".")[: len(package.split(".")) - node.level + 1]
+                target = ".".join(base + ([node.module] if node.module else []))
+            else:
+                target = node.module or ""
+            if target.split(".")[0] != "qsplan":
+                continue
+            for alias in node.names:
+                sub = f"{target}.{alias.name}"
+                yield (sub, None) if sub in MODULES else (target, alias.name)
+        elif isinstance(node, ast.Import):
+            for alias in node.names:
+                if alias.name.split(".")[0] == "qsplan":
+                    yield alias.name, None
+        elif isinstance(node, ast.Call) and getattr(node.func, "attr", getattr(node.func, "id", "")) == "import_module":
+            if node.args and isinstance(node.args[0], ast.Constant) and str(node.args[0].value).startswith("qsplan"):
+                yield node.args[0].value, None
+
+
+def _graph() -> dict[str, set[str]]:
+    """Module -> the project modules it imports (a package import counts as its ``__init__``)."""
+    graph = {}
+    for name, path in MODULES.items():
+        edges = set()
+        for target, _ in _imports(name, path):
+            while target not in MODULES and "." in target:
+                target = target.rpartition(".")[0]
+            if target != name and target in MODULES:
+                edges.add(target)
+        graph[name] = edges
+    return graph
+
+
+def _lazy_targets(name: str, path: Path) -> set[str]:
+    """Modules a package ``__init__`` loads on first attribute access (a ``_LAZY`` name -> module table)."""
+    tree = ast.parse(path.read_text())
+    out = set()
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Assign) and any(getattr(t, "id", "") == "_LAZY" for t in node.targets):
+            if isinstance(node.value, ast.Dict):
+                out |= {v.value for v in node.value.values if isinstance(v, ast.Constant)}
+    return out
+
+
+def _find_cycle(graph: dict[str, set[str]]) -> list[str] | None:
+    colour, stack = {}, []
+
+    def visit(u):
+        colour[u] = 1
+        stack.append(u)
+        for v in sorted(graph.get(u, ())):
+            if colour.get(v) == 1:
+                return stack[stack.index(v):] + [v]
+            if v not in colour and (c := visit(v)):
+                return c
+        colour[u] = 2
+        stack.pop()
+        return None
+
+    for u in sorted(graph):
+        if u not in colour and (c := visit(u)):
+            return c
+    return None
+
+
+def test_every_module_found():
+    assert len(MODULES) > 60
+    assert "qsplan.mechanics.solver" in MODULES and "qsplan.planner.cli" in MODULES
+
+
+def test_import_graph_has_no_cycle():
+    graph = _graph()
+    for name, path in MODULES.items():
+        if path.name == "__init__.py":
+            graph[name] |= {t for t in _lazy_targets(name, path) if t in MODULES}
+    # A package's __init__ re-exports its submodules; a submodule importing its own package's
+    # __init__ would close a cycle through it, which this check reports too.
+    cycle = _find_cycle(graph)
+    assert cycle is None, "import cycle: " + " -> ".join(cycle)
+
+
+def test_the_cycle_check_finds_cycles():
+    assert _find_cycle({"a": {"b"}, "b": {"c"}, "c": {"a"}}) == ["a", "b", "c", "a"]
+    assert _find_cycle({"a": {"b"}, "b": set()}) is None
+
+
+def test_no_private_name_crosses_a_module_boundary():
+    crossings = [
+        f"{name} imports {imported} from {target}"
+        for name, path in MODULES.items()
+        for target, imported in _imports(name, path)
+        if imported is not None and imported.startswith("_") and not imported.startswith("__")
+    ]
+    assert crossings == []
+
+
+def test_examples_and_benchmarks_use_public_names_only():
+    crossings = []
+    for folder in ("examples", "benchmarks"):
+        for path in sorted((ROOT / folder).rglob("*.py")):
+            for target, imported in _imports(path.stem, path):
+                if imported is not None and imported.startswith("_") and not imported.startswith("__"):
+                    crossings.append(f"{path.relative_to(ROOT)} imports {imported} from {target}")
+    assert crossings == []
+
+
+@pytest.mark.parametrize("name", sorted(MODULES))
+def test_module_size(name):
+    lines = MODULES[name].read_text().count("\n")
+    assert lines <= MAX_MODULE_LINES, f"{name}: {lines} lines; split it by concept"
+
+
+def test_only_qsplan_names_are_imported():
+    bare = []
+    for folder in ("mechanics", "hands", "planner", "tests", "examples", "benchmarks", "src"):
+        for path in sorted((ROOT / folder).rglob("*.py")):
+            tree = ast.parse(path.read_text())
+            for node in ast.walk(tree):
+                names = []
+                if isinstance(node, ast.ImportFrom) and not node.level:
+                    names = [node.module or ""]
+                elif isinstance(node, ast.ImportFrom) and node.level and folder not in FOLDERS:
+                    names = ["." * node.level + (node.module or "")]
+                elif isinstance(node, ast.Import):
+                    names = [a.name for a in node.names]
+                for n in names:
+                    if n.split(".")[0] in FOLDERS or (n.startswith(".") and folder not in FOLDERS):
+                        bare.append(f"{path.relative_to(ROOT)}:{node.lineno} imports {n}")
+    assert bare == []
+
+
+def test_pyproject_installs_every_package():
+    config = tomllib.loads((ROOT / "pyproject.toml").read_text())["tool"]["setuptools"]
+    listed = set(config["packages"])
+    on_disk = {name for name, path in MODULES.items() if path.name == "__init__.py"}
+    assert listed == on_disk
+    assert config["package-dir"] == {"qsplan": "src/qsplan", **FOLDERS.__class__({v: k for k, v in FOLDERS.items()})}
