@@ -31,15 +31,15 @@ from pathlib import Path
 
 import numpy as np
 
-from qsplan.hands.segments import first_segment, sample_segment
-from qsplan.hands.two_finger import default_hand
-from qsplan.planner.plotting.bands import plot_speed_accuracy
-from qsplan.planner.torque.sweep import (
+from qsplan.hands import default_hand, first_segment, sample_segment
+from qsplan.planner import (
     competing_modes,
     guaranteed_sweep,
+    new_axes,
+    plot_speed_accuracy,
     sampled_guaranteed_sweep,
+    save_figure,
 )
-from qsplan.planner.plotting.style import new_axes, save_figure
 
 SEED = 1995
 MU_RANGE = (0.0, 0.2)

@@ -23,10 +23,11 @@ from qsplan.hands.paper import eq42_scene
 from qsplan.hands.segments import first_segment, sample_segment
 from qsplan.hands.two_finger import default_hand
 from qsplan.mechanics import scene_from_dict, solve
-from qsplan.mechanics.muspace.maps import feasibility_map, grid_points, mu_slice
+from qsplan.mechanics.muspace.maps import feasibility_map, grid_points
+from qsplan.mechanics.muspace.slices import mu_slice
 from qsplan.mechanics.parallel import first_difference
 from qsplan.mechanics.modes.planted import planted_scene
-from qsplan.planner.torque.sweep import segment_bands
+from qsplan.planner import segment_bands
 
 SEED = 1995
 

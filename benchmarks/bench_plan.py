@@ -5,8 +5,7 @@ Run: ``python3 benchmarks/bench_plan.py`` (the bundled tasks; about a minute).
 
 import time
 
-from qsplan.planner.planning.plan import plan_task
-from qsplan.planner.planning.task import load_task, task_paths
+from qsplan.planner import load_task, plan_task, task_paths
 
 
 def main():

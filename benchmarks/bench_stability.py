@@ -48,11 +48,12 @@ import numpy as np
 
 from qsplan.mechanics import make_scene, solve
 from qsplan.mechanics.crosscheck.exact import exact_feasible_modes
-from qsplan.mechanics.modes.reference import velocity_scale
+from qsplan.mechanics.modes.kinematics import velocity_scale
 from qsplan.mechanics.crosscheck.lcp import solve_lcp
 from qsplan.mechanics.modes.contact_mode import mode_index_array
 from qsplan.mechanics.numerics import DEFAULT_TOLERANCES, Status, hadamard_ratio
-from qsplan.mechanics.solver.batch import ScenePool, equilibrium_matrix, kinematics_stage
+from qsplan.mechanics.modes.equilibrium import equilibrium_matrix
+from qsplan.mechanics.modes.kinematics import ScenePool, kinematics_stage
 
 CHARTS = Path(__file__).resolve().parent / "charts"
 FAMILIES = ("concurrent", "parallel", "slip", "cone", "mu")

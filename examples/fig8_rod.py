@@ -15,11 +15,9 @@ from pathlib import Path
 
 import numpy as np
 
-from qsplan.hands.paper import rod_scene
-from qsplan.mechanics import scene_from_dict, solve
-from qsplan.mechanics.muspace.maps import boundary_agreement, mu_slice
-from qsplan.planner.plotting.muspace import plot_mu_map
-from qsplan.planner.plotting.style import new_axes
+from qsplan.hands import rod_scene
+from qsplan.mechanics import boundary_agreement, mu_slice, scene_from_dict, solve
+from qsplan.planner import new_axes, plot_mu_map
 
 SEED = 8
 L1, L2 = 1.0, 0.6

@@ -12,14 +12,11 @@ friction value on.  Public API only::
 
 import sys
 from dataclasses import replace
-from pathlib import Path
 
-from qsplan.hands.two_finger import make_two_finger_hand
-from qsplan.planner.planning.plan import PlanFailure, plan_task
-from qsplan.planner.export.plan_files import export_plan
-from qsplan.planner.plotting.plan import plan_figures
-from qsplan.planner.plotting.style import save_figure
-from qsplan.planner.planning.task import make_task
+from qsplan.hands import make_two_finger_hand
+from qsplan.planner import PlanFailure, make_task, plan_task, run_plan
+
+SEED = 1
 
 
 def pentagon_task(mu_range=(0.0, 0.2)):
@@ -33,19 +30,16 @@ def pentagon_task(mu_range=(0.0, 0.2)):
 
 def main(out="out/examples/pentagon"):
     task = pentagon_task()
-    plan = plan_task(task, progress=lambda line: print("  " + line))
+    plan = run_plan(task, out, seed=SEED, verify=0, force=True, progress=lambda line: print("  " + line)).plan
     for seg in plan.segments:
         print(f"{seg.name}: {seg.effort_joint} finger torque-controlled, band {seg.width.min():.4g} N m at its "
               f"narrowest, command margin >= {seg.margin.min():.4g} N m")  # fmt: skip
-    export_plan(plan, Path(out), force=True)
-    for name, fig in plan_figures(plan).items():
-        save_figure(fig, Path(out) / f"{name}.png")
     print(f"wrote {out}/")
 
     wide = replace(task, mu_range=(0.0, 0.6))
     try:
         plan_task(wide)
-    except PlanFailure as failure:
+    except PlanFailure as failure:  # no plan exists (a NoAnswerError, not a ValueError)
         report = failure.report
         print("with mu in [0, 0.6]:", report.message)
         print("  as data:", {k: report.as_dict()[k] for k in ("segment", "mu_closes") if k in report.as_dict()})

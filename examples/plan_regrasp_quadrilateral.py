@@ -4,35 +4,28 @@ A quadrilateral workpiece slides on the palm in mode 4S three times (left, right
 left), the fingers regrasping between segments.  The plan is written to
 ``out/examples/quadrilateral/`` (torque trajectory CSV/JSON and the operator plots),
 then the exported file is re-simulated with the finite-motion simulator at friction
-vectors drawn from the task's interval.  Public API only::
+vectors drawn from the task's interval: all of it by one call, :func:`qsplan.planner.run_plan`
+(what ``qsplan demo`` runs).  Public API only::
 
     python examples/plan_regrasp_quadrilateral.py [OUT_DIR]
 """
 
 import sys
-from pathlib import Path
 
-from qsplan.planner.planning.plan import plan_task
-from qsplan.planner.export.plan_files import export_plan, read_plan_csv
-from qsplan.planner.plotting.plan import plan_figures
-from qsplan.planner.plotting.style import save_figure
-from qsplan.planner.planning.replay import friction_samples, replay_plan
-from qsplan.planner.planning.task import demo_task_path, load_task
+from qsplan.planner import demo_task_path, load_task, run_plan
+
+SEED = 1
 
 
 def main(out="out/examples/quadrilateral"):
     task = load_task(demo_task_path())
-    plan = plan_task(task, progress=lambda line: print("  " + line))
+    run = run_plan(task, out, seed=SEED, verify=3, force=True, progress=lambda line: print("  " + line))
+    plan = run.plan
     segment, t, width = plan.narrowest()
     print(f"{task.name}: {plan.duration:.3g} s of motion, narrowest band {width:.4g} N m at t = {t:.3g} s "
           f"({segment}); planned in {plan.seconds:.3g} s")  # fmt: skip
-    out = Path(out)
-    export_plan(plan, out, force=True)
-    for name, fig in plan_figures(plan).items():
-        save_figure(fig, out / f"{name}.png")
-    columns = read_plan_csv(out / "plan.csv")
-    for mu in friction_samples(task.mu_range, 3, seed=1):
-        print("re-simulated at", replay_plan(columns, task.hand, mu).summary())
+    for replay in run.replays:
+        print("re-simulated at", replay.summary())
     print(f"wrote {out}/")
 
 

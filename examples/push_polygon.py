@@ -21,9 +21,9 @@ from pathlib import Path
 
 import numpy as np
 
-from qsplan.hands.pushing import tilted_box_example
-from qsplan.mechanics.motion.simulator import MotionOptions, simulate
-from qsplan.planner.plotting.motion import push_motion_figure
+from qsplan.hands import tilted_box_example
+from qsplan.mechanics import MotionOptions, simulate
+from qsplan.planner import push_motion_figure
 
 SEED = 5  # the run is deterministic; the seed only jitters the start for a robustness check
 

@@ -23,8 +23,8 @@ from pathlib import Path
 
 import numpy as np
 
-from qsplan.hands.rod import rod_closed_form, simulate_rod
-from qsplan.planner.plotting.motion import rod_motion_figure
+from qsplan.hands import rod_closed_form, simulate_rod
+from qsplan.planner import rod_motion_figure
 
 SEED = 20250105
 

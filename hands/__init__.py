@@ -4,6 +4,7 @@
 * :mod:`hands.rod` - the rod on two moving supports as a finite-motion system, with its closed form (Section 5.1).
 * :mod:`hands.pushing` - a polygon pushed across a surface by a finger (contacts appearing).
 * :mod:`hands.two_finger` - the palm and two single-link fingers of Fig. 9 holding a polygon.
+* :mod:`hands.two_finger_scene` - that hand's scene (geometric and raw) at a configuration.
 * :mod:`hands.segments` - manipulation segments of that hand (segment 1: translate left in 4S).
 
 Submodules are imported on first use so that ``import hands`` stays light.
@@ -37,10 +38,10 @@ _LAZY = {
     "DEFAULT_WORKPIECE": "qsplan.hands.two_finger",
     "finger_angles": "qsplan.hands.two_finger",
     "finger_angle_rates": "qsplan.hands.two_finger",
-    "hand_scene": "qsplan.hands.two_finger",
-    "hand_geometric_scene": "qsplan.hands.two_finger",
-    "hand_contacts": "qsplan.hands.two_finger",
-    "hand_polygons": "qsplan.hands.two_finger",
+    "hand_scene": "qsplan.hands.two_finger_scene",
+    "hand_geometric_scene": "qsplan.hands.two_finger_scene",
+    "hand_contacts": "qsplan.hands.two_finger_scene",
+    "hand_polygons": "qsplan.hands.two_finger_scene",
     "workpiece_world": "qsplan.hands.two_finger",
     "ManipulationSegment": "qsplan.hands.segments",
     "SegmentSamples": "qsplan.hands.segments",

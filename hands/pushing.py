@@ -1,4 +1,4 @@
-"""A polygonal workpiece pushed across a floor by a point finger, as a :class:`mechanics.motion.MotionSystem`.
+"""A polygonal workpiece pushed across a floor by a point finger, as a :class:`qsplan.mechanics.motion.system.MotionSystem`.
 
 The plane is vertical, gravity along -y; the floor is the line ``y = 0``.  The
 workpiece is a convex polygon (vertices about its centre of mass, counter-
@@ -17,7 +17,7 @@ The contact geometry on the integrator's hot path is computed here with numpy
 (points on lines, and signed gaps, which contact detection alone does not give);
 shapely validates the polygon.  :meth:`PushedPolygon.geometry_document` exports any
 instant to the geometric scene form, where :func:`mechanics.geometry.find_contacts`
-and :mod:`mechanics.geometric_scene` rebuild the same scene (the tests check it).
+and :mod:`qsplan.mechanics.model.geometric_scene` rebuild the same scene (the tests check it).
 """
 
 from __future__ import annotations
@@ -28,7 +28,7 @@ from typing import ClassVar
 import numpy as np
 
 from qsplan.mechanics import QsplanError, Scene, point_wrench
-from qsplan.mechanics.motion.simulator import Friction, make_friction, rigid_body_rates
+from qsplan.mechanics.motion.system import Friction, make_friction, rigid_body_rates
 
 __all__ = ["PushedPolygon", "make_pushed_polygon", "tilted_box_example", "polygon_world"]
 
@@ -147,11 +147,11 @@ class PushedPolygon:
         )  # fmt: skip
 
     def rates(self, x, qdot, thetadot) -> np.ndarray:
-        """``dx/dt``: the pose from ``qdot`` (:func:`mechanics.motion.pose_rate`), ``s`` from ``thetadot``."""
+        """``dx/dt``: the pose from ``qdot`` (:func:`qsplan.mechanics.motion.system.pose_rate`), ``s`` from ``thetadot``."""
         return rigid_body_rates(x, qdot, thetadot)
 
     def geometry_document(self, x, gravity=9.81, floor_extent=10.0) -> dict:
-        """The instant at ``x`` in the geometric scene form of :mod:`mechanics.geometric_scene`.
+        """The instant at ``x`` in the geometric scene form of :mod:`qsplan.mechanics.model.geometric_scene`.
 
         The floor becomes the palm (a box under ``y = 0``, ``floor_extent`` m each side
         of the origin), the finger a prismatic joint whose link is a narrow triangle with

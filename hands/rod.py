@@ -1,4 +1,4 @@
-"""The thin rod on two moving supports (Section 5.1, Figs. 7-8) as a :class:`mechanics.motion.MotionSystem`.
+"""The thin rod on two moving supports (Section 5.1, Figs. 7-8) as a :class:`qsplan.mechanics.motion.system.MotionSystem`.
 
 The rod lies along x with its centre of mass at the world origin at t = 0.
 Support 1 (contact 1) starts at ``x = -l1``, support 2 (contact 2) at ``x = +l2``;
@@ -75,7 +75,8 @@ from typing import ClassVar
 import numpy as np
 
 from qsplan.mechanics import QsplanError, Scene, point_wrench
-from qsplan.mechanics.motion.simulator import Friction, MotionOptions, make_friction, rigid_body_rates, simulate
+from qsplan.mechanics.motion.simulator import MotionOptions, simulate
+from qsplan.mechanics.motion.system import Friction, make_friction, rigid_body_rates
 
 __all__ = [
     "RodOnSupports",
@@ -170,7 +171,7 @@ class RodOnSupports:
         )  # fmt: skip
 
     def rates(self, x, qdot, thetadot):
-        """``dx/dt``: the pose from ``qdot`` (:func:`mechanics.motion.pose_rate`), the supports from ``thetadot``."""
+        """``dx/dt``: the pose from ``qdot`` (:func:`qsplan.mechanics.motion.system.pose_rate`), the supports from ``thetadot``."""
         return rigid_body_rates(x, qdot, thetadot)
 
     def limits(self, x):
@@ -213,7 +214,7 @@ def rod_distances(states) -> np.ndarray:
 
 def simulate_rod(l1, l2, mu_static, mu_kinetic, speed, duration, options: MotionOptions | None = None,
                  initial_mode: str | None = None, weight: float = 1.0):  # fmt: skip
-    """Simulate the rod of Fig. 7 with :func:`mechanics.motion.simulate`.
+    """Simulate the rod of Fig. 7 with :func:`qsplan.mechanics.motion.simulator.simulate`.
 
     Parameters
     ----------
@@ -268,7 +269,7 @@ class RodClosedForm:
     ----------
     segments : tuple of RodSegment
     stopped : str or None
-        A :data:`mechanics.motion.STOP_KINDS` entry, or None when the duration was reached.
+        A :data:`qsplan.mechanics.motion.trajectory.STOP_KINDS` entry, or None when the duration was reached.
     t_star : float
         ``(l1_0 + l2_0) / (2V)``, where switch instants accumulate (s).
     a, b : float
@@ -291,7 +292,7 @@ def rod_closed_form(l1, l2, mu_static, mu_kinetic, speed, duration, initial_mode
     """Segments of the rod's motion from the closed form of the module docstring.
 
     Parameters are those of :func:`simulate_rod`; ``min_segment`` (s) and
-    ``max_switches`` stop the run exactly as :class:`mechanics.motion.MotionOptions`
+    ``max_switches`` stop the run exactly as :class:`qsplan.mechanics.motion.simulator.MotionOptions`
     does (defaults: theirs).  Static coefficients must be positive (with a zero one the line never
     reaches the rectangle's corner and the model is ambiguous for all time).
     """

@@ -23,14 +23,8 @@ import numpy as np
 
 from qsplan.mechanics.errors import SceneError
 
-from qsplan.hands.two_finger import (
-    JOINT_NAMES,
-    TwoFingerHand,
-    finger_angle_rates,
-    finger_angles,
-    hand_scene,
-    workpiece_world,
-)
+from qsplan.hands.two_finger import JOINT_NAMES, TwoFingerHand, finger_angle_rates, finger_angles, workpiece_world
+from qsplan.hands.two_finger_scene import hand_scene
 
 __all__ = [
     "DEFAULT_SAMPLES",

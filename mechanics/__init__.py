@@ -1,10 +1,24 @@
-"""qsplan.mechanics: the quasistatic contact model of Trinkle & Zeng (1995), Sections 3-4.
+"""qsplan.mechanics: the quasistatic contact model of Trinkle & Zeng (1995), Sections 3-5.
 
-Public API (everything else is private):
+Subpackages, by the paper's concepts (each ``__init__`` lists its modules and equations):
+
+* :mod:`.model` - contact frames and wrenches (eq. 1), manipulators (eqs. 3, 5), scenes, geometry, scene I/O
+* :mod:`.modes` - contact modes (eqs. 12, 29, 49), kinematics (eqs. 23-25), equilibrium and Coulomb
+  friction (eqs. 26-28), solutions with residuals (eqs. 2-11), partitions (eq. 32), the one-mode reference
+* :mod:`.solver` - every feasible mode of a scene, batched, chunked or pruned (Sections 3.1-3.2, 4.7)
+* :mod:`.muspace` - mu-space: multilinear forms, regions, Appendices A and B, maps, slices, Corollary 1
+* :mod:`.bands` - effort bands (eq. 28, Section 5.2) at one friction and over uncertain friction
+* :mod:`.motion` - finite motions through mode switches (Section 5.1)
+* :mod:`.crosscheck` - independent checks: exact rational arithmetic, an LP, the LCP and Lemke
+
+Public API (this module's ``__all__``): the names below.  Modules that need shapely or
+scipy (geometry, manipulators, the simulator, the LP check) load on first use, so that
+``import qsplan.mechanics`` stays light.
 
 * contact frames and wrenches (eq. 1): :func:`cross2`, :func:`tangent_from_normal`,
   :func:`wrench_matrix`, :func:`wrench_matrices`, :func:`shift_wrenches`, :func:`point_wrench`
-* scenes: :class:`Scene`, :func:`make_scene`, :func:`load_scene`, :func:`scene_from_dict`
+* scenes: :class:`Scene`, :func:`make_scene`, :func:`load_scene`, :func:`scene_from_dict`,
+  :func:`scene_to_dict`, :func:`planted_scene` (random scenes with a known feasible mode)
 * manipulators (planar kinematic trees, eq. 5): :func:`make_manipulator`, :func:`link_poses`,
   :func:`point_jacobian`, :func:`contact_jacobian`, :func:`gravity_efforts`
 * the geometric scene form: :func:`scene_from_geometry`, :func:`find_contacts`
@@ -18,33 +32,81 @@ Public API (everything else is private):
   :func:`guaranteed_band_shared`, :func:`sampled_band`
 * all feasible modes, vectorized: :func:`solve`, :class:`SolveResult`, :class:`ModeSolution`
 * residuals of the full model (eqs. 2-11): :func:`model_residuals`
+* finite motion (Section 5.1): :func:`simulate`, :class:`MotionOptions`, :func:`make_friction`
+* independent checks: :func:`lp_mode_feasible`
 * tolerances and statuses: :class:`Tolerances`, :class:`Status`
-* errors: :class:`QsplanError`, :class:`SceneError`, :class:`ModeError`
+* the guaranteed band of one scene with every competitor precluded (Fig. 13): :func:`robust_band`
+* errors: :class:`QsplanError`, :class:`SceneError`, :class:`ModeError` (bad input);
+  :class:`NoAnswerError` (no answer exists; not a ``ValueError``)
+
+Parallel infrastructure (:func:`qsplan.mechanics.parallel.map_chunks`) is not part of it.
 """
 
 if __name__ != "qsplan.mechanics":  # the repository root on sys.path must not load a second copy
     raise ImportError(f"this folder installs as qsplan.mechanics; import qsplan.mechanics (after `pip install .`), not {__name__}")
 
 
+from qsplan.mechanics.bands.effort import Band, effort_band, effort_bands
+from qsplan.mechanics.bands.guaranteed import guaranteed_band_box, guaranteed_band_shared, possible_band_box, sampled_band
+from qsplan.mechanics.bands.robust import RobustBand, robust_band
+from qsplan.mechanics.errors import ModeError, NoAnswerError, QsplanError, SceneError
 from qsplan.mechanics.model.contact import cross2, point_wrench, shift_wrenches, tangent_from_normal, wrench_matrices, wrench_matrix
-from qsplan.mechanics.errors import ModeError, QsplanError, SceneError
-from qsplan.mechanics.modes.reference import ModeCheck, check_mode
-from qsplan.mechanics.bands.effort import Band, effort_band, effort_bands, guaranteed_band_box, guaranteed_band_shared, possible_band_box, sampled_band
-from qsplan.mechanics.muspace.graphical import GraphicalTest, graphical_test, graphical_test_mode
-from qsplan.mechanics.modes.contact_mode import ContactMode, count_modes, enumerate_modes, iter_mode_batches, mode_from_letters
-from qsplan.mechanics.muspace.multilinear import Multilinear
-from qsplan.mechanics.muspace.maps import MuMap, MuSlice, boundary_agreement, feasibility_map, grid_points, mu_slice, polynomial_map
-from qsplan.mechanics.parallel import map_chunks
-from qsplan.mechanics.modes.partition import Partition, effort_partitions, partition_table
-from qsplan.mechanics.muspace.regions import MuRegion, appendix_a, appendix_b, mode_kinematics, mode_region, region_3s, region_rs
-from qsplan.mechanics.numerics import DEFAULT_TOLERANCES, Status, Tolerances
-from qsplan.mechanics.modes.planted import planted_scene
 from qsplan.mechanics.model.scene import Scene, make_scene
 from qsplan.mechanics.model.scene_io import load_scene, scene_from_dict
 from qsplan.mechanics.model.scene_io_write import scene_to_dict
+from qsplan.mechanics.modes.contact_mode import ContactMode, count_modes, enumerate_modes, iter_mode_batches, mode_from_letters
+from qsplan.mechanics.modes.partition import Partition, effort_partitions, partition_table
+from qsplan.mechanics.modes.planted import planted_scene
+from qsplan.mechanics.modes.reference import ModeCheck, check_mode
 from qsplan.mechanics.modes.solution import ModeSolution, model_residuals, relative_velocity
-from qsplan.mechanics.solver.batch import SolveResult, solve
+from qsplan.mechanics.muspace.appendices import appendix_a, appendix_b, region_3s, region_rs
+from qsplan.mechanics.muspace.graphical import GraphicalTest, graphical_test, graphical_test_mode
+from qsplan.mechanics.muspace.maps import MuMap, feasibility_map, grid_points, polynomial_map
+from qsplan.mechanics.muspace.multilinear import Multilinear
+from qsplan.mechanics.muspace.regions import MuRegion, mode_kinematics, mode_region
+from qsplan.mechanics.muspace.slices import MuSlice, boundary_agreement, mu_slice
+from qsplan.mechanics.numerics import DEFAULT_TOLERANCES, Status, Tolerances
+from qsplan.mechanics.solver.all_modes import solve
+from qsplan.mechanics.solver.result import SolveResult
 
+# Geometry needs shapely and the simulator and the LP check scipy: load those modules on first use so that
+# ``import qsplan.mechanics`` (and the CLI's solver path) stays light.
+_LAZY = {
+    "LPCheck": "qsplan.mechanics.crosscheck.lp_check",
+    "lp_mode_feasible": "qsplan.mechanics.crosscheck.lp_check",
+    "simulate": "qsplan.mechanics.motion.simulator",
+    "MotionOptions": "qsplan.mechanics.motion.simulator",
+    "Motion": "qsplan.mechanics.motion.trajectory",
+    "Segment": "qsplan.mechanics.motion.trajectory",
+    "Stop": "qsplan.mechanics.motion.trajectory",
+    "STOP_KINDS": "qsplan.mechanics.motion.trajectory",
+    "Event": "qsplan.mechanics.motion.events",
+    "MotionSystem": "qsplan.mechanics.motion.system",
+    "Friction": "qsplan.mechanics.motion.system",
+    "make_friction": "qsplan.mechanics.motion.system",
+    "pose_rate": "qsplan.mechanics.motion.system",
+    "rigid_body_rates": "qsplan.mechanics.motion.system",
+    "FrozenScene": "qsplan.mechanics.motion.system",
+    "frozen_scene_system": "qsplan.mechanics.motion.system",
+    "GeometricScene": "qsplan.mechanics.model.geometric_scene",
+    "geometric_scene_from_dict": "qsplan.mechanics.model.geometric_scene",
+    "scene_from_geometric_scene": "qsplan.mechanics.model.geometric_scene",
+    "scene_from_geometry": "qsplan.mechanics.model.geometric_scene",
+    "CONTACT_TOL": "qsplan.mechanics.model.geometry",
+    "FoundContact": "qsplan.mechanics.model.geometry",
+    "find_contacts": "qsplan.mechanics.model.geometry",
+    "Joint": "qsplan.mechanics.model.manipulator",
+    "Manipulator": "qsplan.mechanics.model.manipulator",
+    "contact_jacobian": "qsplan.mechanics.model.manipulator",
+    "gravity_efforts": "qsplan.mechanics.model.manipulator",
+    "link_polygons": "qsplan.mechanics.model.manipulator",
+    "link_poses": "qsplan.mechanics.model.manipulator",
+    "make_joint": "qsplan.mechanics.model.manipulator",
+    "make_manipulator": "qsplan.mechanics.model.manipulator",
+    "point_jacobian": "qsplan.mechanics.model.manipulator",
+}
+
+#: The public names: those imported above, then the lazily loaded ones.
 __all__ = [
     "cross2",
     "point_wrench",
@@ -53,26 +115,13 @@ __all__ = [
     "wrench_matrices",
     "wrench_matrix",
     "ModeError",
+    "NoAnswerError",
     "QsplanError",
+    "RobustBand",
+    "robust_band",
     "SceneError",
     "ModeCheck",
     "check_mode",
-    "GeometricScene",
-    "geometric_scene_from_dict",
-    "scene_from_geometric_scene",
-    "scene_from_geometry",
-    "CONTACT_TOL",
-    "FoundContact",
-    "find_contacts",
-    "Joint",
-    "Manipulator",
-    "contact_jacobian",
-    "gravity_efforts",
-    "link_polygons",
-    "link_poses",
-    "make_joint",
-    "make_manipulator",
-    "point_jacobian",
     "Band",
     "effort_band",
     "effort_bands",
@@ -91,7 +140,6 @@ __all__ = [
     "grid_points",
     "mu_slice",
     "polynomial_map",
-    "map_chunks",
     "Partition",
     "effort_partitions",
     "partition_table",
@@ -122,45 +170,6 @@ __all__ = [
     "SolveResult",
     "solve",
 ]
-
-# Geometry needs shapely and the simulator scipy; load those modules on first use so that ``import mechanics``
-# (and the CLI's solver path) stays light.
-_LAZY = {
-    "LPCheck": "qsplan.mechanics.crosscheck.lp_check",
-    "lp_mode_feasible": "qsplan.mechanics.crosscheck.lp_check",
-    "simulate": "qsplan.mechanics.motion.simulator",
-    "Motion": "qsplan.mechanics.motion.simulator",
-    "MotionOptions": "qsplan.mechanics.motion.simulator",
-    "MotionSystem": "qsplan.mechanics.motion.simulator",
-    "Segment": "qsplan.mechanics.motion.simulator",
-    "Stop": "qsplan.mechanics.motion.simulator",
-    "Event": "qsplan.mechanics.motion.simulator",
-    "Friction": "qsplan.mechanics.motion.simulator",
-    "make_friction": "qsplan.mechanics.motion.simulator",
-    "pose_rate": "qsplan.mechanics.motion.simulator",
-    "rigid_body_rates": "qsplan.mechanics.motion.simulator",
-    "FrozenScene": "qsplan.mechanics.motion.simulator",
-    "frozen_scene_system": "qsplan.mechanics.motion.simulator",
-    "STOP_KINDS": "qsplan.mechanics.motion.simulator",
-    "GeometricScene": "qsplan.mechanics.model.geometric_scene",
-    "geometric_scene_from_dict": "qsplan.mechanics.model.geometric_scene",
-    "scene_from_geometric_scene": "qsplan.mechanics.model.geometric_scene",
-    "scene_from_geometry": "qsplan.mechanics.model.geometric_scene",
-    "CONTACT_TOL": "qsplan.mechanics.model.geometry",
-    "FoundContact": "qsplan.mechanics.model.geometry",
-    "find_contacts": "qsplan.mechanics.model.geometry",
-    "Joint": "qsplan.mechanics.model.manipulator",
-    "Manipulator": "qsplan.mechanics.model.manipulator",
-    "contact_jacobian": "qsplan.mechanics.model.manipulator",
-    "gravity_efforts": "qsplan.mechanics.model.manipulator",
-    "link_polygons": "qsplan.mechanics.model.manipulator",
-    "link_poses": "qsplan.mechanics.model.manipulator",
-    "make_joint": "qsplan.mechanics.model.manipulator",
-    "make_manipulator": "qsplan.mechanics.model.manipulator",
-    "point_jacobian": "qsplan.mechanics.model.manipulator",
-}
-
-
 __all__ += list(_LAZY)
 
 

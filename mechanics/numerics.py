@@ -8,10 +8,11 @@ failed (``Status``) so that degenerate cases are counted, never passed.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from enum import IntEnum
 
 import numpy as np
 
-__all__ = ["Tolerances", "DEFAULT_TOLERANCES", "hadamard_ratio", "rcond", "Status", "conditioning_verdict"]
+__all__ = ["Tolerances", "DEFAULT_TOLERANCES", "hadamard_ratio", "rcond", "Status", "StatusCode", "conditioning_verdict"]
 
 
 @dataclass(frozen=True, slots=True)
@@ -84,6 +85,24 @@ class Status:
     ILL_CONDITIONED = frozenset({"kinematics_singular", "equilibrium_singular"})
 
 
+class StatusCode(IntEnum):
+    """The integer code of each :class:`Status`, its index in ``Status.ORDER``.
+
+    The vectorized stages keep one int8 code per mode; ``Status.ORDER[code]`` is its name.
+    """
+
+    FEASIBLE = 0
+    KINEMATICS_SINGULAR = 1
+    BREAKING_VIOLATED = 2
+    BREAKING_ZERO_SPEED = 3
+    ZERO_SLIDING_SPEED = 4
+    EQUILIBRIUM_SINGULAR = 5
+    COULOMB_VIOLATED = 6
+
+
+assert tuple(getattr(Status, c.name) for c in StatusCode) == Status.ORDER
+
+
 def conditioning_verdict(counts: dict, tol: Tolerances = DEFAULT_TOLERANCES) -> str | None:
     """One line saying the result is ill-conditioned, or None when every mode was decided.
 
@@ -111,30 +130,44 @@ def conditioning_verdict(counts: dict, tol: Tolerances = DEFAULT_TOLERANCES) -> 
     )
 
 
-def hadamard_ratio(A):
+def hadamard_ratio(A, *, signed: bool = False, log_row_norms=None):
     """``|det A| / prod_i ||a_i||`` over the rows ``a_i`` of square matrices.
 
     A scale-invariant (per row) singularity measure in [0, 1]: 0 exactly when A
     is singular, 1 when its rows are orthogonal.  For a row-equilibrated k x k
     matrix, ``h / k^(k/2) <= s_min / s_max <= ...`` and ``h <= (s_min / s_max) k^(k/2)``,
     so it vanishes with the reciprocal condition number.  It costs one batched LU
-    (``slogdet``), far less than an SVD.
+    (``slogdet``), far less than an SVD.  This is the one singularity test of
+    ``P_AI`` and ``Q_AI`` (eqs. 23, 26) every solver path calls.
 
     Parameters
     ----------
     A : array-like, shape (..., k, k)
+    signed : bool
+        Return ``det A / prod_i ||a_i||`` (sign of the determinant kept), in [-1, 1]:
+        the finite-motion events watch it cross zero.
+    log_row_norms : array-like, shape (...), optional
+        ``sum_i log ||a_i||`` when the caller already has it (the batched solver gathers
+        it from per-scene row norms); computed from ``A`` otherwise.
 
     Returns
     -------
     ndarray, shape (...)
+        0 where ``A`` is singular or has a zero row; 1 for ``k = 0``.
     """
     A = np.asarray(A, dtype=float)
-    norms = np.linalg.norm(A, axis=-1)
-    with np.errstate(divide="ignore"):
-        lognorm = np.log(norms).sum(axis=-1)
+    if log_row_norms is None:
+        norms = np.linalg.norm(A, axis=-1)
+        with np.errstate(divide="ignore"):
+            lognorm = np.log(norms).sum(axis=-1)
+    else:
+        lognorm = np.asarray(log_row_norms, dtype=float)
     sign, logdet = np.linalg.slogdet(A)
     with np.errstate(invalid="ignore", over="ignore"):
-        h = np.where((sign == 0) | ~np.isfinite(lognorm), 0.0, np.exp(logdet - lognorm))
+        h = np.exp(logdet - lognorm)
+        if signed:
+            h = sign * h
+        h = np.where((sign == 0) | ~np.isfinite(lognorm), 0.0, h)
     return h
 
 

@@ -1,4 +1,133 @@
-"""qsplan.planner: planning two-finger tasks through OMPL with guaranteed torque bands; torque commands, export, plots, the CLI."""
+"""qsplan.planner: planning two-finger tasks through OMPL with guaranteed torque bands; torque commands, export, plots, the CLI.
+
+Public API (loaded on first use, so ``import qsplan.planner`` stays light):
+
+* tasks: :class:`Task`, :func:`load_task`, :func:`make_task`, :func:`demo_task_path`, :func:`task_paths`
+* planning (Section 5.2, Figs. 9-13): :func:`plan_task`, :class:`Plan`, :class:`ContactSegmentPlan`,
+  :class:`RegraspPlan`, :class:`PlannerOptions`, :data:`DEFAULT_OPTIONS`; judged states
+  :func:`check_contact_state`, :func:`check_free_state`, :class:`StateCheck`
+* the whole pipeline (plan, export, plots, re-simulation): :func:`run_plan`, :class:`PlanRun`
+* no plan: :class:`PlanFailure` (a :class:`NoAnswerError`) with its :class:`FailureReport`
+* export: :func:`export_plan`, :func:`read_plan_csv`, :func:`export_schedule`, :func:`check_outputs`
+* replay and verification: :func:`replay_plan`, :func:`friction_samples`, :class:`Replay`
+* torque bands along a segment and commands: :func:`segment_bands`, :func:`guaranteed_sweep`,
+  :func:`point_band_sweep`, :func:`sampled_guaranteed_sweep`, :func:`choose_command`, :func:`sweep_segment`;
+  for one scene, the guaranteed band with every competitor precluded: :func:`robust_band`
+* plots: :func:`plan_figures`, :func:`segment_band_figures`, :func:`plot_hand`, :func:`plot_mu_map`,
+  :func:`rod_motion_figure`, :func:`push_motion_figure`, :func:`save_figure`, ...
+* errors: :class:`QsplanError` (bad input, a ``ValueError``), :class:`NoAnswerError` (no answer exists)
+"""
 
 if __name__ != "qsplan.planner":  # the repository root on sys.path must not load a second copy
     raise ImportError(f"this folder installs as qsplan.planner; import qsplan.planner (after `pip install .`), not {__name__}")
+
+#: Public name -> the module that defines it (imported on first attribute access).
+_LAZY = {
+    # errors
+    "QsplanError": "qsplan.mechanics.errors",
+    "NoAnswerError": "qsplan.mechanics.errors",
+    # tasks
+    "Task": "qsplan.planner.planning.task",
+    "load_task": "qsplan.planner.planning.task",
+    "make_task": "qsplan.planner.planning.task",
+    "demo_task_path": "qsplan.planner.planning.task",
+    "task_paths": "qsplan.planner.planning.task",
+    # planning
+    "plan_task": "qsplan.planner.planning.plan",
+    "DEFAULT_OPTIONS": "qsplan.planner.planning.plan",
+    "REGRASP_OPENING": "qsplan.planner.planning.plan",
+    "SWEEP_STEP": "qsplan.planner.planning.plan",
+    "Plan": "qsplan.planner.planning.results",
+    "ContactSegmentPlan": "qsplan.planner.planning.results",
+    "RegraspPlan": "qsplan.planner.planning.results",
+    "PlanFailure": "qsplan.planner.planning.results",
+    "StateCheck": "qsplan.planner.planning.results",
+    "check_contact_state": "qsplan.planner.planning.contact_state",
+    "check_free_state": "qsplan.planner.planning.contact_state",
+    "contact_samples": "qsplan.planner.planning.contact_state",
+    "FailureReport": "qsplan.planner.planning.failure",
+    "ClosedPoint": "qsplan.planner.planning.failure",
+    "failure_report": "qsplan.planner.planning.failure",
+    "PlannerOptions": "qsplan.planner.planning.ompl_bridge",
+    "PlanResult": "qsplan.planner.planning.ompl_bridge",
+    "PLANNERS": "qsplan.planner.planning.ompl_bridge",
+    "plan_path": "qsplan.planner.planning.ompl_bridge",
+    "ompl_available": "qsplan.planner.planning.ompl_bridge",
+    "run_plan": "qsplan.planner.planning.pipeline",
+    "PlanRun": "qsplan.planner.planning.pipeline",
+    "plan_outputs": "qsplan.planner.planning.pipeline",
+    # replay and verification
+    "replay_plan": "qsplan.planner.planning.replay",
+    "friction_samples": "qsplan.planner.planning.replay",
+    "Replay": "qsplan.planner.planning.replay",
+    "SegmentReplay": "qsplan.planner.planning.replay",
+    # export
+    "export_plan": "qsplan.planner.export.plan_files",
+    "read_plan_csv": "qsplan.planner.export.plan_files",
+    "plan_columns": "qsplan.planner.export.plan_files",
+    "plan_metadata": "qsplan.planner.export.plan_files",
+    "export_schedule": "qsplan.planner.export.schedule",
+    "schedule_columns": "qsplan.planner.export.schedule",
+    "schedule_metadata": "qsplan.planner.export.schedule",
+    "check_outputs": "qsplan.planner.export.files",
+    "OutputExistsError": "qsplan.planner.export.files",
+    # torque bands and commands
+    "robust_band": "qsplan.mechanics.bands.robust",
+    "RobustBand": "qsplan.mechanics.bands.robust",
+    "segment_bands": "qsplan.planner.torque.sweep",
+    "SegmentBands": "qsplan.planner.torque.sweep",
+    "paper_method_wider": "qsplan.planner.torque.sweep",
+    "BandSweep": "qsplan.planner.torque.pointwise",
+    "GuaranteedSweep": "qsplan.planner.torque.pointwise",
+    "guaranteed_sweep": "qsplan.planner.torque.pointwise",
+    "point_band_sweep": "qsplan.planner.torque.pointwise",
+    "sampled_guaranteed_sweep": "qsplan.planner.torque.pointwise",
+    "competing_modes": "qsplan.planner.torque.sweep",
+    "narrowest": "qsplan.planner.torque.pointwise",
+    "choose_command": "qsplan.planner.torque.command",
+    "default_safety_margin": "qsplan.planner.torque.command",
+    "sweep_segment": "qsplan.planner.reports.segment",
+    "SweepRun": "qsplan.planner.reports.segment",
+    "segment_document": "qsplan.planner.reports.segment",
+    # reports
+    "reproduce_paper": "qsplan.planner.reports.paper",
+    "format_solve_result": "qsplan.planner.reports.solve_report",
+    "solve_result_to_dict": "qsplan.planner.reports.solve_report",
+    # plots (matplotlib is imported inside the functions)
+    "plan_figures": "qsplan.planner.plotting.plan",
+    "plot_plan_bands": "qsplan.planner.plotting.plan",
+    "plot_mode_timeline": "qsplan.planner.plotting.plan",
+    "plan_snapshots_figure": "qsplan.planner.plotting.plan",
+    "segment_band_figures": "qsplan.planner.plotting.bands",
+    "plot_band_sweep": "qsplan.planner.plotting.bands",
+    "plot_guaranteed": "qsplan.planner.plotting.bands",
+    "plot_speed_accuracy": "qsplan.planner.plotting.bands",
+    "auto_display_limit": "qsplan.planner.plotting.bands",
+    "plot_hand": "qsplan.planner.plotting.hands",
+    "hand_strip_figure": "qsplan.planner.plotting.hands",
+    "plot_mu_map": "qsplan.planner.plotting.muspace",
+    "plot_contact_scene": "qsplan.planner.plotting.muspace",
+    "rod_motion_figure": "qsplan.planner.plotting.motion",
+    "push_motion_figure": "qsplan.planner.plotting.motion",
+    "plot_rod_distances": "qsplan.planner.plotting.motion",
+    "plot_rod_mu_space": "qsplan.planner.plotting.motion",
+    "plot_push_snapshots": "qsplan.planner.plotting.motion",
+    "new_axes": "qsplan.planner.plotting.style",
+    "save_figure": "qsplan.planner.plotting.style",
+}
+
+__all__ = list(_LAZY)
+
+
+def __getattr__(name):
+    if name in _LAZY:
+        import importlib
+
+        value = getattr(importlib.import_module(_LAZY[name]), name)
+        globals()[name] = value
+        return value
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
+
+def __dir__():
+    return sorted(set(globals()) | set(_LAZY))

@@ -1,1 +1,7 @@
-"""Effort bands (eq. 28, Section 5.2): one joint's efforts that keep a mode feasible, guaranteed over friction, competitors precluded."""
+"""Effort bands (eq. 28, Section 5.2): one joint's efforts that keep a mode feasible.
+
+* :mod:`.effort` - the band at one friction: Coulomb slacks affine in the effort (eqs. 26, 28)
+* :mod:`.guaranteed` - over uncertain friction: guaranteed (box vertices, shared-mu roots), possible, sampled
+* :mod:`.preclusion` - competing modes precluded over uncertain friction (Figs. 12-13)
+* :mod:`.robust` - the guaranteed band of one scene with every competitor precluded (Fig. 13)
+"""

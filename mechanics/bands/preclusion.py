@@ -58,6 +58,11 @@ PRECLUSION_RTOL = 1e-6
 #: competitor (``det Q_AI`` changing sign) cells never resolve, and the budget bounds the time.
 MAX_CELLS = 4000
 
+#: Weight of a cell side's relative width when choosing the side to bisect (the change of the
+#: control values along it weighs 1): small, so it only breaks ties between sides the rows do not
+#: tell apart, such as sides along which nothing changes.
+SPLIT_TIE = 1e-3
+
 
 @dataclass(frozen=True, slots=True)
 class CompetitorTorques:
@@ -131,12 +136,12 @@ class _Cells:
         N1 = (s1 * det[:, None]).reshape(m, 2**d, R)
         pl, pu, pok = _point_bands(s0, s1, scale, self.tol)
         K = 2**d
-        return det.reshape(m, K), N0, N1, pl.reshape(m, K), pu.reshape(m, K), pok.reshape(m, K)
+        det = det.reshape(m, K)
+        return det, N0, N1, pl.reshape(m, K), pu.reshape(m, K), pok.reshape(m, K), _spread(det, N0, N1, d)
 
     def _bernstein(self, a, b):
         n = self.deg
         h = b - a
-        P = np.polynomial.polynomial
         # T[m, j, i]: coefficient of t^i in (a + h t)^j
         j = np.arange(n + 1)
         C = np.array([[comb(jj, ii) for ii in range(n + 1)] for jj in range(n + 1)], dtype=float)
@@ -148,28 +153,45 @@ class _Cells:
         det = M @ self.cdet
         N0 = M @ self.cN0
         N1 = M @ self.cN1
+        # point bands from the model itself (the fitted polynomials lose their accuracy near a root of det)
         pts = np.stack([a, 0.5 * (a + b), b], axis=1)  # (m, 3)
-        dv = P.polyval(pts, self.cdet)
-        n0 = np.moveaxis(P.polyval(pts, self.cN0), 0, -1)  # (m, 3, R)
-        n1 = np.moveaxis(P.polyval(pts, self.cN1), 0, -1)
-        with np.errstate(divide="ignore", invalid="ignore"):
-            s0 = (n0 / dv[..., None]).reshape(-1, n0.shape[-1])
-            s1 = (n1 / dv[..., None]).reshape(-1, n1.shape[-1])
-        scale = np.maximum(np.nanmax(np.abs(s0), axis=1), 1e-300)
+        s0, s1, _, scale = band_rows(self.scene, self.mk, np.repeat(pts.reshape(-1, 1), self.n_c, axis=1))
         pl, pu, pok = _point_bands(s0, s1, scale, self.tol)
         m = a.size
-        return det, N0, N1, pl.reshape(m, 3), pu.reshape(m, 3), pok.reshape(m, 3)
+        return det, N0, N1, pl.reshape(m, 3), pu.reshape(m, 3), pok.reshape(m, 3), np.ones((m, 1))
 
     @staticmethod
-    def split(clo, chi):
-        """Bisect each cell along its widest side."""
-        k = np.argmax(chi - clo, axis=1)
+    def split(clo, chi, spread):
+        """Bisect each cell along the side where its control values vary most (``spread`` (m, d)).
+
+        Splitting a side along which the rows hardly change does not tighten the bound; the
+        widest side breaks ties (and is the choice where every side is flat).
+        """
+        width = chi - clo
+        k = np.argmax(spread * (width > 0) + SPLIT_TIE * width / np.maximum(width.max(axis=1, keepdims=True), 1e-300), axis=1)
         rows = np.arange(clo.shape[0])
         mid = 0.5 * (clo[rows, k] + chi[rows, k])
         lo2, hi1 = clo.copy(), chi.copy()
         hi1[rows, k] = mid
         lo2[rows, k] = mid
         return np.vstack([clo, lo2]), np.vstack([hi1, chi])
+
+
+def _spread(det, N0, N1, d):
+    """How much the control values change along each side of each cell, relative to their size, (m, d).
+
+    For side ``i``: the largest change between vertices that differ in coordinate ``i`` only, of
+    ``det`` and of every row's ``N0`` and ``N1``, each scaled by its largest magnitude on the cell.
+    """
+    m, K, _ = N0.shape
+
+    def unit(x, axes):
+        x = np.where(np.isfinite(x), x, 0.0)
+        return x / np.maximum(np.max(np.abs(x), axis=axes, keepdims=True), 1e-300)
+
+    X = np.concatenate([unit(det, 1)[:, :, None], unit(N0, (1, 2)), unit(N1, (1, 2))], axis=2)  # (m, K, 1 + 2R)
+    idx = np.arange(K)
+    return np.stack([np.max(np.abs(X[:, idx ^ (1 << i)] - X), axis=(1, 2)) for i in range(d)], axis=1)
 
 
 def _point_bands(s0, s1, scale, tol: Tolerances):
@@ -206,7 +228,11 @@ def _lower_bounds(det, N0, N1, g_lo, g_hi, tol: Tolerances):
         up_r = end.max(axis=1)
         whole = np.any(flat & (a >= -e), axis=1) | (up_r >= lo_r)
         cand = np.concatenate([np.full((m, 1), g_lo), lo_r], axis=1)  # (m, R+1)
-        inside = whole[:, None, :] | (cand[:, :, None] <= up_r[:, None, :]) | (cand[:, :, None] >= lo_r[:, None, :])
+        # a row's half-lines (-inf, up_r] and [lo_r, inf) exist only where finite: with g_lo = -inf
+        # the candidate -inf lies in the first only when some control point has a falling row
+        below = (cand[:, :, None] <= up_r[:, None, :]) & (up_r[:, None, :] > -np.inf)
+        above = (cand[:, :, None] >= lo_r[:, None, :]) & (lo_r[:, None, :] < np.inf)
+        inside = whole[:, None, :] | below | above
         valid = np.all(inside, axis=2) & (cand >= g_lo) & (cand <= g_hi)
         steady_lb = np.min(np.where(valid, cand, np.inf), axis=1)
         # --- det changes sign: rows r, q with N_r > 0 and N_q < 0 on the whole cell exclude the effort
@@ -229,7 +255,8 @@ def _lower_bounds(det, N0, N1, g_lo, g_hi, tol: Tolerances):
         E_lo = np.where(live, E_lo, np.nan).reshape(m, -1)
         E_up = np.where(live, E_up, np.nan).reshape(m, -1)
         cand = np.concatenate([np.full((m, 1), g_lo), np.nan_to_num(E_up, nan=np.inf)], axis=1)
-        strictly = (cand[:, :, None] > E_lo[:, None, :]) & (cand[:, :, None] < E_up[:, None, :])
+        # an exclusion interval unbounded below excludes the candidate -inf too
+        strictly = ((cand[:, :, None] > E_lo[:, None, :]) | (E_lo[:, None, :] == -np.inf)) & (cand[:, :, None] < E_up[:, None, :])
         valid = ~np.any(strictly, axis=2) & (cand >= g_lo) & (cand <= g_hi)
         straddle_lb = np.min(np.where(valid, cand, np.inf), axis=1)
     out = np.where(steady, steady_lb, np.where(finite, straddle_lb, g_lo))
@@ -238,35 +265,45 @@ def _lower_bounds(det, N0, N1, g_lo, g_hi, tol: Tolerances):
 
 def _search(cells: _Cells, lo_, hi_, flip, atol, budget, tol):
     """Smallest effort of ``[lo_, hi_]`` possibly feasible; with ``flip`` the efforts are negated
-    (pass ``-hi, -lo`` to find the largest).  Returns (value or NaN, exact, cells used, met a singular cell)."""
+    (pass ``-hi, -lo`` to find the largest).
+
+    Returns ``(value, exact, cells used, met a singular cell)`` with ``value`` (in the unflipped
+    sign) ``+inf`` (``-inf`` with ``flip``) when no effort of the interval is possible: nothing
+    feasible; ``-inf`` (``+inf`` with ``flip``) when the possible efforts reach the interval's
+    unbounded end, proved (a friction point whose band is unbounded there: ``exact``) or not
+    excluded (``exact`` False).  A cell whose bound is ``-inf`` is a safe answer and is kept, never dropped.
+    """
     sign = -1.0 if flip else 1.0
     clo, chi = cells.root
     incumbent, floor, used, exact, straddling = np.inf, np.inf, 0, True, False
     while clo.shape[0]:
-        det, N0, N1, pl, pu, pok = cells.evaluate(clo, chi)
+        det, N0, N1, pl, pu, pok, spread = cells.evaluate(clo, chi)
         used += clo.shape[0]
         if flip:
             pl, pu = -pu, -pl
-        # a friction point whose band reaches the interval (to atol) is a feasible effort: an incumbent
-        feas = pok & (np.maximum(pl, lo_) <= np.minimum(pu, hi_) + atol)
+        # a friction point whose band is not empty and reaches the interval (to atol) is a feasible
+        # effort: an incumbent; a band unbounded below on an interval unbounded below proves -inf.
+        # pok alone admits bands empty by rounding-sized overlaps of nearly singular rows: not a proof.
+        feas = pok & (pl <= pu) & (np.maximum(pl, lo_) <= np.minimum(pu, hi_) + atol)
         if feas.any():
             incumbent = min(incumbent, float(np.min(np.where(feas, np.clip(pl, lo_, hi_), np.inf))))
         lb, steady = _lower_bounds(det, N0, sign * N1, lo_, hi_, tol)
-        straddling |= bool(np.any(~steady & np.isfinite(lb)))
+        possible = lb < np.inf  # lb is +inf for a cell where nothing is possible, and may be -inf
+        straddling |= bool(np.any(~steady & possible))
         # a cell that cannot beat the incumbent, or the interval's far end, by more than atol is resolved
-        done = lb >= min(incumbent, hi_) - atol
-        floor = min(floor, float(np.min(np.where(done & np.isfinite(lb), lb, np.inf), initial=np.inf)))
-        keep = ~done & np.isfinite(lb)
-        clo, chi = clo[keep], chi[keep]
+        done = possible & (lb >= min(incumbent, hi_) - atol)
+        floor = min(floor, float(np.min(lb[done], initial=np.inf)))
+        keep = possible & ~done
+        clo, chi, spread = clo[keep], chi[keep], spread[keep]
         if not clo.shape[0]:
             break
         if used + 2 * clo.shape[0] > budget:
             floor = min(floor, float(np.min(lb[keep])))
             exact = False
             break
-        clo, chi = cells.split(clo, chi)
+        clo, chi = cells.split(clo, chi, spread)
     value = min(incumbent, floor)
-    return (sign * value if np.isfinite(value) else np.nan), exact, used, straddling
+    return sign * value, exact, used, straddling
 
 
 def competitor_torques(scene, mode, lo, hi, g_lo, g_hi, shared=False, tol: Tolerances = DEFAULT_TOLERANCES,
@@ -317,11 +354,11 @@ def competitor_torques(scene, mode, lo, hi, g_lo, g_hi, shared=False, tol: Toler
     finite = [abs(x) for x in (g_lo, g_hi) if np.isfinite(x)]
     atol = rtol * max(finite + [1.0])
     low, ex1, n1, st1 = _search(cells, g_lo, g_hi, False, atol, max_cells, tol)
-    if np.isnan(low):
-        return CompetitorTorques(mode.letters, np.nan, np.nan, True, ex1, None if ex1 else "cell budget exhausted", n1)
+    if low == np.inf:  # proved: no cell admits an effort of the interval
+        return CompetitorTorques(mode.letters, np.nan, np.nan, True, True, None, n1)
     # the largest possibly-feasible effort, searched above the smallest one only
     up, ex2, n2, st2 = _search(cells, -g_hi, -low, True, atol, max_cells, tol)
-    if np.isnan(up):  # nothing above low within atol: the set is (numerically) the point low
+    if up == -np.inf:  # nothing above low within atol: the set is (numerically) the point low
         up = low
     exact = ex1 and ex2
     reason = None

@@ -7,8 +7,11 @@ Coulomb inequalities without rounding.  The strict inequalities of the paper
 (eq. 15 for breaking contacts, the sign in eq. 16 for sliding ones) are tested
 strictly and the non-strict ones (eq. 28) non-strictly, so
 :func:`exact_feasible_modes` is the exact feasible set of the scene as stated.
-It follows :func:`mechanics.feasibility.check_mode` step by step and returns the
-same :class:`~mechanics.numerics.Status` values, with no tolerance at all.
+It follows :func:`qsplan.mechanics.modes.reference.check_mode` step by step and
+returns the same :class:`~qsplan.mechanics.numerics.Status` values, with no tolerance
+at all.  It re-derives eqs. (13)-(28) on purpose, sharing no arithmetic with
+:mod:`qsplan.mechanics.modes.kinematics` and :mod:`qsplan.mechanics.modes.equilibrium`,
+so that it is an independent reference (only the scene check is shared).
 
 It is slow (denominators grow to hundreds of digits) and meant for small scenes
 (``n_c <= 6``): tests and the stability study (``benchmarks/bench_stability.py``).
@@ -70,7 +73,7 @@ class ExactCheck:
     ----------
     mode : ContactMode
     status : str
-        A :class:`~mechanics.numerics.Status` value.
+        A :class:`~qsplan.mechanics.numerics.Status` value.
     qdot : tuple of Fraction or None
     c_n, c_t : tuple of Fraction or None
         Forces when the equilibrium stage was reached.
@@ -168,7 +171,7 @@ def _check(X: _Exact, mode: ContactMode) -> ExactCheck:
 
 
 def exact_check_mode(scene: Scene, mode: ContactMode) -> ExactCheck:
-    """Exact counterpart of :func:`mechanics.feasibility.check_mode` (eqs. 13-28), no tolerances.
+    """Exact counterpart of :func:`~qsplan.mechanics.modes.reference.check_mode` (eqs. 13-28), no tolerances.
 
     Parameters
     ----------
@@ -181,7 +184,7 @@ def exact_check_mode(scene: Scene, mode: ContactMode) -> ExactCheck:
     -------
     ExactCheck
     """
-    from qsplan.mechanics.solver.batch import check_mode_fits
+    from qsplan.mechanics.modes.kinematics import check_mode_fits
 
     return _check(_Exact(scene), check_mode_fits(scene, mode))
 

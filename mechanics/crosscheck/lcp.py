@@ -1,9 +1,9 @@
 """One feasible contact mode from a linear complementarity problem (after Pang, Trinkle & Lo [26]).
 
-The enumerative solver (:mod:`mechanics.solver`) tests every mode; this module
+The enumerative solver (:mod:`qsplan.mechanics.solver`) tests every mode; this module
 finds *one* solution of the quasistatic model (eqs. 2-11) directly, as an LCP
 solved by Lemke's method (:mod:`mechanics.lemke`), and maps it back to a contact
-mode that :func:`mechanics.feasibility.check_mode` then verifies.
+mode that :func:`~qsplan.mechanics.modes.reference.check_mode` then verifies.
 
 Derivation
 ----------
@@ -65,7 +65,7 @@ B; else ``v_t != 0``: S; else R) with the tolerances of
 :class:`~mechanics.numerics.Tolerances`.  A solution whose mode does not have
 ``2 n_R + n_S = 3 + |tau_I|`` constraints (eq. 29) is degenerate in the paper's
 sense (a contact with zero speed and zero force); otherwise the mode is
-re-solved and verified by :func:`~mechanics.feasibility.check_mode`, which also
+re-solved and verified by :func:`~qsplan.mechanics.modes.reference.check_mode`, which also
 gives the full-model residuals (eqs. 2-11).
 """
 
@@ -75,7 +75,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from qsplan.mechanics.modes.reference import check_mode, velocity_scale
+from qsplan.mechanics.modes.kinematics import velocity_scale
+from qsplan.mechanics.modes.reference import check_mode
 from qsplan.mechanics.crosscheck.lemke import DEFAULT_MAX_PIVOTS, LemkeStatus, lemke
 from qsplan.mechanics.modes.contact_mode import ContactMode
 from qsplan.mechanics.numerics import DEFAULT_TOLERANCES, Status, Tolerances
@@ -105,13 +106,13 @@ class LcpResult:
     mode : ContactMode or None
         The verified feasible mode (``status == "solved"``).
     solution : ModeSolution or None
-        Its solution from :func:`~mechanics.feasibility.check_mode`, with residuals.
+        Its solution from :func:`~qsplan.mechanics.modes.reference.check_mode`, with residuals.
     status : str
         An :class:`LcpStatus` value.
     letters : str or None
         The mode read off the LCP solution, also when it failed verification.
     check_status : str or None
-        The :class:`~mechanics.numerics.Status` that check_mode gave ``letters``.
+        The :class:`~qsplan.mechanics.numerics.Status` that check_mode gave ``letters``.
     pivots : int
         Lemke pivots.
     """
@@ -174,7 +175,7 @@ def solve_lcp(scene: Scene, tol: Tolerances = DEFAULT_TOLERANCES, max_pivots: in
     scene : Scene
     tol : Tolerances
         Velocity tolerance for reading the mode off the solution, and the
-        tolerances of the verifying :func:`~mechanics.feasibility.check_mode`.
+        tolerances of the verifying :func:`~qsplan.mechanics.modes.reference.check_mode`.
     max_pivots : int, optional
         Lemke's pivot cap (default ``50 n + 100`` for ``n = 2 (3 + |tau_I|) + 4 n_c``).
 

@@ -1,6 +1,6 @@
 """A second, independent test of the force side of one mode's feasibility, by linear programming.
 
-The solver (:mod:`mechanics.solver`, :mod:`mechanics.feasibility`) decides the
+The solver (:mod:`qsplan.mechanics.solver`, :mod:`qsplan.mechanics.modes.reference`) decides the
 force side of a mode by eliminating the sliding tangential forces (eq. 17),
 solving the square system ``Q_AI c_A = [-g_obj; tau_I - g_man_I]`` (eq. 26)
 and checking ``B_A c_A >= 0`` (eq. 28).  :func:`lp_mode_feasible` asks the
@@ -135,11 +135,8 @@ def lp_mode_feasible(scene: Scene, mode, xi, tol: float = LP_TOL) -> LPCheck:
     -----
     eqs. (2)-(3), (7)-(11), (17); the reduced form the solver uses is eqs. (26)-(28).
     """
-    if not isinstance(mode, ContactMode):
-        mode = mode_from_letters(mode)
     n_c = scene.n_contacts
-    if mode.n_contacts != n_c:
-        raise ModeError(f"mode: expected {n_c} letters (one per contact); got {mode.letters!r}")
+    mode = mode_from_letters(mode, n_c)
     xi = _check_xi(xi, mode)
     if not (np.isfinite(tol) and tol >= 0):
         raise QsplanError(f"tol: expected a nonnegative finite number; got {tol!r}")

@@ -49,6 +49,8 @@ import numpy as np
 from shapely.geometry import Polygon
 
 from qsplan.mechanics.model.contact import point_wrench, wrench_matrices
+from qsplan.mechanics.model.fields import check_keys, number, vector
+from qsplan.mechanics.model.friction import check_friction
 from qsplan.mechanics.errors import SceneError
 from qsplan.mechanics.model.geometry import CONTACT_TOL, FoundContact, check_polygon, find_contacts
 from qsplan.mechanics.model.manipulator import (
@@ -63,7 +65,6 @@ from qsplan.mechanics.model.manipulator import (
     make_manipulator,
 )
 from qsplan.mechanics.model.scene import Scene, make_scene
-from qsplan.mechanics.model.scene_io import _check_keys, _number, _vector
 
 __all__ = [
     "GeometricScene",
@@ -140,7 +141,7 @@ def _frozen(a) -> np.ndarray:
 
 
 def _nonnegative(value, field: str, what: str) -> float:
-    x = _number(value, field)
+    x = number(value, field)
     if x < 0:
         raise SceneError(f"{field}: expected a nonnegative {what}; got {x}")
     return x
@@ -149,14 +150,14 @@ def _nonnegative(value, field: str, what: str) -> float:
 def _polygon(value, field: str) -> np.ndarray:
     if not isinstance(value, (list, tuple)):
         raise SceneError(f"{field}: expected a list of [x, y] vertices; got {value!r}")
-    return check_polygon(np.array([_vector(p, f"{field}[{i}]", 2) for i, p in enumerate(value)]).reshape(-1, 2), field)
+    return check_polygon(np.array([vector(p, f"{field}[{i}]", 2) for i, p in enumerate(value)]).reshape(-1, 2), field)
 
 
 def _table(doc, key, allowed, field=None) -> dict:
     field = field or key
     if key not in doc:
         raise SceneError(f"{field}: missing")
-    _check_keys(doc[key], allowed, field)
+    check_keys(doc[key], allowed, field)
     return doc[key]
 
 
@@ -168,7 +169,7 @@ def _required(d, key, field):
 
 def _parse_joint(jd, i, names):
     f = f"joints[{i}]"
-    _check_keys(jd, _JOINT_KEYS, f)
+    check_keys(jd, _JOINT_KEYS, f)
     name = jd.get("name", f"j{i}")
     if not isinstance(name, str) or not name:
         raise SceneError(f"{f}.name: expected a non-empty string; got {name!r}")
@@ -186,19 +187,19 @@ def _parse_joint(jd, i, names):
         parent_index = names.index(parent)
     else:
         raise SceneError(f"{f}.parent: expected -1 (the base) or the name of an earlier joint {names}; got {parent!r}")
-    origin = _vector(_required(jd, "origin", f), f"{f}.origin", 3)
-    q = _number(jd.get("q", 0.0), f"{f}.q")
+    origin = vector(_required(jd, "origin", f), f"{f}.origin", 3)
+    q = number(jd.get("q", 0.0), f"{f}.q")
     control = _required(jd, "control", f)
     if control not in ("velocity", "effort"):
         raise SceneError(f"{f}.control: expected 'velocity' or 'effort'; got {control!r}")
     if control not in jd:
         raise SceneError(f"{f}.{control}: missing (a {control}-controlled joint needs its {control})")
-    inputs = {key: _number(jd[key], f"{f}.{key}") if key in jd else np.nan for key in ("velocity", "effort")}
+    inputs = {key: number(jd[key], f"{f}.{key}") if key in jd else np.nan for key in ("velocity", "effort")}
     link = jd.get("link", {})
-    _check_keys(link, _LINK_KEYS, f"{f}.link")
+    check_keys(link, _LINK_KEYS, f"{f}.link")
     shape = _polygon(link["polygon"], f"{f}.link.polygon") if "polygon" in link else None
     mass = _nonnegative(link.get("mass", 0.0), f"{f}.link.mass", "mass (kg)")
-    com = _vector(link.get("com", [0.0, 0.0]), f"{f}.link.com", 2)
+    com = vector(link.get("com", [0.0, 0.0]), f"{f}.link.com", 2)
     joint = make_joint(name, kind, parent_index, origin, mass, com, shape, index=i)
     return joint, q, control == "effort", inputs["velocity"], inputs["effort"]
 
@@ -212,21 +213,21 @@ def geometric_scene_from_dict(spec: dict) -> GeometricScene:
         Naming the field with its path, e.g. ``joints[1].type: expected
         'revolute' or 'prismatic'; got 'ball'``; unknown fields are named too.
     """
-    _check_keys(spec, _TOP_KEYS, "scene")
+    check_keys(spec, _TOP_KEYS, "scene")
     for key in ("name", "description"):
         if key in spec and not isinstance(spec[key], str):
             raise SceneError(f"{key}: expected a string; got {spec[key]!r}")
     gravity = _nonnegative(spec.get("gravity", 9.81), "gravity", "magnitude (m/s^2, acting along -y)")
-    tol = _number(spec.get("contact_tolerance", CONTACT_TOL), "contact_tolerance")
+    tol = number(spec.get("contact_tolerance", CONTACT_TOL), "contact_tolerance")
     if tol <= 0:
         raise SceneError(f"contact_tolerance: expected a positive distance (m); got {tol}")
-    mu = _nonnegative(spec.get("mu", 0.0), "mu", "friction coefficient")
+    mu = check_friction(number(spec.get("mu", 0.0), "mu"), "mu")
 
     wp = _table(spec, "workpiece", _WORKPIECE_KEYS)
     polygon = _polygon(_required(wp, "polygon", "workpiece"), "workpiece.polygon")
-    com = _vector(_required(wp, "com", "workpiece"), "workpiece.com", 2)
+    com = vector(_required(wp, "com", "workpiece"), "workpiece.com", 2)
     mass = _nonnegative(_required(wp, "mass", "workpiece"), "workpiece.mass", "mass (kg)")
-    extra = _vector(wp.get("extra_wrench", [0.0, 0.0, 0.0]), "workpiece.extra_wrench", 3)
+    extra = vector(wp.get("extra_wrench", [0.0, 0.0, 0.0]), "workpiece.extra_wrench", 3)
     palm = None
     if "palm" in spec:
         palm = _polygon(_required(_table(spec, "palm", _PALM_KEYS), "polygon", "palm"), "palm.polygon")
@@ -251,14 +252,14 @@ def geometric_scene_from_dict(spec: dict) -> GeometricScene:
     contact_mu, seen = [], {}
     for k, od in enumerate(overrides):
         f = f"contact_mu[{k}]"
-        _check_keys(od, _CONTACT_MU_KEYS, f)
+        check_keys(od, _CONTACT_MU_KEYS, f)
         index = _required(od, "index", f)
         if isinstance(index, bool) or not isinstance(index, int) or index < 0:
             raise SceneError(f"{f}.index: expected a nonnegative integer contact index; got {index!r}")
         if index in seen:
             raise SceneError(f"{f}.index: contact {index} already overridden by contact_mu[{seen[index]}]")
         seen[index] = k
-        contact_mu.append((index, _nonnegative(_required(od, "mu", f), f"{f}.mu", "friction coefficient")))
+        contact_mu.append((index, check_friction(number(_required(od, "mu", f), f"{f}.mu"), f"{f}.mu")))
 
     return GeometricScene(
         workpiece=_frozen(polygon),

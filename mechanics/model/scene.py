@@ -18,6 +18,7 @@ import numpy as np
 
 from qsplan.mechanics.model.contact import shift_wrenches
 from qsplan.mechanics.errors import SceneError
+from qsplan.mechanics.model.friction import check_friction
 
 __all__ = ["Scene", "make_scene", "check_finite_array"]
 
@@ -214,10 +215,7 @@ def make_scene(
     Jn = check_finite_array(Jn, "Jn", (n_c, None))
     n_j = Jn.shape[1]
     Jt = check_finite_array(Jt, "Jt", (n_c, n_j))
-    mu = check_finite_array(mu, "mu", (n_c,))
-    if np.any(mu < 0):
-        i = int(np.flatnonzero(mu < 0)[0])
-        raise SceneError(f"contacts[{i}].mu: expected a nonnegative friction coefficient; got {mu[i]}")
+    mu = check_friction(check_finite_array(mu, "mu", (n_c,)), "mu", element="contacts[{i}].mu")
     g_obj = check_finite_array(g_obj, "g_obj", (3,))
     g_man = np.zeros(n_j) if g_man is None else check_finite_array(g_man, "g_man", (n_j,))
     if effort_controlled is None:

@@ -13,44 +13,24 @@ scene with no ``joints`` gives each contact ``"velocity": [v_n, v_t]`` (the
 manipulator contact point's velocity ``J_i thetadot`` in the contact frame) and
 is solved as noncompliant.  Optional extras: ``"name"`` on joints and contacts,
 ``"name"``/``"description"`` at the top.  A document with a ``"workpiece"``
-table is in the geometric form (:mod:`mechanics.geometric_scene`).
+table is in the geometric form (:mod:`qsplan.mechanics.model.geometric_scene`).
 """
 
 from __future__ import annotations
 
-import json
-import math
-import tomllib
-from pathlib import Path
-
 import numpy as np
 
 from qsplan.mechanics.model.contact import wrench_matrices
+from qsplan.mechanics.model.fields import check_keys, number, read_document, vector
+from qsplan.mechanics.model.friction import check_friction
 from qsplan.mechanics.errors import SceneError
 from qsplan.mechanics.model.scene import Scene, make_scene
 
-__all__ = ["load_scene", "scene_from_dict", "read_document"]
+__all__ = ["load_scene", "scene_from_dict", "check_mu_override"]
 
 _TOP_KEYS = {"g_obj", "joints", "contacts", "name", "description"}
 _JOINT_KEYS = {"control", "velocity", "effort", "g_man", "name"}
 _CONTACT_KEYS = {"wn", "wt", "r", "n", "mu", "jn", "jt", "velocity", "name"}
-
-
-def read_document(path) -> dict:
-    """Read a TOML (``.toml``) or JSON (anything else) file into a dict; errors name the file."""
-    path = Path(path)
-    try:
-        text = path.read_text(encoding="utf-8")
-    except OSError as exc:
-        raise SceneError(f"{path}: cannot read scene file ({exc.strerror})") from None
-    try:
-        doc = tomllib.loads(text) if path.suffix.lower() == ".toml" else json.loads(text)
-    except (tomllib.TOMLDecodeError, json.JSONDecodeError) as exc:
-        kind = "TOML" if path.suffix.lower() == ".toml" else "JSON"
-        raise SceneError(f"{path}: invalid {kind}: {exc}") from None
-    if not isinstance(doc, dict):
-        raise SceneError(f"{path}: expected an object/table at the top level; got {type(doc).__name__}")
-    return doc
 
 
 def load_scene(path, mu=None) -> Scene:
@@ -66,37 +46,11 @@ def load_scene(path, mu=None) -> Scene:
     return scene_from_dict(read_document(path), mu=mu)
 
 
-def _number(value, field: str) -> float:
-    if isinstance(value, bool) or not isinstance(value, (int, float)):
-        raise SceneError(f"{field}: expected a number; got {value!r}")
-    if not math.isfinite(value):
-        raise SceneError(f"{field}: expected a finite number; got {value!r}")
-    return float(value)
-
-
-def _vector(value, field: str, length: int | None) -> np.ndarray:
-    if not isinstance(value, (list, tuple)):
-        raise SceneError(f"{field}: expected a list of {length if length is not None else 'some'} numbers; got {value!r}")
-    if length is not None and len(value) != length:
-        raise SceneError(f"{field}: expected {length} numbers; got {len(value)}")
-    return np.array([_number(v, f"{field}[{i}]") for i, v in enumerate(value)], dtype=float)
-
-
-def _check_keys(d, allowed, field):
-    if not isinstance(d, dict):
-        raise SceneError(f"{field}: expected an object/table; got {d!r}")
-    unknown = sorted(set(d) - allowed)
-    if unknown:
-        raise SceneError(f"{field}: unknown field(s) {', '.join(map(repr, unknown))}; expected some of {sorted(allowed)}")
-
-
 def check_mu_override(mu, n_c: int) -> np.ndarray:
     """Broadcast a friction override (one value or one per contact) to shape (n_c,)."""
-    vals = np.atleast_1d(np.asarray(mu, dtype=float))
+    vals = np.atleast_1d(check_friction(mu, "mu"))
     if vals.size not in (1, n_c):
-        raise SceneError(f"--mu: expected 1 or {n_c} values (one per contact); got {vals.size}")
-    if not np.all(np.isfinite(vals)) or np.any(vals < 0):
-        raise SceneError(f"--mu: expected nonnegative finite friction coefficients; got {vals.tolist()}")
+        raise SceneError(f"mu: expected 1 or {n_c} values (one per contact); got {vals.size}")
     return np.broadcast_to(vals, (n_c,)).copy()
 
 
@@ -117,11 +71,11 @@ def scene_from_dict(doc: dict, mu=None) -> Scene:
 
         scene = scene_from_geometry(doc)
         return scene if mu is None else scene.with_mu(check_mu_override(mu, scene.n_contacts))
-    _check_keys(doc, _TOP_KEYS, "scene")
+    check_keys(doc, _TOP_KEYS, "scene")
     for key in ("g_obj", "contacts"):
         if key not in doc:
             raise SceneError(f"{key}: missing (required in a raw scene)")
-    g_obj = _vector(doc["g_obj"], "g_obj", 3)
+    g_obj = vector(doc["g_obj"], "g_obj", 3)
     contacts = doc["contacts"]
     if not isinstance(contacts, list) or not contacts:
         raise SceneError(f"contacts: expected a non-empty list of contacts; got {contacts!r}")
@@ -139,7 +93,7 @@ def scene_from_dict(doc: dict, mu=None) -> Scene:
     jnames = []
     for i, j in enumerate(joints):
         f = f"joints[{i}]"
-        _check_keys(j, _JOINT_KEYS, f)
+        check_keys(j, _JOINT_KEYS, f)
         control = j.get("control")
         if control not in ("velocity", "effort"):
             raise SceneError(f"{f}.control: expected 'velocity' or 'effort'; got {control!r}")
@@ -148,8 +102,8 @@ def scene_from_dict(doc: dict, mu=None) -> Scene:
             raise SceneError(f"{f}.{control}: missing (a {control}-controlled joint needs its {control})")
         for key, arr in (("velocity", jvel), ("effort", jeff)):
             if key in j:
-                arr[i] = _number(j[key], f"{f}.{key}")
-        g_man[i] = _number(j.get("g_man", 0.0), f"{f}.g_man")
+                arr[i] = number(j[key], f"{f}.{key}")
+        g_man[i] = number(j.get("g_man", 0.0), f"{f}.g_man")
         jnames.append(str(j.get("name", f"j{i}")))
 
     Wn = np.zeros((3, n_c))
@@ -160,15 +114,15 @@ def scene_from_dict(doc: dict, mu=None) -> Scene:
     cnames = []
     for i, c in enumerate(contacts):
         f = f"contacts[{i}]"
-        _check_keys(c, _CONTACT_KEYS, f)
+        check_keys(c, _CONTACT_KEYS, f)
         if "wn" in c or "wt" in c:
             if "r" in c or "n" in c:
                 raise SceneError(f"{f}: give either wn/wt or r/n, not both")
             for key in ("wn", "wt"):
                 if key not in c:
                     raise SceneError(f"{f}.{key}: missing")
-            Wn[:, i] = _vector(c["wn"], f"{f}.wn", 3)
-            Wt[:, i] = _vector(c["wt"], f"{f}.wt", 3)
+            Wn[:, i] = vector(c["wn"], f"{f}.wn", 3)
+            Wt[:, i] = vector(c["wt"], f"{f}.wt", 3)
             for key, w in (("wn", Wn[:, i]), ("wt", Wt[:, i])):
                 if np.hypot(w[0], w[1]) < 1e-12:
                     raise SceneError(f"{f}.{key}: the force part (first two numbers) is zero; expected a unit direction")
@@ -176,8 +130,8 @@ def scene_from_dict(doc: dict, mu=None) -> Scene:
             for key in ("r", "n"):
                 if key not in c:
                     raise SceneError(f"{f}.{key}: missing")
-            r = _vector(c["r"], f"{f}.r", 2)
-            n = _vector(c["n"], f"{f}.n", 2)
+            r = vector(c["r"], f"{f}.r", 2)
+            n = vector(c["n"], f"{f}.n", 2)
             if np.hypot(*n) < 1e-12:
                 raise SceneError(f"{f}.n: zero normal; expected a nonzero direction into the workpiece")
             wn, wt = wrench_matrices(r[None], n[None])
@@ -185,10 +139,7 @@ def scene_from_dict(doc: dict, mu=None) -> Scene:
         else:
             raise SceneError(f"{f}: missing the contact geometry (wn and wt, or r and n)")
         if "mu" in c:
-            m = _number(c["mu"], f"{f}.mu")
-            if m < 0:
-                raise SceneError(f"{f}.mu: expected a nonnegative friction coefficient; got {m}")
-            mus[i] = m
+            mus[i] = check_friction(number(c["mu"], f"{f}.mu"), f"{f}.mu")
         elif mu is None:
             raise SceneError(f"{f}.mu: missing (give it in the scene or override with --mu)")
         if has_joints:
@@ -197,14 +148,14 @@ def scene_from_dict(doc: dict, mu=None) -> Scene:
             for key, J in (("jn", Jn), ("jt", Jt)):
                 if key not in c:
                     raise SceneError(f"{f}.{key}: missing (one number per joint, {n_j} joints)")
-                J[i] = _vector(c[key], f"{f}.{key}", n_j)
+                J[i] = vector(c[key], f"{f}.{key}", n_j)
         else:
             for key in ("jn", "jt"):
                 if key in c:
                     raise SceneError(f"{f}.{key}: Jacobian rows given but the scene has no joints")
             if "velocity" not in c:
                 raise SceneError(f"{f}.velocity: missing (a scene without joints gives [v_n, v_t] per contact)")
-            Jn[i, 0], Jt[i, 0] = _vector(c["velocity"], f"{f}.velocity", 2)
+            Jn[i, 0], Jt[i, 0] = vector(c["velocity"], f"{f}.velocity", 2)
         cnames.append(str(c.get("name", f"c{i + 1}")))
     if mu is not None:
         mus = check_mu_override(mu, n_c)

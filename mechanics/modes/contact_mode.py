@@ -15,6 +15,7 @@ R2S1=4, R2S3=5, R3S1=6, R3S2=7 (Fig. 6's numbering).  Their number is eq. (49).
 from __future__ import annotations
 
 from dataclasses import dataclass
+from enum import IntEnum
 from itertools import combinations
 from math import comb
 
@@ -23,6 +24,10 @@ import numpy as np
 from qsplan.mechanics.errors import ModeError
 
 __all__ = [
+    "Letter",
+    "LETTERS",
+    "letters_to_codes",
+    "combinations_array",
     "random_mode",
     "ContactMode",
     "mode_from_letters",
@@ -33,6 +38,18 @@ __all__ = [
     "codes_to_letters",
     "mode_order_key",
 ]
+
+
+class Letter(IntEnum):
+    """The code of each interaction in letter-code arrays (``uint8``, one per contact)."""
+
+    B = 0  #: breaking
+    R = 1  #: rolling
+    S = 2  #: sliding
+
+
+#: ``LETTERS[code]`` is the letter of a code (the names of :class:`Letter` in code order).
+LETTERS = "".join(c.name for c in Letter)
 
 
 @dataclass(frozen=True, slots=True)
@@ -49,7 +66,7 @@ class ContactMode:
     letters: str
 
     def __post_init__(self):
-        if not self.letters or set(self.letters) - set("RSB"):
+        if not self.letters or set(self.letters) - set(LETTERS):
             raise ModeError(f"mode: expected letters R, S or B (one per contact); got {self.letters!r}")
 
     @property
@@ -99,11 +116,25 @@ class ContactMode:
         return self.letters
 
 
-def mode_from_letters(letters: str, n_contacts: int | None = None) -> ContactMode:
-    """Parse ``"RBS"`` into a :class:`ContactMode`, checking the length if given."""
-    mode = ContactMode(str(letters).upper())
+def mode_from_letters(letters, n_contacts: int | None = None, dof: int | None = None) -> ContactMode:
+    """Parse ``"RBS"`` (or pass a :class:`ContactMode` through), checking that it fits a scene.
+
+    The one "mode fits the scene" check: one letter per contact when ``n_contacts``
+    is given, and ``2 n_R + n_S = dof`` (eq. 29, ``dof = 3 + |tau_I|``) when ``dof`` is.
+
+    Raises
+    ------
+    ModeError
+        Naming the mode, what was expected and what it has.
+    """
+    mode = letters if isinstance(letters, ContactMode) else ContactMode(str(letters).upper())
     if n_contacts is not None and mode.n_contacts != n_contacts:
-        raise ModeError(f"mode: expected {n_contacts} letters (one per contact); got {letters!r}")
+        raise ModeError(f"mode: expected {n_contacts} letters (one per contact); got {mode.letters!r}")
+    if dof is not None and mode.n_constraints != dof:
+        raise ModeError(
+            f"mode {mode.letters}: has {mode.n_constraints} applicable constraints but the scene's partition "
+            f"needs {dof} (eq. 29 with |tau_I| = {dof - 3})"
+        )
     return mode
 
 
@@ -160,7 +191,7 @@ def enumerate_modes(n_contacts: int, dof: int) -> list[ContactMode]:
     return modes
 
 
-def _combinations(n: int, k: int) -> np.ndarray:
+def combinations_array(n: int, k: int) -> np.ndarray:
     """All k-subsets of range(n) in lexicographic order, shape (C(n, k), k)."""
     if k == 0:
         return np.zeros((1, 0), dtype=np.intp)
@@ -185,8 +216,8 @@ def iter_mode_batches(n_contacts: int, dof: int, batch: int = 8192):
         ns = dof - 2 * nr
         if nr + ns > n_contacts:
             continue
-        Rs = _combinations(n_contacts, nr)
-        Sc = _combinations(n_contacts - nr, ns)  # positions within the complement of R
+        Rs = combinations_array(n_contacts, nr)
+        Sc = combinations_array(n_contacts - nr, ns)  # positions within the complement of R
         per_r = Sc.shape[0]
         if per_r <= batch:  # several rolling sets per batch
             pieces = ((slice(lo, lo + batch // per_r), slice(None)) for lo in range(0, Rs.shape[0], batch // per_r))
@@ -218,8 +249,13 @@ def mode_index_array(n_contacts: int, dof: int) -> np.ndarray:
 
 
 def codes_to_letters(codes) -> str:
-    """One row of a letter-code array (0/1/2) as mode letters (``B``/``R``/``S``)."""
-    return "".join("BRS"[int(c)] for c in codes)
+    """One row of a letter-code array (:class:`Letter`: 0/1/2) as mode letters (``B``/``R``/``S``)."""
+    return "".join(LETTERS[int(c)] for c in codes)
+
+
+def letters_to_codes(letters: str) -> np.ndarray:
+    """Mode letters (``B``/``R``/``S``) as a letter-code row (:class:`Letter`), shape (n_c,), uint8."""
+    return np.array([LETTERS.index(c) for c in letters], dtype=np.uint8)
 
 
 def mode_order_key(letters: str) -> tuple:

@@ -21,7 +21,7 @@ from itertools import combinations, product
 import numpy as np
 
 from qsplan.mechanics.errors import ModeError
-from qsplan.mechanics.modes.contact_mode import ContactMode, enumerate_modes
+from qsplan.mechanics.modes.contact_mode import ContactMode, enumerate_modes, mode_from_letters
 from qsplan.mechanics.numerics import DEFAULT_TOLERANCES, Tolerances, hadamard_ratio, rcond
 from qsplan.mechanics.model.scene import Scene
 
@@ -79,8 +79,7 @@ def effort_partitions(scene: Scene, mode: ContactMode, xi=None, tol: Tolerances 
     list of Partition
         Empty when the mode violates (29)-(31) or no joint set satisfies (32).
     """
-    if mode.n_contacts != scene.n_contacts:
-        raise ModeError(f"mode: expected {scene.n_contacts} letters; got {mode.letters!r}")
+    mode = mode_from_letters(mode, scene.n_contacts)
     k = mode.n_constraints
     m = k - 3
     if m < 0 or m > scene.n_joints:  # eq. (29)

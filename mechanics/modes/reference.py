@@ -5,8 +5,11 @@ matrices of eqs. (14), (19), (22), the partitions ``P_AI`` (eq. 23) and
 ``Q_AI`` (eq. 26) for the scene's control-mode partition, and tests the
 kinematics (24), the breaking contacts (25), the sliding directions (16),
 equilibrium (26)-(27) and Coulomb friction (28) in that order.  It is the
-readable reference the vectorized solver (:mod:`mechanics.solver`) is tested
-against; it is not fast.
+readable reference the vectorized solver (:mod:`qsplan.mechanics.solver`) is tested
+against; it is not fast.  It re-derives eqs. (12)-(28) on purpose, independently of
+:mod:`qsplan.mechanics.modes.kinematics` and :mod:`qsplan.mechanics.modes.equilibrium`,
+so that the tests compare two implementations (it shares only the velocity scale of
+the tolerances).
 """
 
 from __future__ import annotations
@@ -15,18 +18,18 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from qsplan.mechanics.errors import ModeError
-from qsplan.mechanics.modes.contact_mode import ContactMode
+from qsplan.mechanics.modes.contact_mode import ContactMode, mode_from_letters
+from qsplan.mechanics.modes.kinematics import velocity_scale
 from qsplan.mechanics.numerics import DEFAULT_TOLERANCES, Status, Tolerances, hadamard_ratio
 from qsplan.mechanics.model.scene import Scene
 from qsplan.mechanics.modes.solution import ModeSolution, model_residuals
 
-__all__ = ["ModeCheck", "check_mode", "selection_matrix", "velocity_scale"]
+__all__ = ["ModeCheck", "check_mode", "selection_matrix"]
 
 
 @dataclass(frozen=True, slots=True, eq=False)
 class ModeCheck:
-    """Outcome of testing one mode: a :class:`~mechanics.numerics.Status` and, when
+    """Outcome of testing one mode: a :class:`~qsplan.mechanics.numerics.Status` and, when
     feasible, the solution."""
 
     mode: ContactMode
@@ -50,14 +53,6 @@ def selection_matrix(indices, n: int) -> np.ndarray:
     return E
 
 
-def velocity_scale(scene: Scene) -> float:
-    """Largest driving speed ``|J_n, J_t thetadot_V|`` at the contacts (m/s); 1 if all are zero."""
-    V = scene.velocity_joints
-    drive = scene.J[:, V] @ scene.joint_velocity[V]
-    s = float(np.max(np.abs(drive))) if drive.size else 0.0
-    return s if s > 0 else 1.0
-
-
 def check_mode(scene: Scene, mode: ContactMode, tol: Tolerances = DEFAULT_TOLERANCES) -> ModeCheck:
     """Test one contact mode under the scene's control-mode partition (eqs. 13-28).
 
@@ -74,14 +69,8 @@ def check_mode(scene: Scene, mode: ContactMode, tol: Tolerances = DEFAULT_TOLERA
         ``status`` is the first check that failed, or ``feasible`` with the solution.
     """
     n_c, n_j = scene.n_contacts, scene.n_joints
-    if mode.n_contacts != n_c:
-        raise ModeError(f"mode: expected {n_c} letters; got {mode.letters!r}")
+    mode = mode_from_letters(mode, n_c, scene.dof)
     k = mode.n_constraints
-    if k != scene.dof:
-        raise ModeError(
-            f"mode {mode.letters}: has {k} applicable constraints but the scene's partition needs "
-            f"3 + {scene.dof - 3} (eq. 29 with |tau_I| = {scene.dof - 3})"
-        )
     ER = selection_matrix(mode.rolling, n_c)
     ES = selection_matrix(mode.sliding, n_c)
     EB = selection_matrix(mode.breaking, n_c)

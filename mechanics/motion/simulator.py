@@ -1,18 +1,18 @@
 """Finite quasistatic motions: stepping through contact-mode switches (Section 5.1).
 
 The model of Sections 3-4 predicts one instant.  :func:`simulate` integrates it:
-the configuration ``x`` of a :class:`MotionSystem` (workpiece pose, joint
+the configuration ``x`` of a :class:`~qsplan.mechanics.motion.system.MotionSystem` (workpiece pose, joint
 positions, ...) evolves under the velocity inputs while a contact mode holds,
 and the mode is re-selected at *events*, located by root finding so that they
 do not depend on the integration step:
 
-* the active mode's conditions (:func:`mechanics.events.mode_values`): Coulomb
+* the active mode's conditions (:func:`qsplan.mechanics.motion.conditions.mode_values`): Coulomb
   slacks ``B_A c_A`` (eq. 28), separation speeds of breaking contacts (eq. 25),
   sliding speeds (sign of eq. 16), and the utility of ``P_AI``, ``Q_AI`` (eq. 32);
 * gaps of potential contacts not in contact (a vertex meeting an edge): contacts appear;
 * the system's own limits (e.g. a support reaching the rod's centre of mass): the run stops.
 
-Friction is per contact (:class:`Friction`): the static coefficient while a
+Friction is per contact (:class:`~qsplan.mechanics.motion.system.Friction`): the static coefficient while a
 contact rolls (sticks), the kinetic one while it slides, switched at events.
 
 Mode selection rule.  Keep the current mode while it stays feasible.  At an
@@ -33,182 +33,21 @@ rod's 2S mode with equal coefficients).  Switches closer than
 from __future__ import annotations
 
 from dataclasses import dataclass, replace
-from typing import Callable, Protocol, runtime_checkable
+from typing import Callable
 
 import numpy as np
 
 from qsplan.mechanics.errors import QsplanError
 from qsplan.mechanics.motion.events import Event, gaps_of, integrate_mode, limit_name, limits_of, persists
+from qsplan.mechanics.motion.system import MotionSystem
+from qsplan.mechanics.motion.trajectory import Motion, Segment, Stop, mode_label
 from qsplan.mechanics.modes.reference import check_mode
 from qsplan.mechanics.modes.contact_mode import ContactMode, count_modes, enumerate_modes
 from qsplan.mechanics.numerics import DEFAULT_TOLERANCES, Tolerances
-from qsplan.mechanics.model.scene import Scene, check_finite_array
+from qsplan.mechanics.model.scene import check_finite_array
 from qsplan.mechanics.modes.solution import ModeSolution
 
-__all__ = [
-    "Friction",
-    "make_friction",
-    "MotionSystem",
-    "MotionOptions",
-    "Event",
-    "Segment",
-    "Stop",
-    "Motion",
-    "simulate",
-    "pose_rate",
-    "rigid_body_rates",
-    "FrozenScene",
-    "frozen_scene_system",
-    "STOP_KINDS",
-]
-
-#: Why a motion stopped before its duration.
-STOP_KINDS = ("ambiguous", "jam", "no_persistent_mode", "zeno", "limit", "max_switches")
-
-
-@dataclass(frozen=True, slots=True, eq=False)
-class Friction:
-    """Static and kinetic Coulomb coefficients of every potential contact (eq. 8).
-
-    Attributes
-    ----------
-    static : ndarray, shape (n_p,)
-        ``mu_R``: used while the contact rolls (sticks) and while it breaks.
-    kinetic : ndarray, shape (n_p,)
-        ``mu_S``: used while it slides; ``0 <= kinetic <= static``.
-    """
-
-    static: np.ndarray
-    kinetic: np.ndarray
-
-    def for_mode(self, mode: ContactMode, contacts) -> np.ndarray:
-        """Coefficients of the contacts ``contacts`` (indices, shape (n_c,)) under ``mode``."""
-        idx = np.asarray(contacts, dtype=int)
-        sliding = np.array([c == "S" for c in mode.letters], dtype=bool)
-        mu = np.where(sliding, self.kinetic[idx], self.static[idx])
-        mu.setflags(write=False)
-        return mu
-
-
-def make_friction(static, kinetic) -> Friction:
-    """Validate and build :class:`Friction`.
-
-    Parameters
-    ----------
-    static, kinetic : array-like, shape (n_p,)
-
-    Raises
-    ------
-    QsplanError
-        Shapes differ, a coefficient is negative or not finite, or a kinetic
-        coefficient exceeds its static one (Coulomb friction: sliding never holds
-        more than sticking).  Equal coefficients are allowed.
-    """
-    s = check_finite_array(np.atleast_1d(static), "friction.static", (None,))
-    k = check_finite_array(np.atleast_1d(kinetic), "friction.kinetic", (s.size,))
-    for name, arr in (("static", s), ("kinetic", k)):
-        if np.any(arr < 0):
-            i = int(np.flatnonzero(arr < 0)[0])
-            raise QsplanError(f"friction.{name}[{i}]: expected a nonnegative coefficient; got {arr[i]}")
-    if np.any(k > s):
-        i = int(np.flatnonzero(k > s)[0])
-        raise QsplanError(f"friction.kinetic[{i}]: expected at most the static coefficient {s[i]}; got {k[i]}")
-    s.setflags(write=False)
-    k.setflags(write=False)
-    return Friction(s, k)
-
-
-@runtime_checkable
-class MotionSystem(Protocol):
-    """A hand and workpiece whose configuration ``x`` evolves under velocity inputs.
-
-    Required attributes and methods:
-
-    * ``state_names`` : tuple of str, length n_x (with units, e.g. ``"x (m)"``).
-    * ``contact_names`` : tuple of str, length n_p, the potential contacts.
-    * ``friction`` : :class:`Friction` over the potential contacts.
-    * ``scene(x, contacts) -> Scene``: the instant at ``x`` with the potential
-      contacts ``contacts`` (tuple of indices, in that order); its ``mu`` is ignored.
-    * ``rates(x, qdot, thetadot) -> ndarray (n_x,)``: ``dx/dt`` when the workpiece
-      point at the world origin moves at ``qdot`` (3,) and the joints at ``thetadot``.
-
-    Optional:
-
-    * ``gaps(x) -> ndarray (n_p,)``: signed distances (m) of the potential contacts,
-      0 when touching; without it every contact is always in contact.
-    * ``limits(x) -> ndarray (n_l,)`` and ``limit_names``: the run stops when one
-      reaches zero (the configuration leaves the system's valid range).
-    """
-
-    state_names: tuple
-    contact_names: tuple
-    friction: Friction
-
-    def scene(self, x, contacts) -> Scene: ...
-
-    def rates(self, x, qdot, thetadot) -> np.ndarray: ...
-
-
-def pose_rate(pose, qdot) -> np.ndarray:
-    """``d(x, y, theta)/dt`` of a workpiece pose from ``qdot``.
-
-    Parameters
-    ----------
-    pose : array-like, shape (3,)
-        Position (m) of the workpiece's reference point (its centre of mass) and angle (rad).
-    qdot : array-like, shape (3,)
-        Velocity of the workpiece point at the world origin (m/s) and angular velocity (rad/s).
-
-    Returns
-    -------
-    ndarray, shape (3,)
-        ``qdot[:2] + qdot[2] * perp(p)`` with ``perp(p) = (-p_y, p_x)``, and ``qdot[2]``.
-    """
-    p = np.asarray(pose, dtype=float)
-    w = float(qdot[2])
-    return np.array([qdot[0] - w * p[1], qdot[1] + w * p[0], w])
-
-
-def rigid_body_rates(x, qdot, thetadot) -> np.ndarray:
-    """Rates of the usual state layout ``x = [pose (3,), joint positions (n_j,)]``, shape (3 + n_j,)."""
-    return np.concatenate([pose_rate(x[:3], qdot), np.asarray(thetadot, dtype=float)])
-
-
-@dataclass(frozen=True, slots=True, eq=False)
-class FrozenScene:
-    """One instant held fixed while the state moves: a raw scene (e.g. eq. 37, 42) as a system.
-
-    The state is the workpiece pose and the joint positions (``3 + n_j``); wrenches and
-    Jacobians do not change with it, so every condition stays constant.  Use it to ask
-    the simulator's start-up question of one configuration: which mode starts, or is
-    the start ambiguous or jammed.  Build it with :func:`frozen_scene_system`.
-    """
-
-    base: Scene
-    friction: Friction
-
-    @property
-    def state_names(self) -> tuple:
-        return ("x (m)", "y (m)", "theta (rad)") + tuple(f"{j} (rad or m)" for j in self.base.joint_names)
-
-    @property
-    def contact_names(self) -> tuple:
-        return self.base.contact_names
-
-    def scene(self, x, contacts) -> Scene:
-        if tuple(contacts) != tuple(range(self.base.n_contacts)):
-            raise QsplanError(f"contacts: a frozen scene has all its contacts; got {contacts}")
-        return self.base
-
-    def rates(self, x, qdot, thetadot) -> np.ndarray:
-        return rigid_body_rates(x, qdot, thetadot)
-
-
-def frozen_scene_system(scene: Scene, mu_kinetic=None) -> FrozenScene:
-    """Wrap ``scene`` as a :class:`FrozenScene`; static friction ``scene.mu``, kinetic
-    ``mu_kinetic`` (scalar or shape (n_c,); default equal to the static)."""
-    kinetic = scene.mu if mu_kinetic is None else np.broadcast_to(np.asarray(mu_kinetic, float), scene.mu.shape)
-    return FrozenScene(scene, make_friction(scene.mu, kinetic))
+__all__ = ["MotionOptions", "simulate"]
 
 
 @dataclass(frozen=True, slots=True)
@@ -266,135 +105,6 @@ class MotionOptions:
                 f"options.probe_time: expected at least 100 event_xtol = {100 * self.event_xtol:g} s (beyond the "
                 f"root finder's uncertainty) and below min_segment = {self.min_segment:g} s; got {self.probe_time:g}"
             )
-
-
-@dataclass(frozen=True, slots=True, eq=False)
-class Segment:
-    """A stretch of motion in one contact mode.
-
-    Attributes
-    ----------
-    mode : ContactMode
-        Over the contacts in contact, in the order of ``contacts``.
-    contacts : tuple of int
-        Indices of the system's potential contacts in contact during the segment.
-    n_potential : int
-        Number of potential contacts of the system.
-    t_start, t_end : float
-        s.
-    times : ndarray, shape (k,)
-        Integration instants, from ``t_start`` to ``t_end``.
-    states : ndarray, shape (k, n_x)
-    mu : ndarray, shape (n_c,)
-        Friction used: static at rolling and breaking contacts, kinetic at sliding ones.
-    solution : ModeSolution
-        The mode's solution at ``t_start`` (forces, velocities, residuals).
-    ended_by : str
-        ``"duration"`` or the kind of the :class:`~mechanics.events.Event` that ended it.
-    """
-
-    mode: ContactMode
-    contacts: tuple
-    n_potential: int
-    t_start: float
-    t_end: float
-    times: np.ndarray
-    states: np.ndarray
-    mu: np.ndarray
-    solution: ModeSolution
-    ended_by: str
-
-    @property
-    def duration(self) -> float:
-        return self.t_end - self.t_start
-
-    @property
-    def x_start(self) -> np.ndarray:
-        return self.states[0]
-
-    @property
-    def x_end(self) -> np.ndarray:
-        return self.states[-1]
-
-    @property
-    def label(self) -> str:
-        """One letter per *potential* contact: R, S, B, or ``-`` when not in contact."""
-        return _label(self.mode, self.contacts, self.n_potential)
-
-
-@dataclass(frozen=True, slots=True, eq=False)
-class Stop:
-    """Why and where a motion stopped before its duration.
-
-    Attributes
-    ----------
-    kind : str
-        One of :data:`STOP_KINDS`.
-    time : float
-        s.
-    state : ndarray, shape (n_x,)
-    candidates : tuple of str
-        Mode labels feasible at that instant (for ``ambiguous``: the persistent ones).
-    message : str
-        One sentence for people, with the numbers.
-    """
-
-    kind: str
-    time: float
-    state: np.ndarray
-    candidates: tuple
-    message: str
-
-
-@dataclass(frozen=True, slots=True, eq=False)
-class Motion:
-    """A simulated finite motion: its segments, events and how it ended.
-
-    Attributes
-    ----------
-    system : MotionSystem
-    segments : tuple of Segment
-    events : tuple of Event
-        Every instant where a segment ended (switches, contacts appearing, stops).
-    stopped : Stop or None
-        None when the motion reached its duration.
-    duration : float
-        Requested duration (s).
-    """
-
-    system: object
-    segments: tuple
-    events: tuple
-    stopped: Stop | None
-    duration: float
-
-    @property
-    def times(self) -> np.ndarray:
-        """All integration instants, shape (k,) (segment ends repeat as the next start)."""
-        return np.concatenate([s.times for s in self.segments]) if self.segments else np.zeros(0)
-
-    @property
-    def states(self) -> np.ndarray:
-        """All integrated states, shape (k, n_x)."""
-        n_x = len(self.system.state_names)
-        return np.concatenate([s.states for s in self.segments]) if self.segments else np.zeros((0, n_x))
-
-    @property
-    def switch_times(self) -> np.ndarray:
-        """Instants where one segment ended and the next began, shape (len(segments) - 1,)."""
-        return np.array([s.t_end for s in self.segments[:-1]])
-
-    @property
-    def labels(self) -> list[str]:
-        """Mode label of each segment (see :attr:`Segment.label`)."""
-        return [s.label for s in self.segments]
-
-
-def _label(mode, contacts, n_potential) -> str:
-    out = ["-"] * n_potential
-    for letter, i in zip(mode.letters, contacts):
-        out[i] = letter
-    return "".join(out)
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -572,5 +282,5 @@ def _candidates(system, x, contacts, tol) -> list[_Candidate]:
         mu = system.friction.for_mode(mode, contacts)
         check = check_mode(replace(base, mu=mu), mode, tol)
         if check.feasible:
-            out.append(_Candidate(mode, mu, check.solution, _label(mode, contacts, len(system.contact_names))))
+            out.append(_Candidate(mode, mu, check.solution, mode_label(mode, contacts, len(system.contact_names))))
     return out

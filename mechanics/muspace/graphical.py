@@ -37,7 +37,7 @@ import numpy as np
 
 from qsplan.mechanics.model.contact import cross2
 from qsplan.mechanics.errors import ModeError, QsplanError
-from qsplan.mechanics.modes.contact_mode import ContactMode
+from qsplan.mechanics.modes.contact_mode import mode_from_letters
 from qsplan.mechanics.numerics import DEFAULT_TOLERANCES, Tolerances
 from qsplan.mechanics.muspace.regions import mode_kinematics
 from qsplan.mechanics.model.scene import Scene
@@ -211,7 +211,7 @@ def active_wrenches(scene: Scene, mode, mu=None, tol: Tolerances = DEFAULT_TOLER
         For other modes, or when the mode's kinematic stage fails (no sliding directions).
     """
     status, kin = mode_kinematics(scene, mode, tol)
-    mode = mode if isinstance(mode, ContactMode) else ContactMode(str(mode).upper())
+    mode = mode_from_letters(mode)
     if mode.kind not in ("3S", "RS"):
         raise ModeError(f"mode {mode.letters}: the graphical test covers 3S and RS modes; got a {mode.kind} mode")
     if kin is None:

@@ -9,9 +9,8 @@ gives for the scene with that mu.
 Two paths give that answer: :func:`feasibility_map` repeats the solver's
 equilibrium stage (an LU solve per mode and point), :func:`polynomial_map`
 evaluates each mode's multilinear form of ``c_A`` (Sections 4.4-4.6) and is
-much faster.  :func:`mu_slice` maps a 2-D slice (the paper's Figs. 3, 6, 8)
-together with the modes' exact regions, whose boundary curves are zero sets of
-polynomials; :func:`boundary_agreement` checks the two against each other.
+much faster.  2-D slices with the modes' exact regions are in
+:mod:`qsplan.mechanics.muspace.slices`.
 """
 
 from __future__ import annotations
@@ -21,24 +20,23 @@ from dataclasses import dataclass
 import numpy as np
 
 from qsplan.mechanics.errors import SceneError
-from qsplan.mechanics.modes.reference import velocity_scale
+from qsplan.mechanics.model.friction import check_friction
 from qsplan.mechanics.modes.contact_mode import ContactMode, codes_to_letters, count_modes, iter_mode_batches
 from qsplan.mechanics.numerics import DEFAULT_TOLERANCES, Status, Tolerances
 from qsplan.mechanics.model.scene import Scene
 from qsplan.mechanics.muspace.multilinear import monomials, restrict_coef
 from qsplan.mechanics.parallel import chunk_count, map_chunks, split_range
-from qsplan.mechanics.muspace.regions import _active, _polynomials_from_kinematics, empty_region, region_from_polynomials
-from qsplan.mechanics.solver.batch import ScenePool, equilibrium_stage, kinematics_stage
+from qsplan.mechanics.muspace.regions import empty_region, polynomials_from_kinematics, region_from_polynomials
+from qsplan.mechanics.modes.equilibrium import coulomb_slacks, equilibrium_stage
+from qsplan.mechanics.modes.kinematics import ScenePool, kinematics_stage, velocity_scale
 
 __all__ = [
     "MuMap",
     "feasibility_map",
     "grid_points",
     "polynomial_map",
-    "MuSlice",
-    "mu_slice",
-    "BoundaryAgreement",
-    "boundary_agreement",
+    "polynomial_pass",
+    "MAP_BATCH",
 ]
 
 #: Rows (mode x mu point) per equilibrium batch; bounds memory to a few tens of MB.
@@ -114,12 +112,10 @@ def _kinematics_all(scene: Scene, tol: Tolerances):
 
 
 def _check_mu_points(scene: Scene, mu_points) -> np.ndarray:
-    mu_points = np.asarray(mu_points, dtype=float)
+    mu_points = check_friction(mu_points, "mu_points")
     n_c = scene.n_contacts
     if mu_points.ndim != 2 or mu_points.shape[1] != n_c:
         raise SceneError(f"mu_points: expected shape (N, {n_c}); got {mu_points.shape}")
-    if not np.all(np.isfinite(mu_points)) or np.any(mu_points < 0):
-        raise SceneError("mu_points: expected finite nonnegative friction coefficients")
     return mu_points
 
 
@@ -219,7 +215,7 @@ def grid_points(base_mu, x: int, y: int, xs, ys) -> np.ndarray:
 def _polynomial_status(eqp, mu_points: np.ndarray, tau_e: np.ndarray, tol: Tolerances, batch: int):
     """Feasible / degenerate / boundary of one mode at every point, from its multilinear form.
 
-    The decisions are the solver's (:func:`~mechanics.solver.equilibrium_stage`): the
+    The decisions are the solver's (:func:`~qsplan.mechanics.modes.equilibrium.equilibrium_stage`): the
     same Hadamard-ratio singularity test of ``Q_AI``, the same Coulomb slacks (28) and
     the same force tolerance; only ``c_A`` comes from ``N(mu) / det Q_AI(mu)`` evaluated
     as polynomials instead of an LU solve.
@@ -256,8 +252,8 @@ def _polynomial_status(eqp, mu_points: np.ndarray, tau_e: np.ndarray, tol: Toler
         q_sing = ~(h >= tol.singular)
         worst = np.full(mu.shape[0], np.inf)
         for i, a, t in rolling:  # Coulomb slacks (28), as the solver computes them
-            mc = mu[:, i] * cA[a]
-            worst = np.minimum(worst, np.minimum(np.minimum(mc + cA[t], mc - cA[t]), cA[a]))  # and c_n >= 0 (eq. 9)
+            plus, minus = coulomb_slacks(mu[:, i], cA[a], cA[t])
+            worst = np.minimum(worst, np.minimum(np.minimum(plus, minus), cA[a]))  # and c_n >= 0 (eq. 9)
         for a in sliding:
             worst = np.minimum(worst, cA[a])
         scale = np.full(mu.shape[0], rhs_scale)
@@ -279,7 +275,7 @@ def _polynomial_columns(scene: Scene, mu_points: np.ndarray, tol: Tolerances, ba
     for mode_cols, kin in kins:
         for r, col in enumerate(mode_cols):
             if int(col) in columns:
-                eqp = _polynomials_from_kinematics(scene, pool, kin, r)
+                eqp = polynomials_from_kinematics(scene, pool, kin, r)
                 out[int(col)] = _polynomial_status(eqp, mu_points, tau_e, tol, batch) + (region_from_polynomials(eqp, tau_e),)
     return out
 
@@ -290,10 +286,17 @@ def _polynomial_chunk(job):
     return _polynomial_columns(scene, grid_points(*grid), tol, batch, _kinematics_all(scene, tol), columns)
 
 
-def _polynomial_pass(scene: Scene, mu_points: np.ndarray, tol: Tolerances, batch: int, grid=None, workers=1,
+def polynomial_pass(scene: Scene, mu_points: np.ndarray, tol: Tolerances, batch: int, grid=None, workers=1,
                      scheduler=None):  # fmt: skip
     """The polynomial map and every mode's region; with ``grid`` (the arguments of
-    :func:`grid_points`) the modes may be split into chunks, each evaluated whole."""
+    :func:`grid_points`) the modes may be split into chunks, each evaluated whole.
+
+    Returns
+    -------
+    mumap : MuMap
+    regions : tuple of MuRegion
+        One per mode of ``mumap.modes`` (empty where the kinematic stage fails).
+    """
     kinematics = _kinematics_all(scene, tol)
     _, modes, kstatus, kins = kinematics
     live = [int(c) for mode_cols, _ in kins for c in mode_cols]
@@ -324,7 +327,7 @@ def polynomial_map(scene: Scene, mu_points, tol: Tolerances = DEFAULT_TOLERANCES
 
     For a kinematically admissible mode ``c_A = adj(Q_AI) rhs / det Q_AI`` with
     ``det`` and ``adj`` multilinear in the sliding contacts' mu (Sections 4.4-4.6,
-    :mod:`mechanics.multilinear`); coefficients that do not vary over the points are
+    :mod:`qsplan.mechanics.muspace.multilinear`); coefficients that do not vary over the points are
     folded in first, so a 2-D slice costs a few multiply-adds per point and mode.
     The singularity test and the Coulomb tolerances are the solver's, so the map
     equals :func:`feasibility_map` (and :func:`mechanics.solve`) except, through
@@ -343,209 +346,4 @@ def polynomial_map(scene: Scene, mu_points, tol: Tolerances = DEFAULT_TOLERANCES
     -------
     MuMap
     """
-    return _polynomial_pass(scene, _check_mu_points(scene, mu_points), tol, batch)[0]
-
-
-@dataclass(frozen=True, slots=True, eq=False)
-class MuSlice:
-    """A 2-D slice of mu-space (the paper's Figs. 3, 6, 8): cell labels and exact regions.
-
-    Attributes
-    ----------
-    x, y : int
-        0-based contacts on the axes (``mu_{x+1}`` horizontal).
-    xs, ys : ndarray, shape (nx,), (ny,)
-    base_mu : ndarray, shape (n_c,)
-        Values of the other coefficients (entries ``x`` and ``y`` unused).
-    mumap : MuMap
-        On :func:`grid_points` ``(base_mu, x, y, xs, ys)``: row ``j * nx + i`` is ``(xs[i], ys[j])``.
-    regions : tuple of MuRegion
-        One per mode of ``mumap.modes``, from the general formulas.
-    """
-
-    x: int
-    y: int
-    xs: np.ndarray
-    ys: np.ndarray
-    base_mu: np.ndarray
-    mumap: MuMap
-    regions: tuple
-
-    @property
-    def modes(self) -> tuple:
-        return self.mumap.modes
-
-    @property
-    def feasible(self) -> np.ndarray:
-        """Feasibility per cell and mode, shape (ny, nx, n_modes)."""
-        return self.mumap.feasible.reshape(self.ys.size, self.xs.size, -1)
-
-    def cells(self) -> list:
-        """``cells[j][i]``: sorted letters of the modes feasible at ``(xs[i], ys[j])``."""
-        f = self.mumap.feasible
-        keys = np.packbits(f, axis=1, bitorder="little") if f.shape[1] else np.zeros((f.shape[0], 1), np.uint8)
-        uniq, inverse = np.unique(keys, axis=0, return_inverse=True)
-        sets = [sorted(self.modes[j].letters for j in np.flatnonzero(np.unpackbits(u, bitorder="little")[: f.shape[1]]))
-                for u in uniq]  # fmt: skip
-        inv = inverse.reshape(self.ys.size, self.xs.size).tolist()
-        return [[list(sets[u]) for u in row] for row in inv]
-
-    def boundary_curves(self, n: int = 400) -> list:
-        """Exact boundaries of every mode's region in the window, list of BoundaryCurve."""
-        xlim, ylim = (self.xs[0], self.xs[-1]), (self.ys[0], self.ys[-1])
-        out = []
-        for reg in self.regions:
-            out += reg.boundary_curves(self.x, self.y, self.base_mu, xlim, ylim, n)
-        return out
-
-
-def _check_axis(value, n_c: int, field: str) -> int:
-    if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, np.integer)) or not 0 <= value < n_c:
-        raise SceneError(f"{field}: expected a contact index in 0..{n_c - 1}; got {value!r}")
-    return int(value)
-
-
-def _check_axis_values(v, field: str) -> np.ndarray:
-    v = np.asarray(v, dtype=float)
-    if v.ndim != 1 or v.size < 2:
-        raise SceneError(f"{field}: expected at least 2 increasing values; got shape {v.shape}")
-    if not np.all(np.isfinite(v)) or np.any(v < 0) or np.any(np.diff(v) < 0):
-        raise SceneError(f"{field}: expected finite nonnegative nondecreasing friction coefficients")
-    return v
-
-
-def mu_slice(scene: Scene, x: int, y: int, xs, ys, base_mu=None, method: str = "polynomial",
-             tol: Tolerances = DEFAULT_TOLERANCES, *, workers=None, scheduler=None) -> MuSlice:  # fmt: skip
-    """Feasible modes on a grid of a 2-D slice of mu-space, with the modes' exact regions.
-
-    Parameters
-    ----------
-    scene : Scene
-    x, y : int
-        0-based contacts on the horizontal and vertical axes (distinct).
-    xs, ys : array-like, shape (nx,), (ny,)
-        Nondecreasing nonnegative values, at least 2 each.
-    base_mu : array-like, shape (n_c,), optional
-        The other coefficients (default the scene's ``mu``).
-    method : {"polynomial", "solver"}
-        ``"polynomial"``: :func:`polynomial_map`; ``"solver"``: :func:`feasibility_map`.
-        Both give the solver's answer.
-    workers : int or None
-        Local processes (``None``: all cores, 1: in-process).  ``"polynomial"`` splits
-        the modes into chunks (each of at least :data:`MIN_CHUNK_POLYNOMIAL_ROWS`
-        mode-point rows), ``"solver"`` the points; a small slice stays in-process.
-    scheduler : str or dask.distributed.Client, optional
-        Send the chunks to a Dask cluster instead (:func:`mechanics.parallel.map_chunks`).
-
-    Returns
-    -------
-    MuSlice
-        The same (bit for bit) however it was split.
-    """
-    n_c = scene.n_contacts
-    x, y = _check_axis(x, n_c, "x"), _check_axis(y, n_c, "y")
-    if x == y:
-        raise SceneError(f"y: expected a contact other than x = {x}; got {y}")
-    xs, ys = _check_axis_values(xs, "xs"), _check_axis_values(ys, "ys")
-    base = scene.mu if base_mu is None else np.asarray(base_mu, dtype=float)
-    if base.shape != (n_c,) or not np.all(np.isfinite(base)) or np.any(base < 0):
-        got = np.asarray(base_mu).tolist()
-        raise SceneError(f"base_mu: expected {n_c} finite nonnegative friction coefficients; got {got}")
-    pts = grid_points(base, x, y, xs, ys)
-    if method == "polynomial":
-        mumap, regions = _polynomial_pass(scene, pts, tol, MAP_BATCH, (base, x, y, xs, ys), workers, scheduler)
-    elif method == "solver":
-        mumap = feasibility_map(scene, pts, tol, workers=workers, scheduler=scheduler)
-        _, regions = _polynomial_pass(scene, pts[:1], tol, MAP_BATCH)
-    else:
-        raise SceneError(f"method: expected 'polynomial' or 'solver'; got {method!r}")
-    base = base.copy()
-    base.setflags(write=False)
-    return MuSlice(x, y, xs, ys, base, mumap, regions)
-
-
-@dataclass(frozen=True, slots=True)
-class BoundaryAgreement:
-    """How well a slice's exact boundary curves separate its cell labels.
-
-    Counted over pairs of adjacent cells and modes: a pair *changes* when the mode is
-    feasible at one cell and not at the other; it is *crossed* when the mode's exact
-    boundary (the active pieces of the zero sets of its boundary polynomials) meets the
-    segment between the two cell centres an odd number of times.  Pairs with a cell
-    centre on a boundary (within ``1e-9`` relative, or feasible only within the force
-    tolerance) are left out and counted in ``excluded``.
-
-    Attributes
-    ----------
-    excluded : int
-    label_changes : int
-    explained : int
-        Changes that are crossed.
-    unexplained : int
-        Changes that are not crossed.
-    spurious : int
-        Crossings without a change.
-    """
-
-    excluded: int
-    label_changes: int
-    explained: int
-    unexplained: int
-    spurious: int
-
-    @property
-    def agrees(self) -> bool:
-        return self.unexplained == 0 and self.spurious == 0
-
-
-def _crossings(bil, ip, fixed, grid, horizontal: bool) -> np.ndarray:
-    """Active roots of polynomial ``ip`` on the grid segments of each row (or column).
-
-    Returns counts, shape (len(fixed), len(grid) - 1).
-    """
-    a, b, c, d = bil[ip]
-    if horizontal:  # y = fixed: p = (a + c y) + (b + d y) x
-        alpha, beta = a + c * fixed, b + d * fixed
-    else:  # x = fixed: p = (a + b x) + (c + d x) y
-        alpha, beta = a + b * fixed, c + d * fixed
-    counts = np.zeros((fixed.size, grid.size - 1), dtype=np.int32)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        root = -alpha / beta
-    ok = np.isfinite(root) & (root >= grid[0]) & (root <= grid[-1])
-    rows = np.flatnonzero(ok)
-    if rows.size == 0:
-        return counts
-    pts = np.column_stack([root[rows], fixed[rows]] if horizontal else [fixed[rows], root[rows]])
-    act = _active(bil, ip, pts)
-    rows = rows[act]
-    seg = np.clip(np.searchsorted(grid, root[rows], side="right") - 1, 0, grid.size - 2)
-    np.add.at(counts, (rows, seg), 1)
-    return counts
-
-
-def boundary_agreement(sl: MuSlice) -> BoundaryAgreement:
-    """Check a slice's cell labels against its exact region boundaries (see :class:`BoundaryAgreement`)."""
-    f = sl.feasible
-    shape = f.shape[:2]
-    changes = explained = spurious = excluded = 0
-    for j, reg in enumerate(sl.regions):
-        fj = f[:, :, j]
-        near = sl.mumap.boundary[:, j].reshape(shape) | reg.near_boundary(sl.mumap.mu).reshape(shape)
-        keep_h = ~(near[:, 1:] | near[:, :-1])
-        keep_v = ~(near[1:, :] | near[:-1, :])
-        excluded += int((~keep_h).sum() + (~keep_v).sum())
-        ch_h = (fj[:, 1:] != fj[:, :-1]) & keep_h  # (ny, nx-1)
-        ch_v = (fj[1:, :] != fj[:-1, :]) & keep_v  # (ny-1, nx)
-        cr_h = np.zeros(ch_h.shape, dtype=np.int32)
-        cr_v = np.zeros(ch_v.T.shape, dtype=np.int32)
-        if reg.kinematic_status == Status.FEASIBLE:
-            bil = np.array([p.bilinear(sl.x, sl.y, sl.base_mu) for p in reg.boundary_polynomials()])
-            for ip in range(bil.shape[0]):
-                if np.any(bil[ip, 1:]):
-                    cr_h += _crossings(bil, ip, sl.ys, sl.xs, True)
-                    cr_v += _crossings(bil, ip, sl.xs, sl.ys, False)
-        odd_h, odd_v = (cr_h % 2 == 1) & keep_h, (cr_v % 2 == 1).T & keep_v
-        changes += int(ch_h.sum() + ch_v.sum())
-        explained += int((ch_h & odd_h).sum() + (ch_v & odd_v).sum())
-        spurious += int((~ch_h & odd_h).sum() + (~ch_v & odd_v).sum())
-    return BoundaryAgreement(excluded, changes, explained, changes - explained, spurious)
+    return polynomial_pass(scene, _check_mu_points(scene, mu_points), tol, batch)[0]

@@ -15,10 +15,10 @@ linear in the effort inputs ``tau_I``.  The region of the mode is
     { D > 0 and P_i >= 0 for all i }  or  { D < 0 and P_i <= 0 for all i },
 
 which for 3S modes is eqs. (35)-(36) with Appendix A's coefficients (50)-(57)
-(:func:`region_3s`) and for RS modes eqs. (40)-(41) with Appendix B's (58)-(60)
-(:func:`region_rs`).  :func:`mode_region` builds the same object for any mode
+(:func:`~qsplan.mechanics.muspace.appendices.region_3s`) and for RS modes eqs. (40)-(41)
+with Appendix B's (58)-(60) (:func:`~qsplan.mechanics.muspace.appendices.region_rs`).  :func:`mode_region` builds the same object for any mode
 (2R, R2S, 4S, ..., Sections 4.4-4.6) from the column expansion of
-:mod:`mechanics.multilinear`; one code path serves all modes and the appendix
+:mod:`qsplan.mechanics.muspace.multilinear`; one code path serves all modes and the appendix
 forms are a cross-check.
 
 Boundaries.  ``P_i = 0`` belongs to the region (the paper's non-strict
@@ -35,28 +35,24 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from qsplan.mechanics.errors import ModeError
-from qsplan.mechanics.modes.contact_mode import ContactMode
-from qsplan.mechanics.muspace.multilinear import Multilinear, ZeroBranch, bilinear_zero_set, column_expansion
+from qsplan.mechanics.modes.contact_mode import ContactMode, codes_to_letters
+from qsplan.mechanics.muspace.multilinear import Multilinear, column_expansion
+from qsplan.mechanics.muspace.zero_sets import ZeroBranch, bilinear_zero_set
 from qsplan.mechanics.numerics import DEFAULT_TOLERANCES, Status, Tolerances
 from qsplan.mechanics.model.scene import Scene
-from qsplan.mechanics.solver.batch import Kinematics, ScenePool, check_mode_fits, single_mode_kinematics
+from qsplan.mechanics.modes.kinematics import Kinematics, ScenePool, check_mode_fits, single_mode_kinematics
 
 __all__ = [
     "MuRegion",
     "BoundaryCurve",
     "EquilibriumPolynomials",
-    "Appendix3S",
-    "AppendixRS",
-    "appendix_a",
-    "appendix_b",
     "mode_kinematics",
+    "polynomials_from_kinematics",
+    "bounds_region",
     "equilibrium_polynomials",
     "mode_region",
     "region_from_polynomials",
     "empty_region",
-    "region_3s",
-    "region_rs",
 ]
 
 
@@ -131,7 +127,7 @@ class EquilibriumPolynomials:
         return int(np.flatnonzero((self.col_contact == contact) & (self.col_normal == normal))[0])
 
 
-def _polynomials_from_kinematics(scene: Scene, pool: ScenePool, kin: Kinematics, row: int) -> EquilibriumPolynomials:
+def polynomials_from_kinematics(scene: Scene, pool: ScenePool, kin: Kinematics, row: int) -> EquilibriumPolynomials:
     n_c = scene.n_contacts
     E = pool.E
     idx, contact, slide = kin.idx[row], kin.contact[row], kin.slide[row]
@@ -143,7 +139,7 @@ def _polynomials_from_kinematics(scene: Scene, pool: ScenePool, kin: Kinematics,
     V[:, cols] = -(xi[contact[cols]])[None, :] * rows[idx[cols] + n_c].T  # eq. (18)-(20): -mu xi w_t
     det_coef, adj_coef = column_expansion(U, V, cols)
     rhs0 = np.concatenate([-scene.g_obj, -scene.g_man[E]])
-    mode = ContactMode("".join("BRS"[c] for c in kin.codes[row]))
+    mode = ContactMode(codes_to_letters(kin.codes[row]))
     return EquilibriumPolynomials(
         mode=mode, xi=xi.copy(), col_contact=contact.copy(), col_normal=idx < n_c,
         sliding=tuple(int(c) for c in contact[cols]), U=U, V=V, det_coef=det_coef, adj_coef=adj_coef, rhs0=rhs0,
@@ -153,7 +149,7 @@ def _polynomials_from_kinematics(scene: Scene, pool: ScenePool, kin: Kinematics,
 def equilibrium_polynomials(scene: Scene, mode, tol: Tolerances = DEFAULT_TOLERANCES) -> EquilibriumPolynomials | None:
     """The multilinear form of ``Q_AI`` of a mode (Sections 4.4-4.6); None if its kinematics fail."""
     status, kin = mode_kinematics(scene, mode, tol)
-    return None if kin is None else _polynomials_from_kinematics(scene, ScenePool(scene), kin, 0)
+    return None if kin is None else polynomials_from_kinematics(scene, ScenePool(scene), kin, 0)
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -252,7 +248,7 @@ class MuRegion:
         """The region's boundary on the slice through ``base_mu`` spanned by ``mu_x``, ``mu_y``.
 
         Each boundary polynomial restricted to the slice is bilinear; its zero set is
-        computed exactly (:func:`~mechanics.multilinear.bilinear_zero_set`) and kept
+        computed exactly (:func:`~qsplan.mechanics.muspace.zero_sets.bilinear_zero_set`) and kept
         where it bounds the region: on ``P_i = 0`` where the other inequalities hold
         and ``D != 0``, on ``D = 0`` where all ``P_j`` share a sign.  Piece ends are
         refined by bisection on the curve.
@@ -290,8 +286,23 @@ def _bil_values(bil, pts):
     return bil[:, 0] + bil[:, 1] * x + bil[:, 2] * y + bil[:, 3] * x * y  # (m, n_poly)
 
 
-def _active(bil, ip, pts, rel=1e-12):
-    """On the zero set of polynomial ``ip``: does the point bound the region?"""
+def bounds_region(bil, ip, pts, rel=1e-12):
+    """On the zero set of polynomial ``ip``: does the point bound the region?
+
+    Parameters
+    ----------
+    bil : ndarray, shape (m, 1 + n_poly, 4)
+        Bilinear coefficients ``[1, x, y, xy]`` of the denominator and the numerators at each point.
+    ip : int
+        0 for the denominator, ``1 + i`` for numerator ``i``.
+    pts : ndarray, shape (m, 2)
+    rel : float
+        Relative tolerance of the other polynomials' signs.
+
+    Returns
+    -------
+    ndarray of bool, shape (m,)
+    """
     vals = _bil_values(bil, pts)
     scale = rel * (np.abs(bil[:, 0]) + np.abs(bil[:, 1] * pts[:, 0, None]) + np.abs(bil[:, 2] * pts[:, 1, None])
                    + np.abs(bil[:, 3] * pts[:, 0, None] * pts[:, 1, None]))  # fmt: skip
@@ -306,7 +317,7 @@ def _active(bil, ip, pts, rel=1e-12):
 
 def _active_pieces(br: ZeroBranch, bil, ip, iters: int = 60) -> list:
     t = br.t
-    act = _active(bil, ip, br.points(t))
+    act = bounds_region(bil, ip, br.points(t))
     if not act.any():
         return []
     pieces = []
@@ -318,7 +329,7 @@ def _active_pieces(br: ZeroBranch, bil, ip, iters: int = 60) -> list:
                 a, b = t[inside], t[outside]
                 for _ in range(iters):  # bisection for where the piece ends on the curve
                     m = 0.5 * (a + b)
-                    if _active(bil, ip, br.points(np.array([m])))[0]:
+                    if bounds_region(bil, ip, br.points(np.array([m])))[0]:
                         a = m
                     else:
                         b = m
@@ -358,10 +369,6 @@ _GENERAL = "general: Cramer's rule on Q_AI (eqs. 26, 28, 46-47)"
 
 def empty_region(mode: ContactMode, status: str, n_c: int, source: str = _GENERAL) -> MuRegion:
     """The empty region of a mode whose kinematic stage failed with ``status``."""
-    return _empty(mode, status, n_c, source)
-
-
-def _empty(mode, status, n_c, source):
     return MuRegion(mode, status, np.zeros(n_c), Multilinear.constant(0.0), (), (), source)
 
 
@@ -385,157 +392,7 @@ def mode_region(scene: Scene, mode, tau_e=None, tol: Tolerances = DEFAULT_TOLERA
     mode = check_mode_fits(scene, mode)
     status, kin = mode_kinematics(scene, mode, tol)
     if kin is None:
-        return _empty(mode, status, scene.n_contacts, _GENERAL)
-    eqp = _polynomials_from_kinematics(scene, ScenePool(scene), kin, 0)
+        return empty_region(mode, status, scene.n_contacts, _GENERAL)
+    eqp = polynomials_from_kinematics(scene, ScenePool(scene), kin, 0)
     tau = np.nan_to_num(scene.joint_effort)[scene.effort_joints] if tau_e is None else np.asarray(tau_e, float)
     return region_from_polynomials(eqp, tau)
-
-
-@dataclass(frozen=True, slots=True)
-class Appendix3S:
-    """Appendix A's coefficients (eqs. 50-57) of a 3S mode; contacts numbered 1-3 in mode order.
-
-    ``F[i, j]`` is ``F_{i+1, j+1}`` (diagonal 0).  The denominator of (34) is
-    ``A mu1 mu2 mu3 + B_1 mu2 mu3 + B_2 mu1 mu3 + B_3 mu1 mu2 + C . mu + D``.
-    """
-
-    A: float
-    B: np.ndarray
-    C: np.ndarray
-    D: float
-    E: np.ndarray
-    F: np.ndarray
-    G: np.ndarray
-
-
-def _det3(*cols):
-    return float(np.linalg.det(np.column_stack(cols)))
-
-
-def appendix_a(wn, wt, g, xi) -> Appendix3S:
-    """Appendix A (eqs. 50-57), transcribed as printed.
-
-    Parameters
-    ----------
-    wn, wt : array-like, shape (3, 3)
-        Columns ``w_in``, ``w_it`` of the three sliding contacts.
-    g : array-like, shape (3,)
-        ``g_obj``.
-    xi : array-like, shape (3,)
-        Sliding directions of the three contacts.
-    """
-    n = [np.asarray(wn, float)[:, i] for i in range(3)]
-    t = [np.asarray(wt, float)[:, i] for i in range(3)]
-    g = np.asarray(g, float)
-    x1, x2, x3 = (float(v) for v in xi)
-    F = np.zeros((3, 3))
-    F[0, 1], F[0, 2] = x2 * _det3(g, t[1], n[2]), x3 * _det3(g, n[1], t[2])  # (54)
-    F[1, 0], F[1, 2] = x1 * _det3(t[0], g, n[2]), x3 * _det3(n[0], g, t[2])  # (55)
-    F[2, 0], F[2, 1] = x1 * _det3(t[0], n[1], g), x2 * _det3(n[0], t[1], g)  # (56)
-    return Appendix3S(
-        A=-x1 * x2 * x3 * _det3(t[0], t[1], t[2]),  # (50)
-        B=np.array([x2 * x3 * _det3(n[0], t[1], t[2]),
-                    x1 * x3 * _det3(t[0], n[1], t[2]),
-                    x1 * x2 * _det3(t[0], t[1], n[2])]),  # (51)
-        C=np.array([-x1 * _det3(t[0], n[1], n[2]), -x2 * _det3(n[0], t[1], n[2]), -x3 * _det3(n[0], n[1], t[2])]),  # (52)
-        D=_det3(n[0], n[1], n[2]),  # (50)
-        E=np.array([-x2 * x3 * _det3(g, t[1], t[2]),
-                    -x1 * x3 * _det3(t[0], g, t[2]),
-                    -x1 * x2 * _det3(t[0], t[1], g)]),  # (53)
-        F=F,
-        G=np.array([-_det3(g, n[1], n[2]), -_det3(n[0], g, n[2]), -_det3(n[0], n[1], g)]),  # (57)
-    )  # fmt: skip
-
-
-@dataclass(frozen=True, slots=True)
-class AppendixRS:
-    """Appendix B's coefficients (eqs. 58-60) of an RS mode.
-
-    ``c_nR = (C1 mu_S + D1) / (A mu_S + B)``, ``c_tR = (C2 mu_S + D2) / (A mu_S + B)``,
-    ``c_nS = D3 / (A mu_S + B)`` (eq. 39).
-    """
-
-    A: float
-    B: float
-    C1: float
-    C2: float
-    D1: float
-    D2: float
-    D3: float
-
-
-def appendix_b(w_rn, w_rt, w_sn, w_st, g, xi_s: float) -> AppendixRS:
-    """Appendix B (eqs. 58-60), transcribed as printed; arguments are wrench columns, shape (3,)."""
-    r_n, r_t, s_n, s_t, g = (np.asarray(v, float) for v in (w_rn, w_rt, w_sn, w_st, g))
-    xs = float(xi_s)
-    return AppendixRS(
-        A=-xs * _det3(r_n, r_t, s_t), B=_det3(r_n, r_t, s_n),  # (58)
-        C1=xs * _det3(g, r_t, s_t), C2=xs * _det3(r_n, g, s_t),  # (59)
-        D1=-_det3(g, r_t, s_n), D2=-_det3(r_n, g, s_n), D3=-_det3(r_n, r_t, g),  # (60)
-    )  # fmt: skip
-
-
-def region_3s(scene: Scene, mode, tol: Tolerances = DEFAULT_TOLERANCES) -> MuRegion:
-    """The region of a 3S mode from Appendix A and inequalities (34)-(36).
-
-    Raises
-    ------
-    ModeError
-        If ``mode`` is not a 3S mode of the scene (three sliding contacts, the rest breaking,
-        no effort-controlled joints).
-    """
-    source = "Appendix A, eqs. (34)-(36), (50)-(57)"
-    mode = check_mode_fits(scene, mode)
-    if mode.kind != "3S":
-        raise ModeError(f"mode {mode.letters}: Appendix A covers 3S modes; got a {mode.kind} mode")
-    status, kin = mode_kinematics(scene, mode, tol)
-    if kin is None:
-        return _empty(mode, status, scene.n_contacts, source)
-    S = list(mode.sliding)
-    xi = kin.xi[0]
-    co = appendix_a(scene.Wn[:, S], scene.Wt[:, S], scene.g_obj, xi[S])
-    i1, i2, i3 = S
-    den = Multilinear.from_terms(S, {
-        (): co.D, (i1,): co.C[0], (i2,): co.C[1], (i3,): co.C[2],
-        (i2, i3): co.B[0], (i1, i3): co.B[1], (i1, i2): co.B[2], (i1, i2, i3): co.A,
-    })  # fmt: skip
-    nums = []
-    for a in range(3):
-        others = [b for b in range(3) if b != a]
-        terms = {(): co.G[a], tuple(S[b] for b in others): co.E[a]}
-        for b in others:
-            terms[(S[b],)] = co.F[a, b]
-        nums.append(Multilinear.from_terms(S, terms))
-    return MuRegion(mode, status, xi, den, tuple(nums), tuple(f"c_n{i + 1} >= 0" for i in S), source)
-
-
-def region_rs(scene: Scene, mode, tol: Tolerances = DEFAULT_TOLERANCES) -> MuRegion:
-    """The region of an RS mode from Appendix B and inequalities (39)-(41).
-
-    Raises
-    ------
-    ModeError
-        If ``mode`` is not an RS mode of the scene.
-    """
-    source = "Appendix B, eqs. (39)-(41), (58)-(60)"
-    mode = check_mode_fits(scene, mode)
-    if mode.kind != "RS":
-        raise ModeError(f"mode {mode.letters}: Appendix B covers RS modes; got a {mode.kind} mode")
-    status, kin = mode_kinematics(scene, mode, tol)
-    if kin is None:
-        return _empty(mode, status, scene.n_contacts, source)
-    (r,), (s,) = mode.rolling, mode.sliding
-    xi = kin.xi[0]
-    co = appendix_b(scene.Wn[:, r], scene.Wt[:, r], scene.Wn[:, s], scene.Wt[:, s], scene.g_obj, xi[s])
-    rs = tuple(sorted((r, s)))
-    den = Multilinear.from_terms(rs, {(s,): co.A, (): co.B})
-    c_nS = Multilinear.from_terms(rs, {(): co.D3})
-    rolled = {(r, s): co.C1, (r,): co.D1}
-    plus = Multilinear.from_terms(rs, {**rolled, (s,): co.C2, (): co.D2})  # (40), second line with +
-    minus = Multilinear.from_terms(rs, {**rolled, (s,): -co.C2, (): -co.D2})
-    c_nR = Multilinear.from_terms(rs, {(s,): co.C1, (): co.D1})  # c_nR >= 0 (eq. 9); (40)-(41) imply it only for mu_R > 0
-    labels = (
-        f"c_n{s + 1} >= 0", f"mu{r + 1} c_n{r + 1} + c_t{r + 1} >= 0", f"mu{r + 1} c_n{r + 1} - c_t{r + 1} >= 0",
-        f"c_n{r + 1} >= 0",
-    )  # fmt: skip
-    return MuRegion(mode, status, xi, den, (c_nS, plus, minus, c_nR), labels, source)

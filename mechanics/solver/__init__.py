@@ -1,1 +1,9 @@
-"""All feasible contact modes of a scene: the batched test (eqs. 24-28), chunks, and the exact pruned search."""
+"""Every feasible contact mode of a scene (Sections 3.1-3.2, 4.7), layered bottom to top.
+
+* :mod:`.result` - :class:`SolveResult` (counts per status sum to eq. 49) and the merge of partial results
+* :mod:`.batch` - one batch of modes through the kinematic and equilibrium stages (eqs. 23-28), and the in-process stream
+* :mod:`.chunks` - the stream split into chunks of batches on local processes or a Dask cluster
+* :mod:`.breaking_sets` - breaking sets that admit equilibrium (eqs. 17, 26, 28 relaxed), one LP each
+* :mod:`.search` - the exact pruned search over those breaking sets
+* :mod:`.all_modes` - the public :func:`solve`, choosing among the three
+"""

@@ -1,8 +1,8 @@
 """The batch solve of every contact mode (eqs. 24-28, 49) split into chunks of consecutive batches.
 
-:func:`mechanics.solver.solve` streams the modes in batches
+:func:`qsplan.mechanics.solve` streams the modes in batches
 (:func:`mechanics.modes.iter_mode_batches`).  Here the batches are numbered, split
-into contiguous ranges, and each range is solved by ``solve(..., batches=(lo, hi))``
+into contiguous ranges, and each range is solved by ``solve_batches(..., batches=(lo, hi))``
 in its own process (:func:`mechanics.parallel.map_chunks`).  Every batch is the
 same one the single-process solve would form, so every mode gets bit-identical
 numbers, and merging in range order keeps the enumeration order of the solutions
@@ -13,8 +13,10 @@ from __future__ import annotations
 
 from qsplan.mechanics.modes.contact_mode import count_modes, iter_mode_batches
 from qsplan.mechanics.parallel import chunk_count, map_chunks, split_range
+from qsplan.mechanics.solver.batch import solve_batches
+from qsplan.mechanics.solver.result import merge_results
 
-__all__ = ["MIN_CHUNK_MODES", "solve_in_chunks", "merge_results"]
+__all__ = ["MIN_CHUNK_MODES", "solve_in_chunks"]
 
 #: Fewest modes worth a chunk of their own: one core tests ~2.5e5 modes/s (n_c = 12..14),
 #: so 65536 modes are ~0.25 s.  Two workers gained nothing on n_c = 12 (73789 modes,
@@ -24,27 +26,8 @@ MIN_CHUNK_MODES = 65536
 
 def _solve_chunk(job):
     """One range of batches, in the process that runs it."""
-    from qsplan.mechanics.solver.batch import solve
-
     scene, tol, batch, residuals, keep_statuses, lo, hi = job
-    return solve(scene, tol, batch, residuals, keep_statuses, workers=1, batches=(lo, hi))
-
-
-def merge_results(parts):
-    """One :class:`~mechanics.solver.SolveResult` from the results of consecutive batch ranges.
-
-    Solutions and statuses are concatenated in range order (the enumeration order),
-    counts per status summed.
-    """
-    from dataclasses import replace
-
-    counts = dict.fromkeys(parts[0].counts, 0)
-    for p in parts:
-        for k, v in p.counts.items():
-            counts[k] += v
-    solutions = tuple(s for p in parts for s in p.solutions)
-    statuses = None if parts[0].statuses is None else tuple(s for p in parts for s in p.statuses)
-    return replace(parts[0], solutions=solutions, counts=counts, statuses=statuses)
+    return solve_batches(scene, tol, batch, residuals, keep_statuses, (lo, hi))
 
 
 def solve_in_chunks(scene, tol, batch, residuals, keep_statuses, *, workers=None, scheduler=None):

@@ -5,7 +5,7 @@ The paper lists as future work finding all solutions without testing all
 in three steps, each exact:
 
 1. Breaking sets that admit no equilibrium are pruned with all their modes
-   (:mod:`mechanics.breaking_sets`: one linear programme per Apriori candidate).
+   (:mod:`qsplan.mechanics.solver.breaking_sets`: one linear programme per Apriori candidate).
    On random planted scenes all but a few percent of the modes go here, while
    kinematic relaxations (one per rolling set) rarely fail, which is why the
    search runs over breaking sets.
@@ -14,7 +14,7 @@ in three steps, each exact:
    ``p x p`` solve, and modes whose breaking contacts clearly penetrate go
    (:func:`penetrates`), without the ``dof x dof`` solve of eq. (24).
 3. The rest are tested by the plain batch stages
-   (:func:`mechanics.solver.solve_batch`), so every reported solution is exactly
+   (:func:`qsplan.mechanics.solver.batch.solve_batch`), so every reported solution is exactly
    the reference's.
 
 Modes of steps 1 and 2 are counted under :data:`PRUNED` and
@@ -31,11 +31,13 @@ from math import comb
 import numpy as np
 
 from qsplan.mechanics.solver.breaking_sets import feasible_breaking_sets
-from qsplan.mechanics.modes.reference import velocity_scale
-from qsplan.mechanics.modes.contact_mode import _combinations, count_modes, mode_order_key
+from qsplan.mechanics.modes.contact_mode import Letter, combinations_array, count_modes, mode_order_key
+from qsplan.mechanics.modes.kinematics import ScenePool, velocity_scale
 from qsplan.mechanics.numerics import DEFAULT_TOLERANCES, Status, Tolerances, hadamard_ratio
 from qsplan.mechanics.parallel import chunk_count, map_chunks
 from qsplan.mechanics.model.scene import Scene
+from qsplan.mechanics.solver.batch import solve_batch
+from qsplan.mechanics.solver.result import SolveResult
 
 __all__ = [
     "PRUNED",
@@ -72,9 +74,9 @@ MIN_TEST_CHUNK = 16384
 
 def _codes(n_c: int, A: np.ndarray, R: np.ndarray) -> np.ndarray:
     """Letter codes (0 B, 1 R, 2 S) of the modes with contacts ``A`` not breaking and rolling sets ``R`` (m, r)."""
-    codes = np.zeros((R.shape[0], n_c), dtype=np.uint8)
-    codes[:, A] = 2
-    codes[np.arange(R.shape[0])[:, None], R] = 1
+    codes = np.full((R.shape[0], n_c), Letter.B, dtype=np.uint8)
+    codes[:, A] = Letter.S
+    codes[np.arange(R.shape[0])[:, None], R] = Letter.R
     return codes
 
 
@@ -100,8 +102,8 @@ def _n_modes(n_c, dof, B) -> int:
 
 @lru_cache(maxsize=64)
 def _positions(n: int, k: int) -> np.ndarray:
-    """:func:`mechanics.modes._combinations`, cached: every breaking set of one size reuses it."""
-    out = _combinations(n, k)
+    """:func:`qsplan.mechanics.modes.contact_mode.combinations_array`, cached: every breaking set of one size reuses it."""
+    out = combinations_array(n, k)
     out.setflags(write=False)
     return out
 
@@ -165,8 +167,6 @@ def _test_chunk(job):
     """Test the modes of some breaking sets: the reduced penetration test, then the batch stages.
 
     Returns (counts, solutions)."""
-    from qsplan.mechanics.solver.batch import ScenePool, solve_batch
-
     scene, tol, batch, residuals, sets = job
     n_c, dof = scene.n_contacts, scene.dof
     pool = ScenePool(scene)
@@ -205,11 +205,9 @@ def search_solve(scene: Scene, tol: Tolerances = DEFAULT_TOLERANCES, batch: int 
                  workers=1, scheduler=None):  # fmt: skip
     """Every feasible mode of ``scene``, testing only modes whose breaking set admits equilibrium.
 
-    Same arguments and result as :func:`mechanics.solver.solve`; the counts carry
+    Same arguments and result as :func:`qsplan.mechanics.solve`; the counts carry
     :data:`PRUNED` for the modes never tested, and still sum to eq. (49).
     """
-    from qsplan.mechanics.solver.batch import SolveResult
-
     n_c, dof = scene.n_contacts, scene.dof
     total = count_modes(n_c, dof)
     sets, _ = feasible_breaking_sets(scene, tol, workers=workers, scheduler=scheduler)

@@ -26,7 +26,8 @@ def add_parser(sub):
 
 def run(args, out) -> int:
     from qsplan.mechanics import QsplanError, load_scene, mode_from_letters
-    from qsplan.mechanics.bands.effort import effort_band, guaranteed_band_box, guaranteed_band_shared
+    from qsplan.mechanics.bands.effort import effort_band
+    from qsplan.mechanics.bands.guaranteed import guaranteed_band_box, guaranteed_band_shared
 
     scene = load_scene(args.scene)
     mode = mode_from_letters(args.mode, scene.n_contacts)

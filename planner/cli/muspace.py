@@ -23,6 +23,8 @@ from __future__ import annotations
 import json
 import re
 
+from qsplan.planner.cli.options import add_parallel_options, parallel_options
+
 __all__ = ["add_parser", "run", "MAX_N"]
 
 #: Largest grid (per axis) the command accepts: 4096^2 points stay within a few seconds and ~1 GB.
@@ -41,8 +43,6 @@ def add_parser(subparsers):
     p.add_argument("--n", type=int, required=True, metavar="N", help=f"samples per axis (2..{MAX_N})")
     p.add_argument("--json", action="store_true", help="machine-readable cells on stdout")
     p.add_argument("--out", metavar="FILE.png", help="write the map (png, svg or pdf)")
-    from qsplan.planner.cli.main import add_parallel_options
-
     add_parallel_options(p)
     return p
 
@@ -117,14 +117,12 @@ def _write_figure(sl, path, source):
     plot_mu_map(sl, ax=axes[0, 0], title=f"{Path(source).name}" + (f": {fixed}" if fixed else ""))
     from qsplan.planner.plotting.style import save_figure
 
-    save_figure(fig, path)
+    save_figure(fig, path, option="--out")
 
 
 def run(args, out) -> int:
     from qsplan.mechanics import load_scene
-    from qsplan.mechanics.muspace.maps import mu_slice
-
-    from qsplan.planner.cli.main import parallel_options
+    from qsplan.mechanics.muspace.slices import mu_slice
 
     scene = load_scene(args.scene)
     x, y, base, xs = _parse(args, scene)

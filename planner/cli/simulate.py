@@ -170,7 +170,7 @@ def _write_figure(motion, cf, path):
     fig = rod_motion_figure(motion, closed_form=cf)
     from qsplan.planner.plotting.style import save_figure
 
-    save_figure(fig, path)
+    save_figure(fig, path, option="--out")
 
 
 def run(args, out) -> int:

@@ -7,17 +7,18 @@
                  [--display-limit L] [--out DIR] [--force] [--no-plots] [--json]
                  [--workers N] [--scheduler ADDRESS]
 
-Builds the default two-finger hand (:func:`hands.two_finger.default_hand`) and the
+Builds the default two-finger hand (:func:`qsplan.hands.default_hand`) and the
 segment (1: translate the workpiece left until the left finger meets its longest
 edge), samples it at N instants over T seconds and computes, for the
 effort-controlled finger: the desired mode's band without friction (Fig. 10) and
 at mu = HI (Fig. 11), the competing modes' bands at mu = HI (Fig. 12) and the
 band guaranteeing the mode and precluding every competitor for friction in
 [LO, HI] (Fig. 13; independent per contact, or with ``--shared-mu`` one shared
-coefficient), exactly, beside the paper's sampled method with K values.
+coefficient), exactly, beside the paper's sampled method with K values: all by
+:func:`qsplan.planner.reports.segment.sweep_segment`.
 
 Into DIR (default ``out/sweep``) it writes ``segment1.csv`` and ``segment1.json``
-(the torque schedule: see :mod:`planner.export`) and, unless ``--no-plots``,
+(the torque schedule: see :mod:`qsplan.planner.export.schedule`) and, unless ``--no-plots``,
 ``fig10_frictionless.png``, ``fig11_mu_high.png``, ``fig12_competitors.png``,
 ``fig13_guaranteed.png`` and ``hand_strip.png``.  Existing files are not
 overwritten without ``--force`` (checked before anything is written).
@@ -39,9 +40,10 @@ from __future__ import annotations
 import json
 import math
 
+from qsplan.planner.cli.options import add_parallel_options, parallel_options
+
 __all__ = ["add_parser", "run"]
 
-_PLOTS = ("fig10_frictionless", "fig11_mu_high", "fig12_competitors", "fig13_guaranteed", "hand_strip")
 
 
 def add_parser(subparsers):
@@ -65,8 +67,6 @@ def add_parser(subparsers):
     p.add_argument("--force", action="store_true", help="overwrite existing files in DIR")
     p.add_argument("--no-plots", action="store_true", help="write the schedule only")
     p.add_argument("--json", action="store_true", help="machine-readable summary on stdout")
-    from qsplan.planner.cli.main import add_parallel_options
-
     add_parallel_options(p)
     return p
 
@@ -74,9 +74,7 @@ def add_parser(subparsers):
 def _check(args):
     from qsplan.mechanics import QsplanError
 
-    from qsplan.planner.cli.main import parallel_options
-
-    parallel_options(args)
+    parallel = parallel_options(args)
     lo, hi = args.mu_range
     if not (math.isfinite(lo) and math.isfinite(hi)) or lo < 0 or lo > hi:
         raise QsplanError(f"--mu-range: expected 0 <= LO <= HI (finite); got {lo} {hi}")
@@ -90,102 +88,26 @@ def _check(args):
                       ("--display-limit", args.display_limit)):  # fmt: skip
         if v is not None and not (math.isfinite(v) and v > 0):
             raise QsplanError(f"{option}: expected a positive finite torque (N m); got {v}")
-
-
-def _planned_files(args):
-    from pathlib import Path
-
-    out = Path(args.out)
-    files = [out / "segment1.csv", out / "segment1.json"]
-    if not args.no_plots:
-        files += [out / f"{name}.png" for name in _PLOTS]
-    return files
-
-
-def _runs(runs):
-    return [[round(a, 9), round(b, 9)] for a, b in runs]
-
-
-def _narrow(sweep):
-    from qsplan.planner.torque.sweep import narrowest
-
-    k, w = narrowest(sweep)
-    if k is None:
-        return None
-    return {"t": float(sweep.t[k]), "width": w, "lower": float(sweep.lower[k]), "upper": float(sweep.upper[k])}
-
-
-def _document(args, sb, files):
-    import numpy as np
-
-    from qsplan.mechanics.modes.contact_mode import ContactMode
-
-    from qsplan.planner.torque.sweep import TOUCH_RTOL
-
-    S = sb.samples
-    seg = S.segment
-    g = sb.guaranteed
-    band = g.band
-    s = sb.sampled
-    both = band.feasible & s.feasible
-    with np.errstate(invalid="ignore"):
-        tol = TOUCH_RTOL * np.maximum(1.0, np.abs(band.lower))
-        wider = both & ((s.lower < band.lower - tol) | (s.upper > band.upper + tol))
-    comps = {}
-    for c, sw in sb.competitors_at_high_mu.items():
-        comps[c] = {"name": f"{ContactMode(c).kind} ({ContactMode(c).name})", "feasible_at_mu_high": _runs(sw.feasible_spans())}
-    return {
-        "segment": seg.name, "duration": seg.duration, "samples": len(S), "mode": band.mode,
-        "effort_joint": seg.effort_joint, "velocity_joint": S.scenes[0].joint_names[seg.velocity_index],
-        "mu_range": list(g.mu_range), "shared_mu": g.shared,
-        "competitors": comps,
-        "frictionless_upper_infinite": _runs(sb.frictionless.infinite_upper_spans()),
-        "mu_high_upper_infinite": _runs(sb.at_high_mu.infinite_upper_spans()),
-        "guaranteed": {"exact": bool(band.exact[band.feasible].all()), "points_without_band": int((~band.feasible).sum()),
-                       "split_points": int(g.split.sum()), "narrowest": _narrow(band)},
-        "paper_method": {"samples": args.paper_samples, "narrowest": _narrow(s), "wider_than_exact_points": int(wider.sum())},
-        "safety_margin": sb.safety_margin, "max_margin": sb.max_margin,
-        "command_max": float(np.nanmax(sb.command)) if np.isfinite(sb.command).any() else None,
-        "files": [str(f) for f in files],
-    }  # fmt: skip
+    return parallel
 
 
 def run(args, out) -> int:
-    from qsplan.hands.segments import first_segment, sample_segment
-    from qsplan.hands.two_finger import default_hand
-    from qsplan.mechanics import QsplanError
+    from qsplan.hands import default_hand, first_segment, sample_segment
 
-    from qsplan.planner.torque.sweep import segment_bands
+    from qsplan.planner.reports.segment import sweep_segment
 
-    _check(args)
-    planned = _planned_files(args)
-    clash = [str(p) for p in planned if p.exists()]
-    if clash and not args.force:
-        raise QsplanError(f"--out: {clash[0]!r} exists ({len(clash)} of the output files do); "
-                          "pass --force to overwrite or choose another --out")  # fmt: skip
-    seg = first_segment(default_hand(), duration=args.duration, effort_joint=args.effort_joint)
-    samples = sample_segment(seg, args.samples)
-    from qsplan.planner.cli.main import parallel_options
-
-    sb = segment_bands(samples, tuple(args.mu_range), args.shared_mu, args.paper_samples, args.safety_margin,
-                       args.max_margin, **parallel_options(args))  # fmt: skip
-    from qsplan.planner.export.schedule import export_schedule
-
-    files = export_schedule(sb, args.out, force=True)
-    if not args.no_plots:
-        from qsplan.planner.plotting.bands import segment_band_figures
-        from qsplan.planner.plotting.style import save_figure
-
-        for name, fig in segment_band_figures(sb, args.display_limit).items():
-            path = f"{args.out}/{name}.png"
-            save_figure(fig, path)
-            files.append(path)
-    doc = _document(args, sb, files)
+    parallel = _check(args)
+    samples = sample_segment(first_segment(default_hand(), duration=args.duration, effort_joint=args.effort_joint),
+                             args.samples)  # fmt: skip
+    result = sweep_segment(samples, args.out, tuple(args.mu_range), shared=args.shared_mu,
+                           paper_samples=args.paper_samples, safety_margin=args.safety_margin,
+                           max_margin=args.max_margin, display_limit=args.display_limit, force=args.force,
+                           plots=not args.no_plots, **parallel)  # fmt: skip
     if args.json:
-        json.dump(doc, out)
+        json.dump(result.document, out)
         out.write("\n")
         return 0
-    _summary(doc, out)
+    _summary(result.document, out)
     return 0
 
 

@@ -1,6 +1,6 @@
 """Export a whole two-finger plan: one torque schedule (CSV and JSON) for every phase, in time order.
 
-The columns are those of :mod:`planner.export` (the band issue's format), for
+The columns are those of :mod:`qsplan.planner.export.schedule` (the band issue's format), for
 both joints since the effort-controlled finger changes between segments, then
 extra columns (extended, never renamed)::
 
@@ -20,20 +20,20 @@ extra columns (extended, never renamed)::
 
 Times are continuous over the plan; a phase's last row and the next phase's first
 row share a time (the switch).  Unbounded band sides are ``inf`` (CSV) / ``null``
-(JSON), as in :mod:`planner.export`.  Files are never overwritten without ``force``.
+(JSON), as in :mod:`qsplan.planner.export.schedule`.  Files are never overwritten without ``force``.
 """
 
 from __future__ import annotations
 
 import json
 import math
-from pathlib import Path
 
 import numpy as np
 
 from qsplan.mechanics.errors import QsplanError
 
-from qsplan.planner.export.schedule import FORMAT, VERSION, _cell, _check_free
+from qsplan.planner.export.files import check_out_dir, check_outputs, csv_cell, json_value
+from qsplan.planner.export.schedule import FORMAT, VERSION
 
 __all__ = ["PLAN_FORMAT", "plan_columns", "plan_metadata", "export_plan", "read_plan_csv"]
 
@@ -45,7 +45,7 @@ _UNITS = {"t": "s", "q": "rad", "qd": "rad/s", "tau": "N m", "margin": "N m", "x
 
 def plan_columns(plan) -> tuple:
     """The plan as ordered columns ``{name: list}`` and units ``{name: str or None}``."""
-    from qsplan.planner.planning.plan import ContactSegmentPlan
+    from qsplan.planner.planning.results import ContactSegmentPlan
 
     names = ("left", "right")
     order = ["t", *(f"q_{n}" for n in names), *(f"qd_{n}" for n in names)]
@@ -83,7 +83,7 @@ def plan_columns(plan) -> tuple:
 
 def plan_metadata(plan) -> dict:
     """What a controller engineer needs to trust the plan (all SI)."""
-    from qsplan.planner.planning.plan import ContactSegmentPlan
+    from qsplan.planner.planning.results import ContactSegmentPlan
 
     task = plan.task
     h = task.hand
@@ -121,23 +121,17 @@ def _num(v):
     return float(v) if v is not None and math.isfinite(v) else None
 
 
-def _json_value(v):
-    return None if isinstance(v, float) and not math.isfinite(v) else v
-
-
 def export_plan(plan, out_dir, stem: str = "plan", force: bool = False) -> list:
     """Write ``<stem>.csv`` and ``<stem>.json`` into ``out_dir`` (checked before writing); returns the paths."""
     import csv
 
-    out = Path(out_dir)
-    if out.exists() and not out.is_dir():
-        raise QsplanError(f"--out: {str(out)!r} is a file; expected a directory")
+    out = check_out_dir(out_dir)
     paths = [out / f"{stem}.csv", out / f"{stem}.json"]
-    _check_free(paths, force)
+    check_outputs(paths, force)
     cols, units = plan_columns(plan)
     names = list(cols)
     doc = {"format": PLAN_FORMAT, "version": VERSION, "columns": names, "units": units,
-           "data": {k: [_json_value(v) for v in vals] for k, vals in cols.items()}, "metadata": plan_metadata(plan),
+           "data": {k: [json_value(v) for v in vals] for k, vals in cols.items()}, "metadata": plan_metadata(plan),
            "null": "tau_<joint>_min: unbounded below; tau_<joint>_max: unbounded above; elsewhere: not applicable "
                    "(the joint is velocity-controlled, or a regrasp row)"}  # fmt: skip
     text = json.dumps(doc, indent=1, allow_nan=False) + "\n"  # before writing anything: no half-written files
@@ -147,11 +141,11 @@ def export_plan(plan, out_dir, stem: str = "plan", force: bool = False) -> list:
             w = csv.writer(f, lineterminator="\n")
             w.writerow(names)
             for row in zip(*(cols[n] for n in names)):
-                w.writerow([_cell(v) for v in row])
+                w.writerow([csv_cell(v) for v in row])
         with open(paths[1], "w") as f:
             f.write(text)
     except OSError as exc:
-        raise QsplanError(f"--out: cannot write into {str(out)!r}: {exc.strerror or exc}") from None
+        raise QsplanError(f"out_dir: cannot write into {str(out)!r}: {exc.strerror or exc}") from None
     return paths
 
 

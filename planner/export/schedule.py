@@ -31,10 +31,11 @@ from __future__ import annotations
 
 import csv
 import json
-import math
 from pathlib import Path
 
 from qsplan.mechanics.errors import QsplanError
+
+from qsplan.planner.export.files import check_out_dir, check_outputs, csv_cell, json_value
 
 __all__ = ["FORMAT", "VERSION", "export_schedule", "schedule_columns", "schedule_metadata", "write_csv", "write_json"]
 
@@ -47,7 +48,7 @@ def schedule_columns(bands) -> tuple:
 
     Parameters
     ----------
-    bands : planner.bands_sweep.SegmentBands
+    bands : qsplan.planner.torque.sweep.SegmentBands
 
     Returns
     -------
@@ -86,7 +87,7 @@ def schedule_metadata(bands) -> dict:
     """What a controller engineer needs to trust the schedule (all SI)."""
     from qsplan.mechanics.modes.contact_mode import ContactMode
 
-    from qsplan.planner.torque.sweep import narrowest
+    from qsplan.planner.torque.pointwise import narrowest
     from qsplan.mechanics.bands.preclusion import PRECLUSION_RTOL
 
     S = bands.samples
@@ -135,24 +136,10 @@ def schedule_metadata(bands) -> dict:
     }  # fmt: skip
 
 
-def _check_free(paths, force: bool):
-    for p in paths:
-        if p.exists() and not force:
-            raise QsplanError(f"--out: {str(p)!r} exists; pass --force to overwrite it or choose another directory")
-        if p.exists() and p.is_dir():
-            raise QsplanError(f"--out: {str(p)!r} is a directory; cannot write the schedule there")
-
-
-def _cell(v):
-    if isinstance(v, str):
-        return v
-    return repr(float(v))
-
-
 def write_csv(bands, path, force: bool = False) -> Path:
     """Write the schedule as CSV (see the module docstring); returns the path."""
     path = Path(path)
-    _check_free([path], force)
+    check_outputs([path], force)
     cols, _ = schedule_columns(bands)
     names = list(cols)
     try:
@@ -161,29 +148,23 @@ def write_csv(bands, path, force: bool = False) -> Path:
             w = csv.writer(f, lineterminator="\n")
             w.writerow(names)
             for row in zip(*(cols[n] for n in names)):
-                w.writerow([_cell(v) for v in row])
+                w.writerow([csv_cell(v) for v in row])
     except OSError as exc:
-        raise QsplanError(f"--out: cannot write {str(path)!r}: {exc.strerror or exc}") from None
+        raise QsplanError(f"out_dir: cannot write {str(path)!r}: {exc.strerror or exc}") from None
     return path
-
-
-def _json_value(v):
-    if isinstance(v, float) and not math.isfinite(v):
-        return None
-    return v
 
 
 def write_json(bands, path, force: bool = False) -> Path:
     """Write the schedule as JSON with units and metadata (see the module docstring); returns the path."""
     path = Path(path)
-    _check_free([path], force)
+    check_outputs([path], force)
     cols, units = schedule_columns(bands)
     doc = {
         "format": FORMAT,
         "version": VERSION,
         "columns": list(cols),
         "units": units,
-        "data": {k: [_json_value(v) for v in vals] for k, vals in cols.items()},
+        "data": {k: [json_value(v) for v in vals] for k, vals in cols.items()},
         "metadata": schedule_metadata(bands),
         "null": "tau_<joint>_min: unbounded below; tau_<joint>_max: unbounded above; elsewhere: no guaranteed band",
     }
@@ -193,7 +174,7 @@ def write_json(bands, path, force: bool = False) -> Path:
             json.dump(doc, f, indent=1, allow_nan=False)
             f.write("\n")
     except OSError as exc:
-        raise QsplanError(f"--out: cannot write {str(path)!r}: {exc.strerror or exc}") from None
+        raise QsplanError(f"out_dir: cannot write {str(path)!r}: {exc.strerror or exc}") from None
     return path
 
 
@@ -206,9 +187,7 @@ def export_schedule(bands, out_dir, stem: str = "segment1", force: bool = False)
     -------
     list of pathlib.Path
     """
-    out = Path(out_dir)
-    if out.exists() and not out.is_dir():
-        raise QsplanError(f"--out: {str(out)!r} is a file; expected a directory")
+    out = check_out_dir(out_dir)
     paths = [out / f"{stem}.csv", out / f"{stem}.json"]
-    _check_free(paths, force)
+    check_outputs(paths, force)
     return [write_csv(bands, paths[0], force=True), write_json(bands, paths[1], force=True)]

@@ -2,7 +2,7 @@
 
 :func:`failure_report` samples the straight line between a segment's start and
 goal (the only route in its one configuration variable) and judges each
-configuration with :func:`planner.plan.check_contact_state`.  Where the band is
+configuration with :func:`qsplan.planner.planning.contact_state.check_contact_state`.  Where the band is
 narrower than the torque resolution it names the cause: the desired mode's own
 guaranteed band (then the friction values at the box corners where its lower
 and upper edges are attained), or a competing mode possible inside it (eq. 28);
@@ -17,7 +17,7 @@ from itertools import product
 
 import numpy as np
 
-__all__ = ["ClosedPoint", "FailureReport", "failure_report"]
+__all__ = ["ClosedPoint", "ConfigurationReport", "FailureReport", "configuration_report", "failure_report"]
 
 #: Configurations sampled along the straight line of a failed segment.
 REPORT_SAMPLES = 21
@@ -111,10 +111,78 @@ class FailureReport:
                                            "desired_width_N_m": _num(p.desired_width), "competitors": list(p.competitors),
                                            "mu_lower_edge": p.mu_lower_edge, "mu_upper_edge": p.mu_upper_edge}  # fmt: skip
 
-        return {"segment": self.segment, "x_start_m": self.x_start, "x_goal_m": self.x_goal,
+        return {"kind": "band closes", "segment": self.segment, "x_start_m": self.x_start, "x_goal_m": self.x_goal,
                 "effort_joint": self.effort_joint, "resolution_N_m": self.resolution, "mu_range": list(self.mu_range),
                 "planner_status": self.planner_status, "closed": [point(p) for p in self.closed],
                 "narrowest": point(self.narrowest), "mu_closes": self.mu_closes, "message": self.message}  # fmt: skip
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class ConfigurationReport:
+    """Why a plan is refused at one configuration: a start, goal or regrasp pose, or a state on a path,
+    where a joint is beyond its limit, two bodies overlap, there is no grasp or OMPL found no motion.
+
+    Attributes
+    ----------
+    phase : str
+        The segment or regrasp concerned.
+    where : str
+        Which configuration, in words ("the start", "the goal", ...).
+    x : float
+        Workpiece x (m).
+    q : tuple of float or None
+        Joint angles (rad), None where no grasp exists.
+    reason : str
+    bodies : tuple of str
+        The two overlapping bodies ("left finger", "right finger", "palm", "workpiece"), or ().
+    overlap_area, overlap_depth : float or None
+        Of that overlap (m^2, m).
+    planner_status : str
+        OMPL's status ("not run" when refused before planning).
+    """
+
+    phase: str
+    where: str
+    x: float
+    q: tuple | None
+    reason: str
+    bodies: tuple = ()
+    overlap_area: float | None = None
+    overlap_depth: float | None = None
+    planner_status: str = "not run (start or goal invalid)"
+
+    @property
+    def message(self) -> str:
+        at = f"workpiece x = {self.x:.4g} m" + ("" if self.q is None else f", q = {[round(v, 4) for v in self.q]} rad")
+        return f"no plan: {self.reason} at {self.where} ({at}; {self.phase})"
+
+    def as_dict(self) -> dict:
+        return {"kind": "invalid configuration", "segment": self.phase, "where": self.where, "x_m": self.x,
+                "q_rad": None if self.q is None else list(self.q), "reason": self.reason, "bodies": list(self.bodies),
+                "overlap_area_m2": self.overlap_area, "overlap_depth_m": self.overlap_depth,
+                "planner_status": self.planner_status, "message": self.message}  # fmt: skip
+
+
+def configuration_report(task, phase, where, x, q, reason=None, planner_status=None) -> ConfigurationReport:
+    """The report of configuration ``q`` (rad, or None) at workpiece ``x`` (m): ``reason`` if given, else what
+    :func:`qsplan.planner.planning.contact_state.configuration_problem` finds (with the colliding bodies)."""
+    from qsplan.planner.planning.collision import find_collisions
+    from qsplan.planner.planning.contact_state import limit_problem
+
+    kw = {} if planner_status is None else {"planner_status": planner_status}
+    if q is None:
+        return ConfigurationReport(phase, where, float(x), None, reason or "no grasp", **kw)
+    q = np.asarray(q, float)
+    qt = tuple(float(v) for v in q)
+    if reason is None:
+        reason = limit_problem(task, q)
+    if reason is None:
+        hit = find_collisions(task.hand, task.pose(x), q, first=True)
+        if hit:
+            c = hit[0]
+            return ConfigurationReport(phase, where, float(x), qt, c.message, c.bodies, c.area, c.depth, **kw)
+        reason = "the configuration is valid"
+    return ConfigurationReport(phase, where, float(x), qt, reason, **kw)
 
 
 def _num(v):
@@ -126,7 +194,7 @@ def _edge_corners(task, x, effort, direction):
     from qsplan.mechanics.bands.effort import effort_bands
     from qsplan.mechanics.modes.contact_mode import ContactMode
 
-    from qsplan.planner.planning.plan import MODE, contact_samples
+    from qsplan.planner.planning.contact_state import MODE, contact_samples
 
     lo, hi = task.mu_range
     scene = contact_samples(task, [x], effort, direction * task.workpiece_speed).scenes[0]
@@ -142,7 +210,7 @@ def _edge_corners(task, x, effort, direction):
 
 def failure_report(task, name, x0, x1, effort, direction, competitors, result=None, xs=None) -> FailureReport:
     """The report for a segment from ``x0`` to ``x1`` (m) with no plan (see the module docstring)."""
-    from qsplan.planner.planning.plan import check_contact_state
+    from qsplan.planner.planning.contact_state import check_contact_state
 
     xs = np.linspace(x0, x1, REPORT_SAMPLES) if xs is None else np.asarray(xs, float)
     if xs.size > REPORT_SAMPLES:
@@ -174,7 +242,7 @@ def _mu_closes(task, x, effort, direction, competitors, iterations=30):
     """The friction upper bound at which the band at ``x`` shrinks to the resolution (bisection), or None."""
     from dataclasses import replace as dc_replace
 
-    from qsplan.planner.planning.plan import check_contact_state
+    from qsplan.planner.planning.contact_state import check_contact_state
 
     lo, hi = task.mu_range
 

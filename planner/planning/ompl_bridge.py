@@ -8,7 +8,11 @@ with the path as an array.  It follows the verified recipes of
 
 * the RNG is seeded before any space or planner is created, and planners are
   stopped by an iteration budget when ``deterministic`` is asked for (a time
-  budget makes anytime planners differ from run to run);
+  budget makes anytime planners differ from run to run), except the PRM family
+  (:data:`TIMED_PLANNERS`): PRM checks for solutions in a second thread that
+  would wait forever for Python's global lock to evaluate a Python termination
+  condition or objective, so it is stopped by OMPL's own timer (C++, no Python)
+  and takes no ``state_cost``;
 * OMPL's console output is silenced unless ``verbose``;
 * the validity checker returns a real Python ``bool``;
 * paths are copied to numpy at once and no OMPL object outlives the call
@@ -31,10 +35,15 @@ import numpy as np
 
 from qsplan.mechanics import QsplanError
 
-__all__ = ["PlannerOptions", "PlanResult", "plan_path", "PLANNERS", "ompl_available"]
+__all__ = ["PlannerOptions", "PlanResult", "plan_path", "PLANNERS", "TIMED_PLANNERS", "ompl_available"]
 
 #: Geometric planners offered (all bound in ompl 2.0.1).
 PLANNERS = ("RRTConnect", "RRT", "RRTstar", "BITstar", "PRM", "KPIECE1")
+
+#: Planners that search in a second thread (the PRM family): stopped by OMPL's timer, never by a Python
+#: callable, and never given a Python objective (either hangs the process: the thread waits for the GIL
+#: that ``solve`` holds).  Not deterministic: the thread's timing changes the roadmap.
+TIMED_PLANNERS = ("PRM",)
 
 
 def ompl_available() -> bool:
@@ -55,19 +64,22 @@ class PlannerOptions:
     planner : str
         One of :data:`PLANNERS`.
     time_limit : float
-        Seconds; the planner stops when it runs out (with ``deterministic`` it stops
-        at the iteration budget or the time limit, whichever comes first).
+        Seconds for the whole query, solve and simplification; the planner stops when it runs
+        out (with ``deterministic`` it stops at the iteration budget or the time limit, whichever
+        comes first).
     iterations : int
         Iteration budget (calls of the termination check) when ``deterministic``.
     deterministic : bool
-        Seeded and stopped by iterations, so that the same inputs give the same path.
+        Seeded and stopped by iterations, so that the same inputs give the same path (not for
+        :data:`TIMED_PLANNERS`, always stopped by the time limit alone).
     seed : int
         OMPL's global RNG seed.
     validity_resolution : float
         Fraction of the space's maximum extent between validity checks along a motion.
     simplify : bool
-        Shortcut and smooth the path (OMPL's simplifyMax, deterministic).  Skipped when a
-        ``state_cost`` is given: the shortcuts minimise length and would undo the cost.
+        Shortcut and smooth the path (OMPL's simplifier, to completion within what is left of
+        ``time_limit``: deterministic unless it runs out).  Skipped when a ``state_cost`` is
+        given: the shortcuts minimise length and would undo the cost.
     interpolate : int
         Number of states of the returned path (0: as planned); states are added
         along the path, each checked again.
@@ -163,7 +175,8 @@ def plan_path(
     Raises
     ------
     QsplanError
-        On malformed bounds or a start/goal outside them or invalid.
+        On malformed bounds or a start/goal outside them or invalid, or a ``state_cost`` with a planner
+        of :data:`TIMED_PLANNERS`.
     """
     try:
         from ompl import base as ob
@@ -172,6 +185,10 @@ def plan_path(
     except ImportError as exc:  # pragma: no cover - ompl is a dependency
         raise QsplanError(f"ompl: the OMPL Python bindings are not installed ({exc})") from None
 
+    timed = options.planner in TIMED_PLANNERS
+    if timed and state_cost is not None:
+        raise QsplanError(f"state_cost: {options.planner} cannot take a Python objective (its second thread would "
+                          f"wait forever for Python's global lock); use RRTstar or BITstar")  # fmt: skip
     low, high = np.asarray(low, float), np.asarray(high, float)
     start, goal = np.asarray(start, float), np.asarray(goal, float)
     d = low.size
@@ -227,7 +244,7 @@ def plan_path(
     ss.setPlanner(_planner(og, si, options.planner))
 
     t0 = time.perf_counter()
-    if options.deterministic:
+    if options.deterministic and not timed:
         count = [0]
         deadline = t0 + options.time_limit
 
@@ -241,14 +258,25 @@ def plan_path(
     status = ss.solve(ptc)
     exact = status.getStatus() == ob.PlannerStatus.EXACT_SOLUTION
     path = np.zeros((0, d))
+    straight = False
     if exact:
-        if options.simplify and state_cost is None:
-            ss.simplifySolution()
-        geo = og.PathGeometric(ss.getSolutionPath())  # a copy: nothing dangles after ss goes
-        if options.interpolate:
-            geo.interpolate(int(options.interpolate))
-        path = np.array([to_np(s) for s in geo.getStates()])
-        del geo
+        left = options.time_limit - (time.perf_counter() - t0)
+        if options.simplify and state_cost is None and left > 0:
+            # the straight line is what the simplifier ends with whenever it is valid (always in one
+            # dimension), and costs one motion check; else the simplifier, with what is left of the time
+            # limit by OMPL's timer (the same as simplifyMax when that suffices; its final B-spline
+            # smoothing does not look at the timer)
+            straight = si.checkMotion(s0, s1)
+            if not straight:
+                ss.simplifySolution(ob.timedPlannerTerminationCondition(left))
+        if straight:  # the line itself, with the states interpolate asks for (OMPL's interpolate spaces them evenly)
+            path = start + np.linspace(0.0, 1.0, max(2, int(options.interpolate)))[:, None] * (goal - start)
+        else:
+            geo = og.PathGeometric(ss.getSolutionPath())  # a copy: nothing dangles after ss goes
+            if options.interpolate:
+                geo.interpolate(int(options.interpolate))
+            path = np.array([to_np(s) for s in geo.getStates()])
+            del geo
     seconds = time.perf_counter() - t0
     text = str(status)
     del ss, si, space

@@ -3,7 +3,7 @@
 A plan promises that, for every friction coefficient in the task's interval, the
 commands of its torque file make the workpiece slide in the planned mode (4S) along
 each in-contact segment.  :func:`replay_plan` checks the promise the hard way: it
-reads the commands back from the exported columns (:func:`planner.plan_export.read_plan_csv`),
+reads the commands back from the exported columns (:func:`qsplan.planner.export.plan_files.read_plan_csv`),
 drives the hand with them through :func:`mechanics.motion.simulate` at a friction
 vector, and compares the simulated mode sequence and workpiece path with the plan's.
 
@@ -84,7 +84,7 @@ class ReplaySystem:
         return float(np.interp(t, self.t, self.velocity)), float(np.interp(t, self.t, self.effort))
 
     def scene(self, x, contacts):
-        from qsplan.hands.two_finger import hand_scene
+        from qsplan.hands.two_finger_scene import hand_scene
 
         if tuple(contacts) != (0, 1, 2, 3):
             raise QsplanError(f"contacts: the replay keeps all four contacts; got {tuple(contacts)}")
@@ -92,7 +92,7 @@ class ReplaySystem:
         return hand_scene(self.hand, x[:3], x[3:5], self.effort_joint, velocity=velocity, effort=effort)
 
     def rates(self, x, qdot, thetadot) -> np.ndarray:
-        from qsplan.mechanics.motion.simulator import pose_rate
+        from qsplan.mechanics.motion.system import pose_rate
 
         return np.concatenate([pose_rate(x[:3], qdot), np.asarray(thetadot, float), [1.0]])
 
@@ -164,12 +164,22 @@ class Replay:
         why = bad.stop or f"modes {' -> '.join(bad.labels)}"
         return f"mu = ({mu}): left the plan in phase {bad.phase} ({bad.planned_mode} planned): {why}"
 
+    def as_dict(self) -> dict:
+        """The ``replay.json`` entry (JSON has no NaN: ``null``)."""
+
+        def num(v):
+            return float(v) if np.isfinite(v) else None
+
+        return {"mu": [float(m) for m in self.mu], "followed": self.followed, "x_error_m": num(self.x_error),
+                "segments": [{"phase": s.phase, "planned_mode": s.planned_mode, "modes": list(s.labels), "stop": s.stop,
+                              "x_error_m": num(s.x_error), "x_end_m": num(s.x_end)} for s in self.segments]}  # fmt: skip
+
 
 def _start_modes(system, x0, mu) -> tuple:
     """Letters of every mode feasible at ``x0`` (the full solver, eqs. 13-28): the planned one alone, or the plan fails."""
     from dataclasses import replace
 
-    from qsplan.mechanics.solver.batch import solve
+    from qsplan.mechanics.solver.all_modes import solve
 
     scene = replace(system.scene(x0, (0, 1, 2, 3)), mu=np.asarray(mu, float))
     return tuple(solve(scene, residuals=False).feasible_modes)
@@ -185,7 +195,7 @@ def friction_samples(mu_range, n, seed=1, shared=False) -> list:
 
 
 def replay_segments(columns) -> list:
-    """Split plan columns (:func:`planner.plan_export.read_plan_csv`) into in-contact segments.
+    """Split plan columns (:func:`qsplan.planner.export.plan_files.read_plan_csv`) into in-contact segments.
 
     Returns
     -------
@@ -194,7 +204,7 @@ def replay_segments(columns) -> list:
     """
     for key in ("t", "phase", "mode", "effort_joint", "x_workpiece", "q_left", "q_right"):
         if key not in columns:
-            raise QsplanError(f"plan: column {key!r} missing; expected the columns of planner.plan_export")
+            raise QsplanError(f"plan: column {key!r} missing; expected the columns of qsplan.planner.export.plan_files")
     phases = np.asarray(columns["phase"], float).astype(int)
     out = []
     for p in np.unique(phases):
@@ -212,7 +222,7 @@ def replay_plan(columns, hand, mu, options=None) -> Replay:
     Parameters
     ----------
     columns : dict
-        The plan's columns as read by :func:`planner.plan_export.read_plan_csv`.
+        The plan's columns as read by :func:`qsplan.planner.export.plan_files.read_plan_csv`.
     hand : hands.two_finger.TwoFingerHand
         The task's hand.
     mu : float or array-like, shape (4,)
@@ -225,7 +235,8 @@ def replay_plan(columns, hand, mu, options=None) -> Replay:
     Replay
     """
     from qsplan.hands.two_finger import finger_angles
-    from qsplan.mechanics.motion.simulator import make_friction, simulate
+    from qsplan.mechanics.motion.simulator import simulate
+    from qsplan.mechanics.motion.system import make_friction
 
     options = options or _default_options()
     mu = np.broadcast_to(np.asarray(mu, float), (4,)).copy()

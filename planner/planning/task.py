@@ -3,7 +3,7 @@
 A task names the hand and its workpiece, the workpiece's start and the goal of
 each in-contact segment, the friction uncertainty, the torque resolution of the
 effort-controlled joint's controller and the joint and speed limits.  Everything
-else is derived by :mod:`planner.plan`: the contacts (from the polygons), the
+else is derived by :mod:`qsplan.planner.planning.plan`: the contacts (from the polygons), the
 desired mode of each segment (4S: the workpiece slides on the palm and under
 both fingers), which finger is effort-controlled (the control-mode partitioner
 and the guaranteed bands) and the grasps (the fingers' tangency with the workpiece).
@@ -46,6 +46,7 @@ from pathlib import Path
 import numpy as np
 
 from qsplan.mechanics.errors import QsplanError
+from qsplan.mechanics.model.friction import check_mu_range
 
 __all__ = ["Task", "load_task", "make_task", "demo_task_path", "task_paths"]
 
@@ -146,9 +147,7 @@ def make_task(hand, start_x, waypoints, mu_range=(0.0, 0.2), torque_resolution=0
     if np.any(wp == prev):
         k = int(np.flatnonzero(wp == prev)[0])
         raise QsplanError(f"motion.waypoints: segment {k + 1} does not move the workpiece (x = {wp[k]})")
-    lo, hi = _pair(mu_range, "friction.range", "friction coefficients")
-    if lo < 0:
-        raise QsplanError(f"friction.range: expected 0 <= lo; got {lo}")
+    lo, hi = check_mu_range(*_pair(mu_range, "friction.range", "friction coefficients"), "friction.range")
     limits = np.array([_pair(joint_limits[k], f"limits.{side}", "rad") for k, side in enumerate(("left", "right"))])
     base = hand.workpiece[:2, 0]
     if not base.min() < 0.0 < base.max():

@@ -1,6 +1,6 @@
-"""Plots for operators: torque bands along a segment (Figs. 10-13) and hand snapshots (Fig. 9).
+"""Plots for operators: torque bands along a segment (Figs. 10-13); hand snapshots are in :mod:`.hands`.
 
-Compute lives in :mod:`planner.bands_sweep` and :mod:`hands`; this module only draws.
+Compute lives in :mod:`qsplan.planner.torque`; this module only draws.
 As in the paper, upper bounds are bold solid curves and lower bounds bold dashed
 ones; a side beyond the display limit (or infinite) is drawn along the limit with
 up (down) arrows and said so in the legend, as the paper truncated Fig. 10 "at 200
@@ -14,6 +14,9 @@ matplotlib is imported inside the functions.
 from __future__ import annotations
 
 import numpy as np
+
+from qsplan.planner.plotting.hands import hand_strip_figure, plot_hand
+from qsplan.planner.plotting.style import axes_or_new
 
 __all__ = [
     "OZ_IN_PER_N_M",
@@ -41,12 +44,7 @@ _DRAW_RTOL = 1e-6
 
 
 def _axes(ax, size=(6.4, 3.6)):
-    if ax is not None:
-        return ax
-    from qsplan.planner.plotting.style import new_axes
-
-    _, axes = new_axes(1, 1, size=size)
-    return axes[0, 0]
+    return axes_or_new(ax, size)
 
 
 def _nice_ceiling(x: float) -> float:
@@ -105,7 +103,7 @@ def plot_band_sweep(sweep, ax=None, display_limit=None, color=_UPPER, fill=_FILL
 
     Parameters
     ----------
-    sweep : planner.bands_sweep.BandSweep
+    sweep : qsplan.planner.torque.pointwise.BandSweep
     ax : matplotlib Axes, optional
     display_limit : float, optional
         N m; sides beyond it (or infinite) are drawn along it with arrows.  Default
@@ -179,7 +177,7 @@ def plot_guaranteed(bands, ax=None, display_limit=None, show_sampled=True, show_
 
     Parameters
     ----------
-    bands : planner.bands_sweep.SegmentBands
+    bands : qsplan.planner.torque.sweep.SegmentBands
     ax : matplotlib Axes, optional
     display_limit : float, optional
         N m; default :func:`auto_display_limit` of the guaranteed band.
@@ -194,7 +192,7 @@ def plot_guaranteed(bands, ax=None, display_limit=None, show_sampled=True, show_
     """
     from qsplan.mechanics.modes.contact_mode import ContactMode
 
-    from qsplan.planner.torque.sweep import narrowest
+    from qsplan.planner.torque.pointwise import narrowest
 
     ax = _axes(ax, size=(7.0, 4.0))
     g = bands.guaranteed
@@ -243,88 +241,13 @@ def plot_guaranteed(bands, ax=None, display_limit=None, show_sampled=True, show_
     return ax
 
 
-def plot_hand(hand, pose, q=None, ax=None, alpha=1.0, contacts=True, label_joints=False):
-    """The palm, the fingers and the workpiece at one configuration (Fig. 9).
-
-    Parameters
-    ----------
-    hand : hands.two_finger.TwoFingerHand
-    pose : array-like, shape (3,)
-        Workpiece ``(x, y, theta)`` (m, m, rad).
-    q : array-like, shape (2,), optional
-        Joint angles (rad); default the fingers' tangency angles.
-    contacts : bool
-        Mark the contacts found from the geometry, with their normals.
-
-    Returns
-    -------
-    matplotlib.axes.Axes
-    """
-    from matplotlib.patches import Polygon as Patch
-
-    from qsplan.hands.two_finger import hand_contacts, hand_geometric_scene, hand_polygons
-
-    ax = _axes(ax, size=(3.2, 2.6))
-    polys = hand_polygons(hand, pose, q)
-    styles = {"palm": ("#bdbdbd", "#636363"), "left": ("#6baed6", "#08519c"), "right": ("#fd8d3c", "#a63603"),
-              "workpiece": ("#fff7bc", "#8c6d31")}  # fmt: skip
-    for name in ("palm", "left", "right", "workpiece"):
-        face, edge = styles[name]
-        ax.add_patch(Patch(polys[name], closed=True, facecolor=face, edgecolor=edge, lw=1.0, alpha=alpha))
-    if contacts:
-        gs = hand_geometric_scene(hand, pose, q)
-        scale = 0.12 * hand.finger_length
-        for c in hand_contacts(gs):
-            ax.plot(*c.point, "o", ms=3.5, color="k", alpha=alpha)
-            ax.arrow(*c.point, *(scale * c.normal), width=0.0, head_width=0.2 * scale, color="k", lw=0.8,
-                     length_includes_head=True, alpha=alpha)  # fmt: skip
-    if label_joints:
-        for name, p in zip(("left", "right"), hand.pivots):
-            ax.annotate(name, p, xytext=(0, -11), textcoords="offset points", ha="center", fontsize=7)
-    r = hand.finger_base + 0.5 * hand.finger_length
-    ax.set_xlim(-r, r)
-    ax.set_ylim(-0.3 * hand.finger_length, 1.05 * hand.finger_length)
-    ax.set_aspect("equal")
-    ax.set_xticks([])
-    ax.set_yticks([])
-    return ax
-
-
-def hand_strip_figure(samples, n=5, title=None):
-    """A strip of ``n`` hand snapshots along a sampled segment, with times and joint angles.
-
-    Parameters
-    ----------
-    samples : hands.segments.SegmentSamples
-    n : int
-        At least 2.
-
-    Returns
-    -------
-    matplotlib.figure.Figure
-    """
-    from qsplan.planner.plotting.style import new_axes
-
-    n = max(2, int(n))
-    fig, axes = new_axes(n, 1, size=(2.6, 2.4))
-    idx = np.unique(np.round(np.linspace(0, len(samples) - 1, n)).astype(int))
-    seg = samples.segment
-    for ax, k in zip(axes[0], idx):
-        plot_hand(seg.hand, samples.pose[k], samples.q[k], ax=ax, label_joints=k == idx[0])
-        ax.set_title(f"t = {samples.t[k]:.3g} s\nq = ({np.degrees(samples.q[k, 0]):.1f}, "
-                     f"{np.degrees(samples.q[k, 1]):.1f}) deg", fontsize=8)  # fmt: skip
-    for ax in axes[0][len(idx):]:
-        ax.set_visible(False)
-    fig.suptitle(title or f"{seg.name} ({seg.mode}; {seg.effort_joint} finger torque-controlled)", fontsize=9)
-    return fig
-
 
 def segment_band_figures(bands, display_limit=None, strip=5) -> dict:
     """Figs. 10-13 and the snapshot strip for one segment.
 
     Parameters
     ----------
-    bands : planner.bands_sweep.SegmentBands
+    bands : qsplan.planner.torque.sweep.SegmentBands
     display_limit : float, optional
         N m for every band figure; default per figure (:func:`auto_display_limit`).
     strip : int

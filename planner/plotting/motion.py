@@ -146,12 +146,12 @@ def plot_mode_timeline(motion, ax=None):
     -------
     matplotlib.axes.Axes
     """
-    from qsplan.planner.plotting.style import _PALETTE
+    from qsplan.planner.plotting.style import PALETTE
 
     ax = _axes(ax, size=(6.0, 1.6))
     colours = {}
     for seg in motion.segments:
-        c = colours.setdefault(seg.label, _PALETTE[len(colours) % len(_PALETTE)])
+        c = colours.setdefault(seg.label, PALETTE[len(colours) % len(PALETTE)])
         ax.barh(0, seg.duration, left=seg.t_start, color=c, edgecolor="k", lw=0.5)
         if seg.duration > 0.06 * max(motion.duration, 1e-12):
             ax.text(seg.t_start + seg.duration / 2, 0, seg.label, ha="center", va="center", fontsize=9, family="monospace")

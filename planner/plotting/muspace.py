@@ -42,7 +42,7 @@ def plot_mu_map(sl, ax=None, curves=True, numbers=True, title=None, colours=None
     """Draw a :class:`mechanics.muspace.MuSlice`: cells by mode set, exact region boundaries on top.
 
     Cells take the colour of their set of feasible modes (jams light grey, overlaps
-    their own colour, see :func:`planner.plots.plot_mu_slice`).  The boundary of each
+    their own colour, see :func:`qsplan.planner.plotting.style.plot_mu_slice`).  The boundary of each
     mode's region is drawn from the zero sets of its boundary polynomials
     (:meth:`mechanics.regions.MuRegion.boundary_curves`), not from the cells.
 
@@ -56,7 +56,7 @@ def plot_mu_map(sl, ax=None, curves=True, numbers=True, title=None, colours=None
         Write the modes' enumeration numbers (3S=1, R1S2=2, ... for three contacts) in the regions.
     title : str, optional
     colours : dict, optional
-        Shared mode-set colours across panels (see :func:`planner.plots.plot_mu_slice`).
+        Shared mode-set colours across panels (see :func:`qsplan.planner.plotting.style.plot_mu_slice`).
     samples : int
         Samples per axis of each boundary curve.
 

@@ -1,6 +1,6 @@
 """Operator plots of a two-finger plan: bands along the whole plan, the mode timeline, hand snapshots.
 
-Each function takes a :class:`planner.plan.Plan`, draws into ``ax`` (or a new
+Each function takes a :class:`qsplan.planner.Plan`, draws into ``ax`` (or a new
 figure) and returns the axes or the figure; matplotlib is imported inside.
 :func:`plan_figures` gives all three for ``qsplan demo`` / ``qsplan plan``.
 """
@@ -76,7 +76,7 @@ def plot_plan_bands(plan, axes=None):
 
 def plot_mode_timeline(plan, ax=None):
     """Which mode each phase keeps and which finger is torque-controlled, against time."""
-    from qsplan.planner.planning.plan import ContactSegmentPlan
+    from qsplan.planner.planning.results import ContactSegmentPlan
     from qsplan.planner.plotting.style import new_axes
 
     if ax is None:
@@ -96,8 +96,8 @@ def plot_mode_timeline(plan, ax=None):
 
 def plan_snapshots_figure(plan, per_phase=3):
     """Hand snapshots: ``per_phase`` along each in-contact segment and the open grasp of each regrasp."""
-    from qsplan.planner.plotting.bands import plot_hand
-    from qsplan.planner.planning.plan import ContactSegmentPlan
+    from qsplan.planner.plotting.hands import plot_hand
+    from qsplan.planner.planning.results import ContactSegmentPlan
     from qsplan.planner.plotting.style import new_axes
 
     shots = []

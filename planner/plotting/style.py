@@ -8,10 +8,10 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["plot_mu_slice", "new_axes", "save_figure"]
+__all__ = ["PALETTE", "axes_or_new", "plot_mu_slice", "new_axes", "save_figure"]
 
 #: Colours for mode sets, in order of first appearance; "jam" is always light grey.
-_PALETTE = ["#4c72b0", "#dd8452", "#55a868", "#c44e52", "#8172b3", "#937860", "#da8bc3", "#8c8c8c", "#ccb974", "#64b5cd"]
+PALETTE = ["#4c72b0", "#dd8452", "#55a868", "#c44e52", "#8172b3", "#937860", "#da8bc3", "#8c8c8c", "#ccb974", "#64b5cd"]
 _JAM = "#e8e8e8"
 
 
@@ -24,9 +24,17 @@ def new_axes(ncols=1, nrows=1, size=(4.2, 3.8)):
     return fig, axes
 
 
-def save_figure(fig, path, option: str = "--out", dpi: int = 110) -> None:
+def axes_or_new(ax, size=(6.4, 3.6)):
+    """``ax``, or the axes of a new figure of ``size`` (inches) when ``ax`` is None."""
+    if ax is not None:
+        return ax
+    _, axes = new_axes(1, 1, size=size)
+    return axes[0, 0]
+
+
+def save_figure(fig, path, option: str = "path", dpi: int = 110) -> None:
     """Write ``fig`` to ``path`` (parent folders created); an unwritable path raises a
-    :class:`~mechanics.QsplanError` naming ``option``."""
+    :class:`~qsplan.mechanics.QsplanError` naming ``option`` (the caller's name for the path)."""
     from pathlib import Path
 
     from qsplan.mechanics import QsplanError
@@ -82,7 +90,7 @@ def plot_mu_slice(mumap, xs, ys, ax=None, xlabel="$\\mu_1$", ylabel="$\\mu_2$", 
         else:
             key = tuple(int(j) for j in s)
             if key not in shared:
-                shared[key] = _PALETTE[len(shared) % len(_PALETTE)]
+                shared[key] = PALETTE[len(shared) % len(PALETTE)]
             colours.append(shared[key])
             label = " + ".join(f"{mumap.modes[j].name} ({j + 1})" if names else mumap.modes[j].letters for j in s)
             labels.append(label + ("  [ambiguous]" if s.size > 1 else ""))

@@ -18,7 +18,8 @@ import numpy as np
 
 from qsplan.hands.paper import eq37_scene, eq42_scene, rod_scene
 from qsplan.mechanics import count_modes, scene_from_dict
-from qsplan.mechanics.muspace.maps import boundary_agreement, mu_slice, polynomial_map
+from qsplan.mechanics.muspace.maps import polynomial_map
+from qsplan.mechanics.muspace.slices import boundary_agreement, mu_slice
 
 __all__ = ["reproduce_paper", "TABLE1"]
 

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from qsplan.mechanics.errors import QsplanError
+from qsplan.mechanics.errors import NoAnswerError, QsplanError
 
 __all__ = ["choose_command", "default_safety_margin"]
 
@@ -69,11 +69,11 @@ def default_safety_margin(band) -> float:
     The narrowest point sets the torque resolution the controller needs anyway (Fig. 13),
     so keeping that margin from a finite edge where the band is unbounded asks nothing
     more of it.  With no bounded point, the largest finite edge (the size of the
-    torque the mode needs); with none, an error.
+    torque the mode needs); with none, :class:`qsplan.mechanics.NoAnswerError` (no band to size it from).
 
     Parameters
     ----------
-    band : planner.bands_sweep.BandSweep
+    band : qsplan.planner.torque.pointwise.BandSweep
     """
     w = band.width
     bounded = band.feasible & np.isfinite(w) & (w > 0)
@@ -82,4 +82,4 @@ def default_safety_margin(band) -> float:
     edges = np.abs(np.concatenate([band.lower[np.isfinite(band.lower)], band.upper[np.isfinite(band.upper)]]))
     if edges.size and edges.max() > 0:
         return float(edges.max())  # no bounded point: the size of the effort the mode needs
-    raise QsplanError("safety margin: no bounded band along the segment to size it from; pass one explicitly")
+    raise NoAnswerError("safety margin: no bounded band along the segment to size it from; pass one explicitly")

@@ -14,15 +14,13 @@ from qsplan.hands.two_finger import (
     default_hand,
     finger_angle_rates,
     finger_angles,
-    hand_contacts,
-    hand_geometric_scene,
-    hand_polygons,
-    hand_scene,
     make_two_finger_hand,
     workpiece_world,
 )
+from qsplan.hands.two_finger_scene import hand_contacts, hand_geometric_scene, hand_polygons, hand_scene
 from qsplan.mechanics import ContactMode, SceneError, check_mode, solve
-from qsplan.mechanics.bands.effort import effort_band, effort_bands, guaranteed_band_box
+from qsplan.mechanics.bands.effort import effort_band, effort_bands
+from qsplan.mechanics.bands.guaranteed import guaranteed_band_box
 
 EDGE = 1e-6  # efforts this close to a band edge are not judged (the edge itself is feasible, eq. 28's >=)
 SSSS, BSRS = ContactMode("SSSS"), ContactMode("BSRS")

@@ -4,14 +4,8 @@ import numpy as np
 import pytest
 
 from qsplan.mechanics import SceneError, check_mode, planted_scene
-from qsplan.mechanics.bands.effort import (
-    effort_band,
-    effort_bands,
-    guaranteed_band_box,
-    guaranteed_band_shared,
-    possible_band_box,
-    sampled_band,
-)
+from qsplan.mechanics.bands.effort import effort_band, effort_bands
+from qsplan.mechanics.bands.guaranteed import guaranteed_band_box, guaranteed_band_shared, possible_band_box, sampled_band
 
 EDGE = 1e-6  # efforts this close to a band edge are not judged (the edge itself is feasible, eq. 28's >=)
 

@@ -15,7 +15,7 @@ from qsplan.mechanics.muspace.graphical import (
     line_of_action,
 )
 from qsplan.mechanics.numerics import Status
-from qsplan.mechanics.muspace.regions import appendix_a, appendix_b, region_3s, region_rs
+from qsplan.mechanics.muspace.appendices import appendix_a, appendix_b, region_3s, region_rs
 
 CONFIGS = 1500
 

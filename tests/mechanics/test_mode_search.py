@@ -66,7 +66,8 @@ def test_paper_examples(mu):
 
 def test_two_finger_hand_scenes():
     from qsplan.hands.segments import first_segment
-    from qsplan.hands.two_finger import default_hand, hand_scene
+    from qsplan.hands.two_finger import default_hand
+    from qsplan.hands.two_finger_scene import hand_scene
 
     hand = default_hand()
     segment = first_segment(hand, duration=10.0)
@@ -145,9 +146,8 @@ def test_cli_stats_and_search(tmp_path, capsys):
 
 
 def test_reduced_penetration_flags_only_modes_the_reference_rejects():
-    from qsplan.mechanics.modes.reference import velocity_scale
+    from qsplan.mechanics.modes.kinematics import ScenePool, velocity_scale
     from qsplan.mechanics.solver.search import PENETRATION_MARGIN, _codes, _rolling_sets, penetrates
-    from qsplan.mechanics.solver.batch import ScenePool
 
     flagged_any = 0
     for seed in range(4):

@@ -7,15 +7,12 @@ from qsplan.hands.paper import eq37_scene, eq42_scene
 from qsplan.hands.pushing import make_pushed_polygon, tilted_box_example
 from qsplan.hands.rod import make_rod_system, rod_initial_state
 from qsplan.mechanics import ContactMode, QsplanError, Status, check_mode, enumerate_modes, planted_scene, scene_from_dict
-from qsplan.mechanics.motion.events import mode_values, rk4_step, signed_hadamard
-from qsplan.mechanics.motion.simulator import (
-    STOP_KINDS,
-    MotionOptions,
-    frozen_scene_system,
-    make_friction,
-    pose_rate,
-    simulate,
-)
+from qsplan.mechanics.motion.conditions import mode_values
+from qsplan.mechanics.motion.events import rk4_step
+from qsplan.mechanics.numerics import hadamard_ratio
+from qsplan.mechanics.motion.simulator import MotionOptions, simulate
+from qsplan.mechanics.motion.system import frozen_scene_system, make_friction, pose_rate
+from qsplan.mechanics.motion.trajectory import STOP_KINDS
 
 # --- the conditions of one mode as numbers (eqs. 15, 16, 24-28) -----------------------------
 
@@ -60,9 +57,11 @@ def test_frozen_sliding_direction_turns_a_sign_change_into_a_zero_crossing():
 
 def test_signed_hadamard_sign_and_scale():
     A = np.array([[2.0, 0.0], [0.0, 3.0]])
-    assert signed_hadamard(A) == pytest.approx(1.0)
-    assert signed_hadamard(A[::-1]) == pytest.approx(-1.0)
-    assert signed_hadamard(np.array([[1.0, 2.0], [2.0, 4.0]])) == 0.0
+    assert hadamard_ratio(A, signed=True) == pytest.approx(1.0)
+    assert hadamard_ratio(A[::-1], signed=True) == pytest.approx(-1.0)
+    assert hadamard_ratio(A[::-1]) == pytest.approx(1.0)
+    assert hadamard_ratio(np.array([[1.0, 2.0], [2.0, 4.0]]), signed=True) == 0.0
+    assert hadamard_ratio(np.zeros((0, 0)), signed=True) == 1.0
 
 
 def test_rk4_is_exact_for_constant_rates_and_fourth_order_otherwise():

@@ -17,7 +17,8 @@ from qsplan.mechanics import QsplanError, scene_from_dict, solve
 from qsplan.mechanics import parallel
 from qsplan.mechanics.muspace import maps as muspace
 from qsplan.mechanics.solver import chunks as mode_chunks
-from qsplan.mechanics.muspace.maps import feasibility_map, grid_points, mu_slice
+from qsplan.mechanics.muspace.maps import feasibility_map, grid_points
+from qsplan.mechanics.muspace.slices import mu_slice
 from qsplan.mechanics.numerics import DEFAULT_TOLERANCES
 from qsplan.mechanics.parallel import chunk_count, first_difference, map_chunks, split_range
 from qsplan.mechanics.modes.planted import planted_scene

@@ -8,25 +8,18 @@ from qsplan.mechanics import ContactMode, ModeError, QsplanError, SceneError, en
 from qsplan.mechanics.muspace.multilinear import (
     Multilinear,
     adjugate,
-    bilinear_zero_set,
     column_expansion,
     corner_values,
     moebius,
     monomials,
     restrict_coef,
 )
-from qsplan.mechanics.muspace.maps import boundary_agreement, feasibility_map, mu_slice, polynomial_map
+from qsplan.mechanics.muspace.maps import feasibility_map, polynomial_map
+from qsplan.mechanics.muspace.zero_sets import bilinear_zero_set
+from qsplan.mechanics.muspace.slices import boundary_agreement, mu_slice
 from qsplan.mechanics.numerics import Status
-from qsplan.mechanics.muspace.regions import (
-    MuRegion,
-    appendix_a,
-    appendix_b,
-    equilibrium_polynomials,
-    mode_kinematics,
-    mode_region,
-    region_3s,
-    region_rs,
-)
+from qsplan.mechanics.muspace.appendices import appendix_a, appendix_b, region_3s, region_rs
+from qsplan.mechanics.muspace.regions import MuRegion, equilibrium_polynomials, mode_kinematics, mode_region
 
 POINTS_PER_TYPE = 10_000
 

@@ -225,7 +225,7 @@ def test_frictionless_rolling_contact_cannot_pull():
     # eq. (9): c_n >= 0 at a rolling contact even when mu = 0 (the cone rows of eq. 7 then say only c_t = 0).
     # Block on a floor, weight outside the supports: RS would need the floor to pull (c_n1 = -0.5).
     from qsplan.mechanics import wrench_matrices
-    from qsplan.mechanics.muspace.regions import region_rs
+    from qsplan.mechanics.muspace.appendices import region_rs
 
     Wn, Wt = wrench_matrices([[-1, 0], [1, 0]], [[0, 1], [0, 1]])
     scene = make_scene(Wn, Wt, [[0.0], [0.0]], [[-1.0], [0.0]], [0.0, 0.0], [0, -1, -2], joint_velocity=[1.0])

@@ -8,8 +8,8 @@ from qsplan.hands.two_finger import default_hand
 from qsplan.mechanics import ModeError, QsplanError, SceneError, planted_scene, solve
 from qsplan.mechanics.bands.effort import band_kinematics, effort_bands
 from qsplan.mechanics.modes.contact_mode import enumerate_modes
+from qsplan.mechanics.bands.robust import subtract_hull
 from qsplan.planner.torque.sweep import (
-    _subtract,
     competing_modes,
     guaranteed_sweep,
     narrowest,
@@ -224,5 +224,5 @@ def test_choose_command_caps_the_margin():
     ],
 )
 def test_subtracting_a_competitor(c_lo, c_hi, expected):
-    a, b, split = _subtract(0.0, 10.0, c_lo, c_hi, 1e-9)
+    a, b, split = subtract_hull(0.0, 10.0, c_lo, c_hi, 1e-9)
     assert np.allclose([a, b], expected[:2], equal_nan=True) and split == expected[2]

@@ -10,7 +10,7 @@ import pytest
 
 from qsplan.hands.paper import eq42_scene, rod_scene
 from qsplan.mechanics import enumerate_modes, scene_from_dict, solve
-from qsplan.mechanics.muspace.maps import mu_slice
+from qsplan.mechanics.muspace.slices import mu_slice
 from qsplan.planner.cli.main import main
 
 LEGEND = ["3S", "R1S2", "R1S3", "R2S1", "R2S3", "R3S1", "R3S2"]

@@ -81,7 +81,7 @@ def test_no_silent_overwrite(bands, tmp_path):
     assert [p.name for p in paths] == ["seg.csv", "seg.json"]
     before = paths[0].read_text()
     (tmp_path / "other.json").write_text("{}")
-    with pytest.raises(QsplanError, match="exists; pass --force"):
+    with pytest.raises(QsplanError, match="exists; pass force=True"):
         export_schedule(bands, tmp_path, stem="seg")
     with pytest.raises(QsplanError, match="exists"):
         write_json(bands, tmp_path / "other.json")

@@ -5,12 +5,13 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from qsplan.hands.two_finger import default_hand, finger_angles, hand_scene
+from qsplan.hands.two_finger import default_hand, finger_angles
+from qsplan.hands.two_finger_scene import hand_scene
 from qsplan.mechanics import QsplanError
-from qsplan.mechanics.bands.effort import guaranteed_band_box
+from qsplan.mechanics.bands.guaranteed import guaranteed_band_box
 from qsplan.mechanics.modes.contact_mode import ContactMode
 from qsplan.planner.export.plan_files import export_plan, read_plan_csv
-from qsplan.mechanics.solver.batch import solve
+from qsplan.mechanics.solver.all_modes import solve
 from qsplan.planner.planning.plan import check_free_state
 from qsplan.planner.planning.replay import friction_samples, replay_plan
 from qsplan.planner.planning.task import demo_task_path, load_task, make_task, task_paths
@@ -162,7 +163,26 @@ def test_degenerate_closure_is_named_without_meaningless_edge_corners():
 
     task = load_task(task_paths()["pentagon_task"])
     with pytest.raises(PlanFailure) as info:
-        plan_task(make_task(task.hand, 0.0, [0.02], mu_range=(0.0, 0.6), torque_resolution=0.01))
+        # from x = 0.025 (the fingers cross above the pentagon below 0.0175) to 0.035, the same contacts throughout
+        plan_task(make_task(task.hand, 0.025, [0.035], mu_range=(0.0, 0.6), torque_resolution=0.01))
     r = info.value.report
     assert "degenerate" in r.narrowest.reason and "edges attained" not in r.message
     assert r.narrowest.mu_lower_edge is None and 0.0 < r.mu_closes < 0.6
+
+
+@pytest.mark.ompl
+@pytest.mark.parametrize("stem", sorted(task_paths()))
+def test_bundled_tasks_are_planned_without_overlaps_or_refused_with_a_reason(stem, demo_files, tmp_path):
+    """Checked independently of the planner, from the exported rows (tests/planner/overlaps.py)."""
+    from tests.planner.overlaps import plan_or_refuse, plan_overlaps
+
+    task = load_task(task_paths()[stem])
+    if task_paths()[stem] == demo_task_path():  # planned once for the whole module
+        plan, _, cols = demo_files
+        assert plan_overlaps(plan.task.hand, cols) == []
+        return
+    outcome, result = plan_or_refuse(task, tmp_path / "out")
+    if outcome == "plan":
+        assert plan_overlaps(task.hand, result) == []
+    else:
+        assert result["reason"] if "reason" in result else result["narrowest"]

@@ -1,0 +1,207 @@
+"""Effort bands over uncertain friction: guaranteed, possible and sampled (eq. 28, Section 5.2).
+
+Over uncertain friction the guarantee is exact:
+
+* **independent coefficients in a box** (:func:`guaranteed_band_box`): ``Q_AI`` is
+  affine in each sliding contact's mu, so ``det Q_AI`` and ``det Q_AI * s_r`` are
+  multilinear in the mu's (rolling contacts' mu enter ``B_A`` linearly) and affine
+  in tau.  Where ``det Q_AI`` keeps its sign on the box (checked at the vertices,
+  which suffices for a multilinear function), ``s_r >= 0`` on the whole box iff it
+  holds at the ``2^m`` vertices: the guaranteed band is the intersection of the
+  vertex bands, exactly.  Where the sign changes, ``Q_AI`` is singular inside the
+  box, the mode is degenerate there, and nothing is guaranteed (reported).
+* **one shared coefficient** (:func:`guaranteed_band_shared`): each band edge is a
+  ratio of polynomials in mu; its extremes over ``[lo, hi]`` are found from the
+  polynomial's roots (critical points and sign changes), not from samples.
+
+:func:`sampled_band` keeps the paper's method (intersection over a list of mu)
+for comparison.
+"""
+
+from __future__ import annotations
+
+from itertools import product
+
+import numpy as np
+
+from qsplan.mechanics.bands.effort import Band, band_kinematics, band_rows, check_one_effort_joint, effort_band, effort_bands, intersect_rows
+from qsplan.mechanics.model.friction import check_mu_range
+from qsplan.mechanics.model.scene import Scene
+from qsplan.mechanics.modes.contact_mode import ContactMode
+from qsplan.mechanics.numerics import DEFAULT_TOLERANCES, Tolerances
+
+__all__ = ["guaranteed_band_box", "guaranteed_band_shared", "possible_band_box", "sampled_band"]
+
+
+def _box_vertices(scene: Scene, mode: ContactMode, lo, hi) -> np.ndarray:
+    n_c = scene.n_contacts
+    lo, hi = check_mu_range(lo, hi, n=n_c)
+    free = [c for c in range(n_c) if mode.letters[c] != "B" and hi[c] > lo[c]]
+    verts = np.tile(lo, (2 ** len(free), 1))
+    for k, bits in enumerate(product((0, 1), repeat=len(free))):
+        for c, b in zip(free, bits):
+            verts[k, c] = hi[c] if b else lo[c]
+    return verts
+
+
+def guaranteed_band_box(scene: Scene, mode: ContactMode, lo, hi, tol: Tolerances = DEFAULT_TOLERANCES) -> Band:
+    """Efforts for which ``mode`` is feasible for **every** mu with ``lo <= mu_i <= hi`` (exact).
+
+    Parameters
+    ----------
+    lo, hi : float or array-like, shape (n_c,)
+        Independent intervals per contact (breaking contacts' mu do not matter).
+    """
+    joint = check_one_effort_joint(scene)
+    verts = _box_vertices(scene, mode, lo, hi)
+    mk = band_kinematics(scene, mode, tol)
+    if not mk.ok:
+        return Band(mode.letters, joint, np.nan, np.nan, False, f"kinematics: {mk.status}", "box-vertices")
+    s0, s1, det, scale = band_rows(scene, mk, verts)
+    if not (np.all(det > 0) or np.all(det < 0)):
+        return Band(
+            mode.letters, joint, np.nan, np.nan, False,
+            "equilibrium_singular: det Q_AI changes sign inside the mu box (the mode is degenerate there)",
+            "box-vertices",
+        )  # fmt: skip
+    lower, upper, ok = intersect_rows(s0, s1, scale, tol)
+    if not ok.all():
+        return Band(mode.letters, joint, np.nan, np.nan, False, "coulomb: no effort works at some vertex of the mu box", "box-vertices")
+    lo_, up_ = float(lower.max()), float(upper.min())
+    if lo_ > up_:
+        return Band(mode.letters, joint, np.nan, np.nan, False, "coulomb: vertex bands do not overlap", "box-vertices")
+    return Band(mode.letters, joint, lo_, up_, True, None, "box-vertices")
+
+
+def possible_band_box(scene: Scene, mode: ContactMode, lo, hi, tol: Tolerances = DEFAULT_TOLERANCES) -> Band:
+    """An interval containing every effort for which ``mode`` is feasible for **some** mu in the box.
+
+    Used to preclude a competing mode: outside this interval the mode is
+    infeasible for every mu in the box.  Each Coulomb row alone is exactly
+    feasible for some mu iff it holds at some vertex (``max`` of a multilinear
+    function); requiring every row separately gives a superset of the true set
+    (``exact=False``: conservative for precluding).  When ``det Q_AI`` changes sign
+    in the box, the mode may be feasible for any effort near the singularity:
+    the whole line is returned.
+    """
+    joint = check_one_effort_joint(scene)
+    verts = _box_vertices(scene, mode, lo, hi)
+    mk = band_kinematics(scene, mode, tol)
+    if not mk.ok:
+        return Band(mode.letters, joint, np.nan, np.nan, False, f"kinematics: {mk.status}", "possible-superset", True)
+    s0, s1, det, scale = band_rows(scene, mk, verts)
+    if not (np.all(det > 0) or np.all(det < 0)):
+        return Band(mode.letters, joint, -np.inf, np.inf, True, "det Q_AI changes sign in the box", "possible-superset", False)
+    ftol = tol.force * scale[:, None]
+    big = np.max(np.abs(s1), axis=1, keepdims=True)
+    flat = np.abs(s1) <= tol.force * big
+    with np.errstate(divide="ignore", invalid="ignore"):
+        edge = -s0 / s1
+    lower, upper = -np.inf, np.inf
+    for r in range(s0.shape[1]):
+        # {tau : exists vertex v with s0 + tau s1 >= 0}: union of half-lines
+        if np.any(flat[:, r] & (s0[:, r] >= -ftol[:, 0])):
+            continue  # holds for every tau at some vertex
+        lo_r = np.min(np.where(~flat[:, r] & (s1[:, r] > 0), edge[:, r], np.inf))
+        up_r = np.max(np.where(~flat[:, r] & (s1[:, r] < 0), edge[:, r], -np.inf))
+        if up_r >= lo_r:
+            continue  # the half-lines cover the line
+        if np.isinf(lo_r) and np.isinf(up_r):
+            return Band(mode.letters, joint, np.nan, np.nan, False, "coulomb: infeasible at every vertex", "possible-superset", False)
+        # the row's set is (-inf, up_r] U [lo_r, inf); keep the hull side that is a half-line
+        if np.isinf(up_r):
+            lower = max(lower, lo_r)
+        elif np.isinf(lo_r):
+            upper = min(upper, up_r)
+        # else: two half-lines with a gap (up_r, lo_r); the interval hull is the whole line (superset)
+    if lower > upper:
+        return Band(mode.letters, joint, np.nan, np.nan, False, "coulomb: rows exclude each other", "possible-superset", False)
+    return Band(mode.letters, joint, float(lower), float(upper), True, None, "possible-superset", False)
+
+
+def sampled_band(scene: Scene, mode: ContactMode, mu_rows, tol: Tolerances = DEFAULT_TOLERANCES) -> Band:
+    """The paper's method: intersect the point bands over the listed mu (e.g. 0, 0.01, ..., 0.2).
+
+    Parameters
+    ----------
+    mu_rows : array-like, shape (N, n_c) or (N,)
+        Friction points; a 1-D array gives one shared coefficient per sample.
+    """
+    joint = check_one_effort_joint(scene)
+    mu_rows = np.asarray(mu_rows, dtype=float)
+    if mu_rows.ndim == 1:
+        mu_rows = np.repeat(mu_rows[:, None], scene.n_contacts, axis=1)
+    lower, upper, ok = effort_bands(scene, mode, mu_rows, tol)
+    if not ok.all():
+        return Band(mode.letters, joint, np.nan, np.nan, False, "infeasible at some sample", "sampled", False)
+    lo_, up_ = float(lower.max()), float(upper.min())
+    if lo_ > up_:
+        return Band(mode.letters, joint, np.nan, np.nan, False, "sample bands do not overlap", "sampled", False)
+    return Band(mode.letters, joint, lo_, up_, True, None, "sampled", False)
+
+
+def _poly_fit_exact(x, y, degree):
+    """Coefficients (numpy.polynomial order) of the degree-``degree`` polynomial through the points."""
+    V = np.vander(x, degree + 1, increasing=True)
+    return np.linalg.solve(V, y)
+
+
+def guaranteed_band_shared(scene: Scene, mode: ContactMode, lo: float, hi: float, tol: Tolerances = DEFAULT_TOLERANCES) -> Band:
+    """Efforts for which ``mode`` is feasible for every shared coefficient ``mu`` in ``[lo, hi]`` (exact).
+
+    With one coefficient shared by all contacts, ``det Q_AI`` is a polynomial of
+    degree ``n_S`` in mu and ``det Q_AI * s_r`` one of degree ``n_S + 1``; both are
+    recovered exactly from ``n_S + 2`` evaluations at Chebyshev points.  Each row
+    bounds the effort by ``-N0_r(mu) / N1_r(mu)``; its extremes over the interval
+    are taken at the ends, at the real roots of ``N0' N1 - N0 N1'`` and in the
+    limits at roots of ``N1`` (where the bound leaves to infinity, harmlessly if
+    the row holds there and fatally if not).  A root of ``det Q_AI`` inside the
+    interval means a degenerate mode: nothing is guaranteed.
+    """
+    joint = check_one_effort_joint(scene)
+    lo, hi = check_mu_range(lo, hi)
+    mk = band_kinematics(scene, mode, tol)
+    if not mk.ok:
+        return Band(mode.letters, joint, np.nan, np.nan, False, f"kinematics: {mk.status}", "shared-roots")
+    if hi == lo:
+        b = effort_band(scene, mode, np.full(scene.n_contacts, lo), tol)
+        return Band(b.mode, joint, b.lower, b.upper, b.feasible, b.reason, "shared-roots")
+    deg = len(mode.sliding) + 1
+    nodes = 0.5 * (lo + hi) + 0.5 * (hi - lo) * np.cos(np.pi * (np.arange(deg + 1) + 0.5) / (deg + 1))
+    s0, s1, det, scale = band_rows(scene, mk, np.repeat(nodes[:, None], scene.n_contacts, axis=1))
+    pdet = _poly_fit_exact(nodes, det, deg)
+    P = np.polynomial.Polynomial
+    roots_det = [r.real for r in P(pdet).roots() if abs(r.imag) < 1e-12 and lo <= r.real <= hi]
+    if roots_det or np.any(det == 0):
+        return Band(mode.letters, joint, np.nan, np.nan, False,
+                    f"equilibrium_singular: det Q_AI vanishes at mu = {roots_det[0] if roots_det else nodes[det == 0][0]:.6g}",
+                    "shared-roots")  # fmt: skip
+    lower, upper = -np.inf, np.inf
+    fscale = float(np.max(scale))
+    for r in range(s0.shape[1]):
+        n0 = P(_poly_fit_exact(nodes, s0[:, r] * det, deg))
+        n1 = P(_poly_fit_exact(nodes, s1[:, r] * det, deg))
+        d = P(pdet)
+        cand = [lo, hi]
+        crit = (n0.deriv() * n1 - n0 * n1.deriv()).roots()
+        cand += [c.real for c in np.atleast_1d(crit) if abs(c.imag) < 1e-9 and lo < c.real < hi]
+        zeros1 = [c.real for c in np.atleast_1d(n1.roots()) if abs(c.imag) < 1e-12 and lo <= c.real <= hi]
+        for z in zeros1:
+            # at a root of the slope the row holds for every effort iff s0 >= 0 there
+            if n0(z) / d(z) < -tol.force * fscale:
+                return Band(mode.letters, joint, np.nan, np.nan, False,
+                            f"coulomb: row {r} fails for every effort at mu = {z:.6g}", "shared-roots")  # fmt: skip
+        for c in cand:
+            sl = n1(c) / d(c)
+            if abs(sl) <= tol.force * max(1e-300, float(np.max(np.abs(s1[:, r])))):
+                if n0(c) / d(c) < -tol.force * fscale:
+                    return Band(mode.letters, joint, np.nan, np.nan, False, f"coulomb: row {r} fails at mu = {c:.6g}", "shared-roots")
+                continue
+            e = -n0(c) / n1(c)
+            if sl > 0:
+                lower = max(lower, e)
+            else:
+                upper = min(upper, e)
+    if lower > upper:
+        return Band(mode.letters, joint, np.nan, np.nan, False, "coulomb: no effort works for every mu in the range", "shared-roots")
+    return Band(mode.letters, joint, float(lower), float(upper), True, None, "shared-roots")

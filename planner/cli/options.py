@@ -1,0 +1,95 @@
+"""What every ``qsplan`` subcommand shares: the parser that fails in one line, common options, translation.
+
+* :class:`Parser` raises :class:`UsageError` (one line, exit :data:`EXIT_USAGE`) instead of printing usage;
+* :func:`add_parallel_options` / :func:`parallel_options`: ``--workers`` and ``--scheduler``;
+* :func:`add_plan_options`: the options of ``qsplan plan`` and ``qsplan demo``;
+* :func:`overwrite_message`: the CLI's message when the library's overwrite check
+  (:func:`qsplan.planner.export.files.check_outputs`) refuses;
+* :func:`cli_message`: library messages name library fields (``out_dir``, ``force=True``); the CLI
+  names its options (``--out``, ``--force``).
+"""
+
+from __future__ import annotations
+
+import argparse
+
+__all__ = [
+    "EXIT_FAILED",
+    "EXIT_USAGE",
+    "FLAGS",
+    "Parser",
+    "UsageError",
+    "add_parallel_options",
+    "add_plan_options",
+    "cli_message",
+    "overwrite_message",
+    "parallel_options",
+]
+
+#: Exit status of bad input, and of valid input without an answer (no plan, no band).
+EXIT_USAGE = 2
+
+#: Exit status when the command ran but its result failed a check (a re-simulated plan left its modes).
+EXIT_FAILED = 1
+
+#: Library field names and the options that set them, to translate library messages.
+FLAGS = {"out_dir": "--out", "workers": "--workers", "scheduler": "--scheduler"}
+
+
+class UsageError(Exception):
+    """Bad command line: the message is printed as it is, exit :data:`EXIT_USAGE`."""
+
+
+class Parser(argparse.ArgumentParser):
+    """argparse that reports errors in one line (no usage dump) and exits 2."""
+
+    def error(self, message):  # noqa: D102
+        raise UsageError(f"{self.prog}: {message}")
+
+
+def cli_message(message: str, flags: dict | None = None) -> str:
+    """A library message with its field names as the command's options (``out_dir:`` -> ``--out:``)."""
+    table = {**FLAGS, **(flags or {})}
+    field, sep, rest = message.partition(":")
+    if sep and field in table:
+        message = table[field] + ":" + rest
+    return message.replace("pass force=True", "pass --force")
+
+
+def add_parallel_options(p):
+    """``--workers N`` and ``--scheduler ADDRESS`` (see :func:`qsplan.mechanics.map_chunks`)."""
+    p.add_argument("--workers", type=int, metavar="N",
+                   help="local processes for independent chunks (default: all cores; 1: in-process)")  # fmt: skip
+    p.add_argument("--scheduler", metavar="ADDRESS",
+                   help="run the chunks on a Dask cluster, e.g. tcp://host:8786 (needs qsplan[cluster])")  # fmt: skip
+
+
+def parallel_options(args) -> dict:
+    """``{"workers": ..., "scheduler": ...}`` from :func:`add_parallel_options`'s arguments, checked."""
+    from qsplan.mechanics.errors import QsplanError
+
+    if args.workers is not None and args.workers < 1:
+        raise QsplanError(f"--workers: expected a positive number of processes (1 runs in-process); got {args.workers}")
+    return {"workers": args.workers, "scheduler": args.scheduler}
+
+
+def add_plan_options(p, default_out):
+    """The options of ``qsplan plan`` and ``qsplan demo``."""
+    from qsplan.planner.planning.ompl_bridge import PLANNERS
+
+    p.add_argument("--out", default=default_out, metavar="DIR", help=f"output directory (default {default_out})")
+    p.add_argument("--seed", type=int, default=1, metavar="S", help="OMPL's random seed (default 1)")
+    p.add_argument("--planner", choices=PLANNERS, default="RRTConnect", help="OMPL planner (default RRTConnect)")
+    p.add_argument("--time-limit", type=float, default=None, metavar="SECONDS",
+                   help="time limit of each OMPL query (default 120; the iteration budget decides first)")
+    p.add_argument("--force", action="store_true", help="overwrite existing files in DIR")
+    p.add_argument("--quiet", action="store_true", help="no progress lines on stderr")
+    p.add_argument("--no-plots", action="store_true", help="write the torque trajectory only")
+    p.add_argument("--verify", type=int, default=3, metavar="N",
+                   help="re-simulate the exported plan at N friction vectors from the interval (the two uniform "
+                        "extremes, then seeded random ones; 0: skip; default 3)")  # fmt: skip
+
+
+def overwrite_message(exc) -> str:
+    """The CLI's message for a :class:`qsplan.planner.export.files.OutputExistsError`."""
+    return f"--out: {exc.path!r} exists ({exc.count} of the output files do); pass --force to overwrite or choose another --out"

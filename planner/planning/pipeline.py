@@ -1,0 +1,152 @@
+"""The planning pipeline in one call: plan a task, export it, draw it, re-simulate the exported file.
+
+:func:`run_plan` is what ``qsplan plan`` and ``qsplan demo`` run, and what a planning
+script calls: it checks its outputs before planning (nothing is overwritten without
+``force``), plans (:func:`qsplan.planner.planning.plan.plan_task`), writes ``plan.csv`` and
+``plan.json`` (:func:`qsplan.planner.export.plan_files.export_plan`), the operator plots
+(:func:`qsplan.planner.plotting.plan.plan_figures`) and ``replay.json``: the exported file
+re-simulated (:func:`qsplan.planner.planning.replay.replay_plan`) at ``verify`` friction
+vectors of the interval.  When no plan exists it writes ``failure.json`` (the report of
+where the band closes, which mode closes it, at which friction) and raises
+:class:`qsplan.planner.planning.results.PlanFailure`.
+"""
+
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass, replace
+from pathlib import Path
+
+from qsplan.mechanics.errors import QsplanError
+
+from qsplan.planner.export.files import check_out_dir, check_outputs
+from qsplan.planner.planning.plan import DEFAULT_OPTIONS, plan_task
+from qsplan.planner.planning.results import Plan, PlanFailure
+
+__all__ = ["PLAN_FILES", "PLAN_PLOTS", "PlanRun", "plan_outputs", "run_plan"]
+
+#: Files :func:`run_plan` writes into its directory (``replay.json`` only when ``verify`` > 0).
+PLAN_FILES = ("plan.csv", "plan.json", "replay.json")
+
+#: Plots it writes (``<name>.png``) unless ``plots=False``.
+PLAN_PLOTS = ("plan_bands", "mode_timeline", "hand_snapshots")
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class PlanRun:
+    """What :func:`run_plan` did.
+
+    Attributes
+    ----------
+    plan : Plan
+    out_dir : pathlib.Path
+    files : tuple of str
+        Files written, in order.
+    replays : tuple of qsplan.planner.planning.replay.Replay
+        The exported plan re-simulated, one per friction vector.
+    """
+
+    plan: Plan
+    out_dir: Path
+    files: tuple
+    replays: tuple
+
+    @property
+    def followed(self) -> bool:
+        """Every re-simulation followed the planned modes (True when none was run)."""
+        return all(r.followed for r in self.replays)
+
+
+def plan_outputs(out_dir, plots: bool = True) -> list:
+    """The paths :func:`run_plan` may write into ``out_dir`` (checked before planning)."""
+    out = Path(out_dir)
+    return [out / f for f in PLAN_FILES] + ([out / f"{n}.png" for n in PLAN_PLOTS] if plots else [])
+
+
+def run_plan(task, out_dir, *, seed: int = 1, planner: str = "RRTConnect", time_limit: float | None = None,
+             verify: int = 3, force: bool = False, plots: bool = True, progress=None) -> PlanRun:  # fmt: skip
+    """Plan ``task``, export it into ``out_dir``, draw it and re-simulate the exported file.
+
+    Parameters
+    ----------
+    task : qsplan.planner.planning.task.Task
+    out_dir : str or pathlib.Path
+    seed : int
+        OMPL's random seed.
+    planner : str
+        OMPL planner, one of :data:`qsplan.planner.planning.ompl_bridge.PLANNERS`.
+    time_limit : float, optional
+        Seconds per OMPL query; default that of :data:`qsplan.planner.planning.plan.DEFAULT_OPTIONS`.
+    verify : int
+        Friction vectors to re-simulate the exported plan at (the two uniform extremes, then seeded
+        random ones: :func:`qsplan.planner.planning.replay.friction_samples`); 0 skips.
+    force : bool
+        Overwrite existing files.
+    plots : bool
+        Draw ``plan_bands.png``, ``mode_timeline.png`` and ``hand_snapshots.png``.
+    progress : callable, optional
+        ``progress(line)`` for progress messages.
+
+    Returns
+    -------
+    PlanRun
+        Check :attr:`PlanRun.followed`: False when a re-simulation left the planned modes.
+
+    Raises
+    ------
+    QsplanError
+        Bad arguments, or an output exists and ``force`` is False (before anything is planned or written).
+    PlanFailure
+        No plan exists; ``failure.json`` in ``out_dir`` holds the report (``report_path``).
+    """
+    if isinstance(verify, bool) or int(verify) != verify or verify < 0:
+        raise QsplanError(f"verify: expected a nonnegative number of friction vectors; got {verify}")
+    out = check_out_dir(out_dir)
+    check_outputs(plan_outputs(out, plots), force)
+    limit = DEFAULT_OPTIONS.time_limit if time_limit is None else time_limit
+    if not (limit > 0 and limit < float("inf")):
+        raise QsplanError(f"time_limit: expected a positive number of seconds; got {time_limit}")
+    progress = progress or (lambda line: None)
+    options = replace(DEFAULT_OPTIONS, seed=seed, planner=planner, time_limit=limit)
+    progress(f"task {task.name!r}: {len(task.waypoints)} in-contact segments, mu in {list(task.mu_range)}, "
+             f"torque resolution {task.torque_resolution:g} N m")  # fmt: skip
+    try:
+        plan = plan_task(task, options, progress)
+    except PlanFailure as exc:
+        out.mkdir(parents=True, exist_ok=True)
+        path = out / "failure.json"
+        with open(path, "w") as f:
+            json.dump(exc.report.as_dict(), f, indent=1)
+        raise PlanFailure(exc.report, report_path=path) from None
+    from qsplan.planner.export.plan_files import export_plan
+
+    files = [str(p) for p in export_plan(plan, out, force=True)]
+    if plots:
+        progress("drawing the plots")
+        from qsplan.planner.plotting.plan import plan_figures
+        from qsplan.planner.plotting.style import save_figure
+
+        for name, fig in plan_figures(plan).items():
+            path = out / f"{name}.png"
+            save_figure(fig, path, option="out_dir")
+            files.append(str(path))
+    replays = _verify(plan, out / "plan.csv", int(verify), seed, progress)
+    if replays:
+        with open(out / "replay.json", "w") as f:
+            json.dump([r.as_dict() for r in replays], f, indent=1)
+        files.append(str(out / "replay.json"))
+    return PlanRun(plan, out, tuple(files), tuple(replays))
+
+
+def _verify(plan, csv_path, n, seed, progress) -> list:
+    """Re-simulate the exported file at ``n`` friction vectors of the task's interval."""
+    from qsplan.planner.export.plan_files import read_plan_csv
+    from qsplan.planner.planning.replay import friction_samples, replay_plan
+
+    mus = friction_samples(plan.task.mu_range, n, seed, shared=plan.task.shared_mu)
+    columns = read_plan_csv(csv_path)
+    out = []
+    for mu in mus:
+        progress(f"re-simulating the exported plan at mu = {[round(float(m), 4) for m in mu]}")
+        out.append(replay_plan(columns, plan.task.hand, mu))
+    return out
