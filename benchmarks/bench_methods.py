@@ -1,9 +1,9 @@
 """Benchmark: speed against accuracy of the two methods, n_c = 3..20 (issue 7; Table 1, Section 4.7).
 
-Methods: ``enumerate`` (:func:`mechanics.solve`, every feasible mode, eq. (49) modes tested)
-and ``lcp`` (:func:`mechanics.lcp.solve_lcp`, one mode by Lemke's method, verified by
+Methods: ``enumerate`` (:func:`qsplan.mechanics.solve`, every feasible mode, eq. (49) modes tested)
+and ``lcp`` (:func:`qsplan.mechanics.crosscheck.lcp.solve_lcp`, one mode by Lemke's method, verified by
 ``check_mode``).  For each ``n_c`` the scenes are seeded planted scenes
-(:func:`mechanics.planted_scene`) with ``|tau_I| = n_c - 3`` effort-controlled joints of
+(:func:`qsplan.mechanics.planted_scene`) with ``|tau_I| = n_c - 3`` effort-controlled joints of
 ``n_c - 1``, so at least one mode (the planted one) is feasible in every scene.
 
 Printed tables:

@@ -60,7 +60,7 @@ def time_solve(scene, repeat: int):
 
 
 def time_command(scene):
-    """Wall-clock seconds of ``python -m planner.cli modes FILE --json`` and its parsed output, or None."""
+    """Wall-clock seconds of ``python -m qsplan.planner.cli modes FILE --json`` and its parsed output, or None."""
     if not (ROOT / "planner" / "cli.py").exists():
         return None
     env = {**os.environ, "PYTHONPATH": os.pathsep.join(filter(None, [str(ROOT), os.environ.get("PYTHONPATH")]))}

@@ -2,7 +2,7 @@
 
 Section 4.7 proposes ordering the modes so that consecutive ``P_AI`` (eq. 23) differ by one
 row, and updating a factorization instead of refactoring.  The plain path of
-:func:`mechanics.solve` factors every mode's ``dof x dof`` matrix in numpy batches
+:func:`qsplan.mechanics.solve` factors every mode's ``dof x dof`` matrix in numpy batches
 (``np.linalg.solve`` on a ``(K, dof, dof)`` stack: LAPACK ``gesv`` per matrix, ``O(dof^3)``).
 A Gray-order walk would instead replace one row per step, which is a rank-one change
 ``A' = A + e_i (r' - r_i)^T`` and, by Sherman-Morrison, an ``O(dof^2)`` update of

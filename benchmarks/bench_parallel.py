@@ -7,7 +7,7 @@ per way of running it: 1 worker (in-process), 2 local workers, and a local Dask
 cluster of 2 single-threaded worker processes started here.  Times are the best of
 ``REPEAT`` wall-clock runs (the cluster's start-up is not included: it is started
 once, as a user's cluster would be); "identical" compares the whole result, every
-array bit for bit, with the in-process run (:func:`mechanics.parallel.first_difference`).
+array bit for bit, with the in-process run (:func:`qsplan.mechanics.parallel.first_difference`).
 
 Usage, with qsplan installed with its cluster extra (``pip install .[cluster]``)
 or ``PYTHONPATH=.``: ``python benchmarks/bench_parallel.py [--repeat 3]``.
@@ -54,7 +54,7 @@ def main(argv=None) -> int:
     ap.add_argument("--repeat", type=int, default=3)
     args = ap.parse_args(argv)
     rows, refs = [], {}
-    for name, f in tasks():  # local runs first: a live Dask client's threads rule out fork (see mechanics.parallel)
+    for name, f in tasks():  # local runs first: a live Dask client's threads rule out fork (see qsplan.mechanics.parallel)
         for label, kw in (("1", {"workers": 1}), ("2", {"workers": 2})):
             t, out = best_of(lambda: f(**kw), args.repeat)
             refs.setdefault(name, (t, out))

@@ -1,6 +1,6 @@
 """Benchmark: every contact mode at scale, exactly (Section 4.7's n_c = 12 ... 20), whole ``qsplan modes`` command.
 
-For each row a seeded planted scene (``mechanics.planted``, with a planted mode drawn
+For each row a seeded planted scene (``qsplan.mechanics.modes.planted``, with a planted mode drawn
 uniformly from the eq. (49) modes) is written to JSON and ``qsplan modes FILE --json
 --stats`` is run as a subprocess (interpreter start, imports, JSON in and out) ``--repeat``
 times; the table gives the best wall-clock time, the modes found, whether the planted mode is

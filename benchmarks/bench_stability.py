@@ -3,7 +3,7 @@
 Five families of three-contact scenes (two velocity-controlled joints, ``3 + |tau_I| = 3``) are
 driven toward a degeneracy by a distance ``eps = 2^-k`` (``k = 0, 4, ..., 52``, and ``eps = 0``
 itself).  All data are dyadic rationals with few bits, so the floats the methods see are the
-exact data and :mod:`mechanics.exact` gives the exact feasible set (strict inequalities strict,
+exact data and :mod:`qsplan.mechanics.crosscheck.exact` gives the exact feasible set (strict inequalities strict,
 singular meaning exactly singular):
 
 ``concurrent``
@@ -20,15 +20,15 @@ singular meaning exactly singular):
     the same force, and ``mu`` moved by ``eps`` to either side of the value where the rolling
     mode's region ends.
 
-Methods: ``enumerate`` (:func:`mechanics.solve`, default :class:`~mechanics.numerics.Tolerances`)
-and ``lcp`` (:func:`mechanics.lcp.solve_lcp`).  Counted per method: false modes (reported
+Methods: ``enumerate`` (:func:`qsplan.mechanics.solve`, default :class:`~qsplan.mechanics.numerics.Tolerances`)
+and ``lcp`` (:func:`qsplan.mechanics.crosscheck.lcp.solve_lcp`).  Counted per method: false modes (reported
 feasible, exactly infeasible), missed modes (exactly feasible, rejected by an ordinary check),
 declined modes (exactly feasible, reported degenerate or ill-conditioned: an honest "cannot
 tell", not a guess), exceptions; for ``lcp``: a returned mode not exactly feasible (false), or
 no mode though the exact set is not empty (missed).
 
 Condition measure: each mode's Hadamard ratio ``h = min(h(P_AI), h(Q_AI))``
-(:func:`mechanics.numerics.hadamard_ratio`; ``Q_AI`` when the kinematics pass).  The chart
+(:func:`qsplan.mechanics.numerics.hadamard_ratio`; ``Q_AI`` when the kinematics pass).  The chart
 ``benchmarks/charts/stability.png`` shows the enumerate method's wrong-answer and decline rates
 per mode against ``h`` and each family's errors against ``eps``; a threshold sweep over
 ``Tolerances.singular`` gives the wrong answers left above each threshold and the exactly
@@ -90,7 +90,7 @@ def _geometry(rng, n_c=3):
 
 
 def _planted(rng, r, n, letters, sgn, mu, slip=0.5, cone=0.5, mu_shift=0.0):
-    """A scene in which the mode ``letters`` is feasible up to the perturbations (cf. mechanics.planted).
+    """A scene in which the mode ``letters`` is feasible up to the perturbations (cf. qsplan.mechanics.modes.planted).
 
     Sliding contacts slip at ``sgn * slip``; rolling ones carry ``c_n = 1``, ``c_t = sgn cone mu``,
     and their ``mu`` is then moved by ``mu_shift`` (the force lies ``-mu_shift`` outside the cone);

@@ -22,7 +22,7 @@ SEED = 1
 def pentagon_task(mu_range=(0.0, 0.2)):
     hand = make_two_finger_hand(
         workpiece=[[0.0, 0.0], [0.070, 0.0], [0.070, 0.060], [0.035, 0.090], [0.0, 0.060]],  # m, counter-clockwise
-        workpiece_mass=0.15, finger_base=0.09, finger_length=0.16, finger_width=0.012,
+        workpiece_mass=0.15, finger_base=0.09, finger_length=0.11, finger_width=0.012,
     )  # fmt: skip
     return make_task(hand, start_x=0.0, waypoints=[0.02, -0.02], mu_range=mu_range, torque_resolution=0.01,
                      joint_speed=0.5, workpiece_speed=0.01, name="pentagon: right then left")  # fmt: skip

@@ -1,11 +1,11 @@
 """qsplan.hands: concrete hands and scenes.
 
-* :mod:`hands.paper` - the paper's example scenes (eqs. 37, 42, the rod of Fig. 7) in the raw form.
-* :mod:`hands.rod` - the rod on two moving supports as a finite-motion system, with its closed form (Section 5.1).
-* :mod:`hands.pushing` - a polygon pushed across a surface by a finger (contacts appearing).
-* :mod:`hands.two_finger` - the palm and two single-link fingers of Fig. 9 holding a polygon.
-* :mod:`hands.two_finger_scene` - that hand's scene (geometric and raw) at a configuration.
-* :mod:`hands.segments` - manipulation segments of that hand (segment 1: translate left in 4S).
+* :mod:`qsplan.hands.paper` - the paper's example scenes (eqs. 37, 42, the rod of Fig. 7) in the raw form.
+* :mod:`qsplan.hands.rod` - the rod on two moving supports as a finite-motion system, with its closed form (Section 5.1).
+* :mod:`qsplan.hands.pushing` - a polygon pushed across a surface by a finger (contacts appearing).
+* :mod:`qsplan.hands.two_finger` - the palm and two single-link fingers of Fig. 9 holding a polygon.
+* :mod:`qsplan.hands.two_finger_scene` - that hand's scene (geometric and raw) at a configuration.
+* :mod:`qsplan.hands.segments` - manipulation segments of that hand (segment 1: translate left in 4S).
 
 Submodules are imported on first use so that ``import hands`` stays light.
 """

@@ -5,8 +5,8 @@
 * :func:`rod_scene` - the thin rod on two moving supports of Fig. 7 (R1S2 / R2S1, Fig. 8).
 
 The numbers are the paper's, printed to three decimals; each function returns
-a fresh raw-form dict (see :mod:`mechanics.scene_io`) that can be written to a
-file or passed to :func:`mechanics.scene_from_dict`.
+a fresh raw-form dict (see :mod:`qsplan.mechanics.model.scene_io`) that can be written to a
+file or passed to :func:`qsplan.mechanics.scene_from_dict`.
 """
 
 from __future__ import annotations

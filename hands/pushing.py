@@ -16,7 +16,7 @@ the edge's segment (``limits``).
 The contact geometry on the integrator's hot path is computed here with numpy
 (points on lines, and signed gaps, which contact detection alone does not give);
 shapely validates the polygon.  :meth:`PushedPolygon.geometry_document` exports any
-instant to the geometric scene form, where :func:`mechanics.geometry.find_contacts`
+instant to the geometric scene form, where :func:`qsplan.mechanics.model.geometry.find_contacts`
 and :mod:`qsplan.mechanics.model.geometric_scene` rebuild the same scene (the tests check it).
 """
 
@@ -115,7 +115,7 @@ class PushedPolygon:
     def scene(self, x, contacts) -> Scene:
         """The instant at ``x`` with the potential contacts ``contacts`` (eq. 1 about the world origin).
 
-        Built directly (no :func:`mechanics.make_scene` checks): the inputs are validated
+        Built directly (no :func:`qsplan.mechanics.make_scene` checks): the inputs are validated
         by :func:`make_pushed_polygon` and the simulator never passes a non-finite state.
         """
         x = np.asarray(x, dtype=float)
@@ -156,8 +156,8 @@ class PushedPolygon:
         The floor becomes the palm (a box under ``y = 0``, ``floor_extent`` m each side
         of the origin), the finger a prismatic joint whose link is a narrow triangle with
         its apex at the tip, and the workpiece mass is ``weight / gravity``.  Loading it
-        (:func:`mechanics.scene_from_dict`) finds the contacts with
-        :func:`mechanics.geometry.find_contacts`: the same points, normals and Jacobian
+        (:func:`qsplan.mechanics.scene_from_dict`) finds the contacts with
+        :func:`qsplan.mechanics.model.geometry.find_contacts`: the same points, normals and Jacobian
         rows as :meth:`scene` gives for the contacts in contact (tests check it), though
         ordered palm first and with one friction coefficient (the finger's static one).
         """

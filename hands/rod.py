@@ -4,7 +4,7 @@ The rod lies along x with its centre of mass at the world origin at t = 0.
 Support 1 (contact 1) starts at ``x = -l1``, support 2 (contact 2) at ``x = +l2``;
 each is a velocity-controlled prismatic joint along x, support 1 moving right
 and support 2 left, both at ``speed``.  Contact normals point up into the rod,
-``t = (-1, 0)``; in the raw form of :func:`hands.paper.rod_scene` the contact
+``t = (-1, 0)``; in the raw form of :func:`qsplan.hands.paper.rod_scene` the contact
 velocities are ``[v_n, v_t] = [0, -V]`` and ``[0, +V]``, here ``J_t = -I``.
 
 Closed form (derived for :func:`rod_closed_form`)
@@ -148,7 +148,7 @@ class RodOnSupports:
     def scene(self, x, contacts=(0, 1)):
         """The instant at ``x`` (eq. 1 wrenches about the world origin, ``J_n, J_t`` of the supports).
 
-        Built directly (no :func:`mechanics.make_scene` checks): every input is validated
+        Built directly (no :func:`qsplan.mechanics.make_scene` checks): every input is validated
         when the system is made, and the simulator never passes a non-finite state.
         """
         x = np.asarray(x, dtype=float)

@@ -2,10 +2,10 @@
 
 A segment moves the workpiece's pose linearly from ``pose_start`` to ``pose_end``
 over ``duration`` seconds; along it both fingers stay on the workpiece
-(:func:`hands.two_finger.finger_angles`), the velocity-controlled finger turns at
-the path's rate (:func:`hands.two_finger.finger_angle_rates`) and the
+(:func:`qsplan.hands.two_finger.finger_angles`), the velocity-controlled finger turns at
+the path's rate (:func:`qsplan.hands.two_finger.finger_angle_rates`) and the
 effort-controlled one is given a torque chosen inside a band (Figs. 10-13).
-:func:`sample_segment` gives the configurations and the :class:`mechanics.Scene`
+:func:`sample_segment` gives the configurations and the :class:`qsplan.mechanics.Scene`
 of each sample.
 
 The paper's plan has three 4S segments; :func:`first_segment` builds the first:
@@ -41,7 +41,7 @@ __all__ = [
 #: the workpiece along a whole edge (two contacts: the next segment's contact set).
 #: 1e-3 rad keeps the far end of the edge 1e-3 x its length (about 0.1 mm for the
 #: default hand) off the finger, a hundred times the contact tolerance
-#: (:data:`mechanics.geometry.CONTACT_TOL`), so each sample still has one
+#: (:data:`qsplan.mechanics.model.geometry.CONTACT_TOL`), so each sample still has one
 #: contact per finger; it shortens the path by well under 1 %.
 FLUSH_CLEARANCE = 1e-3
 

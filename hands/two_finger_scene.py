@@ -20,7 +20,7 @@ __all__ = ["hand_manipulator", "hand_geometric_scene", "hand_contacts", "hand_sc
 
 
 def hand_manipulator(hand: TwoFingerHand):
-    """The two fingers as a :class:`mechanics.Manipulator` (joints "left", "right"; palm as the base)."""
+    """The two fingers as a :class:`qsplan.mechanics.Manipulator` (joints "left", "right"; palm as the base)."""
     from qsplan.mechanics.model.manipulator import make_joint, make_manipulator
 
     L, w = hand.finger_length, 0.5 * hand.finger_width
@@ -35,7 +35,7 @@ def hand_manipulator(hand: TwoFingerHand):
 
 
 def hand_geometric_scene(hand: TwoFingerHand, pose, q=None, effort_joint="right", velocity=0.0, effort=0.0, mu=None):
-    """The instant as a :class:`mechanics.GeometricScene` (polygons, joints, inputs).
+    """The instant as a :class:`qsplan.mechanics.GeometricScene` (polygons, joints, inputs).
 
     Parameters
     ----------
@@ -102,7 +102,7 @@ def hand_contacts(gs) -> list:
 
 
 def hand_scene(hand: TwoFingerHand, pose, q=None, effort_joint="right", velocity=0.0, effort=0.0, mu=None):
-    """The :class:`mechanics.Scene` of the hand at ``pose`` (contacts found from the polygons).
+    """The :class:`qsplan.mechanics.Scene` of the hand at ``pose`` (contacts found from the polygons).
 
     Parameters are those of :func:`hand_geometric_scene`.
 

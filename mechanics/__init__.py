@@ -46,7 +46,7 @@ if __name__ != "qsplan.mechanics":  # the repository root on sys.path must not l
     raise ImportError(f"this folder installs as qsplan.mechanics; import qsplan.mechanics (after `pip install .`), not {__name__}")
 
 
-from qsplan.mechanics.bands.effort import Band, effort_band, effort_bands
+from qsplan.mechanics.bands.effort import Band, ForceMargin, effort_band, effort_bands
 from qsplan.mechanics.bands.guaranteed import guaranteed_band_box, guaranteed_band_shared, possible_band_box, sampled_band
 from qsplan.mechanics.bands.robust import RobustBand, robust_band
 from qsplan.mechanics.errors import ModeError, NoAnswerError, QsplanError, SceneError
@@ -123,6 +123,7 @@ __all__ = [
     "ModeCheck",
     "check_mode",
     "Band",
+    "ForceMargin",
     "effort_band",
     "effort_bands",
     "guaranteed_band_box",

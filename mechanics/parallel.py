@@ -23,9 +23,11 @@ import os
 import pickle
 import threading
 from concurrent.futures import ProcessPoolExecutor
+from concurrent.futures.process import BrokenProcessPool
 from functools import partial
 
-from qsplan.mechanics.errors import QsplanError
+from qsplan.mechanics.cluster import connect, gather_with_progress, quiet_dask_logs
+from qsplan.mechanics.errors import ParallelError, QsplanError
 
 __all__ = [
     "map_chunks",
@@ -33,13 +35,22 @@ __all__ = [
     "resolve_workers",
     "split_range",
     "first_difference",
+    "no_progress_timeout",
     "CONNECT_TIMEOUT",
+    "NO_PROGRESS_TIMEOUT",
     "MAX_CLUSTER_CHUNKS",
 ]
 
 #: Seconds to wait for a Dask scheduler to answer: long enough for a cluster on a
 #: local network, short enough that a mistyped ``--scheduler`` fails promptly.
 CONNECT_TIMEOUT = 5.0
+
+#: Seconds a Dask cluster may go with no chunk finished and none running before the wait is an
+#: error (:func:`qsplan.mechanics.cluster.gather_with_progress`): a nanny restarts a lost worker
+#: in a few seconds and the scheduler reassigns its chunk at once, so a minute without any chunk
+#: running means no worker is coming; a chunk still running (however long) keeps the wait alive.
+#: Set ``QSPLAN_NO_PROGRESS_TIMEOUT`` for clusters whose workers take longer to join.
+NO_PROGRESS_TIMEOUT = 60.0
 
 #: Chunks sent to a cluster when ``workers`` does not say: enough to keep a few dozen
 #: workers busy and balanced, few enough that per-task overhead (~ms) stays negligible.
@@ -93,6 +104,9 @@ def chunk_count(n_units: int, min_units: int, *, workers=None, scheduler=None) -
     return max(1, min(cap, n_units // max(1, min_units)))
 
 
+_MISSING = object()
+
+
 def _one_blas_thread():
     """Pool initializer: one BLAS thread per worker process.
 
@@ -125,18 +139,46 @@ def _client(scheduler):
                 f"got {type(scheduler).__name__}"
             )
         return scheduler, False
+    return connect(scheduler, CONNECT_TIMEOUT), True
+
+
+def no_progress_timeout() -> float:
+    """:data:`NO_PROGRESS_TIMEOUT`, or the environment's ``QSPLAN_NO_PROGRESS_TIMEOUT`` (seconds) when set."""
+    raw = os.environ.get("QSPLAN_NO_PROGRESS_TIMEOUT")
+    if raw is None:
+        return NO_PROGRESS_TIMEOUT
     try:
-        from distributed import Client
-    except ImportError:
-        raise QsplanError(
-            f"--scheduler {scheduler}: needs Dask distributed; install it with: pip install 'qsplan[cluster]'"
-        ) from None
-    try:
-        return Client(scheduler, timeout=CONNECT_TIMEOUT, set_as_default=False), True
-    except (OSError, TimeoutError, ValueError, TypeError) as exc:
-        raise QsplanError(
-            f"--scheduler {scheduler}: cannot reach a Dask scheduler within {CONNECT_TIMEOUT:g} s ({exc})"
-        ) from None
+        value = float(raw)
+    except ValueError:
+        value = float("nan")
+    if not 0 < value < float("inf"):
+        raise QsplanError(f"QSPLAN_NO_PROGRESS_TIMEOUT: expected a positive number of seconds; got {raw!r}")
+    return value
+
+
+def _in_pool(fn, items: list, n: int, progress=None) -> list:
+    """``[fn(item) ...]`` on ``n`` local processes; a pool that breaks is replaced once for the missing items."""
+    results: list = [_MISSING] * len(items)
+    todo = list(range(len(items)))
+    for attempt in (1, 2):
+        try:
+            with ProcessPoolExecutor(max_workers=min(n, len(todo)), mp_context=_pool_context(),
+                                     initializer=_one_blas_thread) as ex:  # fmt: skip
+                futures = [(i, ex.submit(fn, items[i])) for i in todo]
+                for i, f in futures:  # in order: the first exception of fn propagates, as in a loop
+                    results[i] = f.result()
+                    if progress:
+                        progress(sum(r is not _MISSING for r in results), len(items), "chunks")
+            return results
+        except BrokenProcessPool:
+            for i, f in futures:
+                if f.done() and not f.cancelled() and f.exception() is None:
+                    results[i] = f.result()
+            todo = [i for i in todo if results[i] is _MISSING]
+    raise ParallelError(
+        f"workers: a local worker process died (killed, or out of memory) while running {len(todo)} of "
+        f"{len(items)} chunks, and again in a new pool; rerun with workers=1 to compute in this process"
+    )
 
 
 #: Protocol 4 rebuilds numpy arrays by copying into memory numpy allocates, as a local
@@ -155,7 +197,13 @@ def _call_unpickled(fn, payload: bytes):
     return fn(pickle.loads(payload))
 
 
-def map_chunks(fn, items, *, workers=None, scheduler=None) -> list:
+def _on_cluster(client, fn, items: list, address: str, timeout: float, progress) -> list:
+    payloads = [pickle.dumps(item, protocol=_PROTOCOL) for item in items]
+    futures = client.map(partial(_call_unpickled, fn), payloads, pure=False)
+    return gather_with_progress(client, futures, address, timeout, progress)
+
+
+def map_chunks(fn, items, *, workers=None, scheduler=None, progress=None) -> list:
     """``[fn(item) for item in items]``, computed in parallel, in input order.
 
     Parameters
@@ -169,6 +217,8 @@ def map_chunks(fn, items, *, workers=None, scheduler=None) -> list:
         A single item, or a call from a daemon process, runs in-process.  Ignored
         when ``scheduler`` is given (callers then use it as the number of chunks:
         :func:`chunk_count`).
+    progress : callable, optional
+        ``progress(done, total, "chunks")`` each time another chunk is done.
     scheduler : str or dask.distributed.Client or None
         Address of a Dask scheduler (``"tcp://host:8786"``) or a connected client:
         the chunks run on that cluster.  A client passed in is left open.
@@ -181,24 +231,45 @@ def map_chunks(fn, items, *, workers=None, scheduler=None) -> list:
     Raises
     ------
     QsplanError
-        Bad ``workers``; a scheduler that cannot be reached within
-        :data:`CONNECT_TIMEOUT`; Dask not installed.  Exceptions raised by ``fn``
-        propagate unchanged.
+        Bad ``workers``; a malformed scheduler address, or one where no scheduler answers
+        within :data:`CONNECT_TIMEOUT`; Dask not installed.
+    ParallelError
+        A local worker process died, and again when its chunks were rerun in a new pool;
+        a cluster on which, for :func:`no_progress_timeout` seconds, no chunk finished or
+        ran (no workers, workers lost, a scheduler that stopped answering), or whose
+        scheduler gave up after workers died.  Exceptions raised by ``fn`` propagate unchanged.
     """
     items = list(items)
     if scheduler is not None:
-        client, owned = _client(scheduler)
-        payloads = [pickle.dumps(item, protocol=_PROTOCOL) for item in items]
+        timeout = no_progress_timeout()
+        if not isinstance(scheduler, str):
+            client = _client(scheduler)[0]
+            address = getattr(getattr(client, "scheduler", None), "address", "the client's")
+            return _on_cluster(client, fn, items, address, timeout, progress)
         try:
-            return client.gather(client.map(partial(_call_unpickled, fn), payloads, pure=False))
-        finally:
-            if owned:
-                client.close()
+            import distributed  # noqa: F401
+        except ImportError:
+            raise QsplanError(
+                f"scheduler: {scheduler} needs Dask distributed; install it with: pip install 'qsplan[cluster]'"
+            ) from None
+        with quiet_dask_logs():
+            client = _client(scheduler)[0]
+            try:
+                return _on_cluster(client, fn, items, scheduler, timeout, progress)
+            finally:
+                try:
+                    client.close(timeout=CONNECT_TIMEOUT)
+                except Exception:  # noqa: BLE001 - a dead scheduler: the error raised above says so
+                    pass
     n = min(resolve_workers(workers), len(items))
     if n <= 1 or multiprocessing.current_process().daemon:  # a daemon (a Dask worker) may not start processes
-        return [fn(item) for item in items]
-    with ProcessPoolExecutor(max_workers=n, mp_context=_pool_context(), initializer=_one_blas_thread) as ex:
-        return list(ex.map(fn, items))
+        out = []
+        for item in items:
+            out.append(fn(item))
+            if progress:
+                progress(len(out), len(items), "chunks")
+        return out
+    return _in_pool(fn, items, n, progress)
 
 
 def first_difference(a, b, path: str = "result", skip=("scene", "samples")) -> str | None:

@@ -10,6 +10,7 @@ Public API (loaded on first use, so ``import qsplan.planner`` stays light):
 * no plan: :class:`PlanFailure` (a :class:`NoAnswerError`) with its :class:`FailureReport`
 * export: :func:`export_plan`, :func:`read_plan_csv`, :func:`export_schedule`, :func:`check_outputs`
 * replay and verification: :func:`replay_plan`, :func:`friction_samples`, :class:`Replay`
+* independent certification of an exported plan: :func:`certify_plan`, :class:`Certificate`
 * torque bands along a segment and commands: :func:`segment_bands`, :func:`guaranteed_sweep`,
   :func:`point_band_sweep`, :func:`sampled_guaranteed_sweep`, :func:`choose_command`, :func:`sweep_segment`;
   for one scene, the guaranteed band with every competitor precluded: :func:`robust_band`
@@ -55,6 +56,9 @@ _LAZY = {
     "ompl_available": "qsplan.planner.planning.ompl_bridge",
     "run_plan": "qsplan.planner.planning.pipeline",
     "PlanRun": "qsplan.planner.planning.pipeline",
+    "certify_plan": "qsplan.planner.planning.certify",
+    "Certificate": "qsplan.planner.planning.certify",
+    "Violation": "qsplan.planner.planning.certify",
     "plan_outputs": "qsplan.planner.planning.pipeline",
     # replay and verification
     "replay_plan": "qsplan.planner.planning.replay",

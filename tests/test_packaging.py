@@ -3,6 +3,7 @@ and the bundled task files; and the repository's folders refuse to load under th
 
 from __future__ import annotations
 
+import shutil
 import subprocess
 import sys
 import zipfile
@@ -18,7 +19,13 @@ FOLDERS = {"mechanics": "qsplan/mechanics", "hands": "qsplan/hands", "planner": 
 def wheel(tmp_path_factory) -> zipfile.ZipFile:
     """The wheel pip builds from the working tree (the same build ``pip install .`` runs)."""
     out = tmp_path_factory.mktemp("wheel")
-    r = subprocess.run([sys.executable, "-m", "pip", "wheel", "-q", "--no-deps", "-w", str(out), str(ROOT)],
+    # a copy of what the build reads, so setuptools' build/ folder never lands in the working tree
+    src = tmp_path_factory.mktemp("source")
+    for name in ("pyproject.toml", "README.md"):
+        shutil.copy(ROOT / name, src / name)
+    for folder in ("src", *FOLDERS):
+        shutil.copytree(ROOT / folder, src / folder, ignore=shutil.ignore_patterns("__pycache__"))
+    r = subprocess.run([sys.executable, "-m", "pip", "wheel", "-q", "--no-deps", "-w", str(out), str(src)],
                        capture_output=True, text=True)
     assert r.returncode == 0, r.stderr[-2000:]
     (path,) = out.glob("qsplan-*.whl")

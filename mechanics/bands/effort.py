@@ -5,8 +5,10 @@ depend on the effort or on friction, and the wrench intensities are affine in
 the effort: ``c_A(tau) = Q_AI^{-1} ([-g_obj; -g_man_I] + tau e)`` (eq. 26).
 Every Coulomb inequality of eq. (28) is then ``s_r(tau) = s0_r + tau s1_r >= 0``,
 a half-line of efforts, and the band is their intersection (Section 5.2,
-Figs. 10-12).  Bands over uncertain friction (guaranteed, possible, sampled) are
-in :mod:`qsplan.mechanics.bands.guaranteed`.
+Figs. 10-12).  A :class:`ForceMargin` asks for ``s_r >= m_r`` instead: every loaded
+contact's normal force at least ``normal`` and every rolling contact's cone slacks at
+least ``slack`` (N); still a half-line per row.  Bands over uncertain friction
+(guaranteed, possible, sampled) are in :mod:`qsplan.mechanics.bands.guaranteed`.
 """
 
 from __future__ import annotations
@@ -15,7 +17,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from qsplan.mechanics.errors import SceneError
+from qsplan.mechanics.errors import QsplanError, SceneError
 from qsplan.mechanics.modes.contact_mode import ContactMode
 from qsplan.mechanics.numerics import DEFAULT_TOLERANCES, Status, Tolerances
 from qsplan.mechanics.model.scene import Scene
@@ -24,6 +26,9 @@ from qsplan.mechanics.modes.kinematics import ScenePool, single_mode_kinematics
 
 __all__ = [
     "Band",
+    "ForceMargin",
+    "check_force_margin",
+    "row_margins",
     "ModeKinematics",
     "check_one_effort_joint",
     "band_kinematics",
@@ -91,6 +96,79 @@ class Band:
         return d
 
 
+@dataclass(frozen=True, slots=True)
+class ForceMargin:
+    """How far inside eq. (28) a band keeps the mode: a minimum normal force and a minimum Coulomb slack.
+
+    Exactly at a band edge some normal force or cone slack of eq. (28) is zero: the model is
+    on the brink of another mode, and any unmodelled load (a mass error, an inertial force,
+    a torque error) tips it over.  With a margin every row ``s_r >= 0`` becomes ``s_r >= m_r``.
+
+    Attributes
+    ----------
+    normal : float
+        N, >= 0: every rolling and sliding contact's normal force ``c_n >= normal`` (eq. 9, made strict).
+        Breaking contacts carry no force by definition and are not constrained.
+    slack : float
+        N, >= 0: both cone slacks ``mu c_n + c_t`` and ``mu c_n - c_t`` of every rolling contact
+        ``>= slack`` (eqs. 21, 28, made strict).  A sliding contact lies on its cone's edge by
+        definition (eq. 17): its only row is ``c_n``.  At ``mu = 0`` a rolling contact's slacks
+        are ``+-c_t``, so any positive ``slack`` empties a band whose friction set reaches 0.
+
+    Raises
+    ------
+    QsplanError
+        A field negative, non-finite or not a number (the message names it).
+    """
+
+    normal: float = 0.0
+    slack: float = 0.0
+
+    def __post_init__(self):
+        for name in ("normal", "slack"):
+            v = getattr(self, name)
+            if isinstance(v, bool) or not isinstance(v, (int, float, np.integer, np.floating)):
+                raise QsplanError(f"force_margin.{name}: expected a nonnegative finite force (N); got {v!r}")
+            if not (np.isfinite(v) and v >= 0):
+                raise QsplanError(f"force_margin.{name}: expected a nonnegative finite force (N); got {v!r}")
+            object.__setattr__(self, name, float(v))
+
+    @property
+    def is_zero(self) -> bool:
+        """Both margins 0: the plain eq. (28)."""
+        return self.normal == 0.0 and self.slack == 0.0
+
+    def to_dict(self) -> dict:
+        """``{"min_normal_force_N", "min_coulomb_slack_N"}`` for exports."""
+        return {"min_normal_force_N": self.normal, "min_coulomb_slack_N": self.slack}
+
+
+def check_force_margin(force_margin) -> ForceMargin:
+    """A :class:`ForceMargin` from ``None`` (no margin), a ForceMargin, or a pair ``(normal, slack)`` (N)."""
+    if force_margin is None:
+        return ForceMargin()
+    if isinstance(force_margin, ForceMargin):
+        return force_margin
+    if isinstance(force_margin, (tuple, list)) and len(force_margin) == 2:
+        return ForceMargin(*force_margin)
+    raise QsplanError(f"force_margin: expected a ForceMargin or (normal, slack) in N; got {force_margin!r}")
+
+
+def row_margins(mode: ContactMode, force_margin) -> np.ndarray:
+    """The margin of each row of :func:`band_rows` for ``mode``, shape (r,) (N).
+
+    Rows in :func:`band_rows`' order: per rolling contact ``slack, slack, normal``, per sliding one ``normal``.
+    """
+    fm = check_force_margin(force_margin)
+    out = []
+    for letter in mode.letters:
+        if letter == "R":
+            out += [fm.slack, fm.slack, fm.normal]
+        elif letter != "B":
+            out.append(fm.normal)
+    return np.array(out, dtype=float)
+
+
 @dataclass(frozen=True, slots=True, eq=False)
 class ModeKinematics:
     """A mode's mu- and effort-independent kinematic solution, or why it has none."""
@@ -120,7 +198,7 @@ def band_kinematics(scene: Scene, mode: ContactMode, tol: Tolerances = DEFAULT_T
     return ModeKinematics(*single_mode_kinematics(scene, mode, tol))
 
 
-def band_rows(scene: Scene, mk: ModeKinematics, mu_rows) -> tuple:
+def band_rows(scene: Scene, mk: ModeKinematics, mu_rows, force_margin=None) -> tuple:
     """Coulomb slacks of eq. (28) as affine functions of the effort, at each mu row.
 
     Parameters
@@ -130,12 +208,17 @@ def band_rows(scene: Scene, mk: ModeKinematics, mu_rows) -> tuple:
     mk : ModeKinematics
         With ``mk.ok``.
     mu_rows : array-like, shape (N, n_c)
+    force_margin : ForceMargin, optional
+        Subtracted from ``s0`` (:func:`row_margins`): the rows then read ``s(tau) - m >= 0``.
+        ``det Q_AI (s - m)`` stays multilinear in the mu's (``det`` is), so the vertex and root
+        arguments of :mod:`qsplan.mechanics.bands.guaranteed` hold unchanged.
 
     Returns
     -------
     s0, s1 : ndarray, shape (N, r)
         ``s(tau) = s0 + tau * s1`` for the mode's r Coulomb rows: ``mu c_n + c_t`` and
-        ``mu c_n - c_t`` and ``c_n`` per rolling contact, ``c_n`` per sliding contact.
+        ``mu c_n - c_t`` and ``c_n`` per rolling contact, ``c_n`` per sliding contact
+        (minus their margins with ``force_margin``).
     det : ndarray, shape (N,)
         ``det Q_AI`` (sign and size tell singularity).
     scale : ndarray, shape (N,)
@@ -177,6 +260,8 @@ def band_rows(scene: Scene, mk: ModeKinematics, mu_rows) -> tuple:
     s0 = np.column_stack(out0)
     s1 = np.column_stack(out1)
     scale = np.maximum(np.max(np.abs(sol[:, :, 0]), axis=1), np.max(np.abs(r0)))
+    if force_margin is not None:
+        s0 = s0 - row_margins(mk.mode, force_margin)[None, :]
     s0[bad] = np.nan
     s1[bad] = np.nan
     return s0, s1, det, scale
@@ -199,8 +284,8 @@ def intersect_rows(s0, s1, scale, tol: Tolerances):
     return lower, upper, ok
 
 
-def effort_bands(scene: Scene, mode: ContactMode, mu_rows, tol: Tolerances = DEFAULT_TOLERANCES):
-    """Bands of ``mode`` at many friction points at once.
+def effort_bands(scene: Scene, mode: ContactMode, mu_rows, tol: Tolerances = DEFAULT_TOLERANCES, *, force_margin=None):
+    """Bands of ``mode`` at many friction points at once (``force_margin``: see :class:`ForceMargin`).
 
     Returns
     -------
@@ -209,17 +294,19 @@ def effort_bands(scene: Scene, mode: ContactMode, mu_rows, tol: Tolerances = DEF
         False where the band is empty, the kinematics fail or ``Q_AI`` is singular.
     """
     check_one_effort_joint(scene)
+    force_margin = None if force_margin is None else check_force_margin(force_margin)
     mu_rows = np.atleast_2d(np.asarray(mu_rows, dtype=float))
     mk = band_kinematics(scene, mode, tol)
     N = mu_rows.shape[0]
     if not mk.ok:
         return np.full(N, np.nan), np.full(N, np.nan), np.zeros(N, dtype=bool)
-    s0, s1, det, scale = band_rows(scene, mk, mu_rows)
+    s0, s1, det, scale = band_rows(scene, mk, mu_rows, force_margin)
     lower, upper, ok = intersect_rows(s0, s1, scale, tol)
     return lower, upper, ok
 
 
-def effort_band(scene: Scene, mode: ContactMode, mu=None, tol: Tolerances = DEFAULT_TOLERANCES) -> Band:
+def effort_band(scene: Scene, mode: ContactMode, mu=None, tol: Tolerances = DEFAULT_TOLERANCES, *,
+                force_margin=None) -> Band:
     """The band of ``mode`` at the scene's friction (or at ``mu``), eq. (28).
 
     Parameters
@@ -228,13 +315,16 @@ def effort_band(scene: Scene, mode: ContactMode, mu=None, tol: Tolerances = DEFA
         Exactly one effort-controlled joint; its commanded effort is ignored.
     mode : ContactMode
     mu : array-like, shape (n_c,), optional
+    force_margin : ForceMargin or (float, float), optional
+        Minimum normal force and Coulomb slack (N) the band keeps (default none: eq. 28 as is).
     """
     joint = check_one_effort_joint(scene)
+    force_margin = None if force_margin is None else check_force_margin(force_margin)
     mk = band_kinematics(scene, mode, tol)
     if not mk.ok:
         return Band(mode.letters, joint, np.nan, np.nan, False, f"kinematics: {mk.status}")
     mu = scene.mu if mu is None else np.broadcast_to(np.asarray(mu, float), (scene.n_contacts,))
-    s0, s1, det, scale = band_rows(scene, mk, mu[None])
+    s0, s1, det, scale = band_rows(scene, mk, mu[None], force_margin)
     if not np.isfinite(s0).all():
         return Band(mode.letters, joint, np.nan, np.nan, False, "equilibrium_singular")
     lower, upper, ok = intersect_rows(s0, s1, scale, tol)

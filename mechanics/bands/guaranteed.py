@@ -14,6 +14,13 @@ Over uncertain friction the guarantee is exact:
   ratio of polynomials in mu; its extremes over ``[lo, hi]`` are found from the
   polynomial's roots (critical points and sign changes), not from samples.
 
+A force margin (:class:`qsplan.mechanics.bands.effort.ForceMargin`: ``s_r >= m_r``
+with a constant ``m_r`` instead of ``s_r >= 0``) keeps both exact: where ``det Q_AI``
+keeps its sign, ``s_r - m_r >= 0`` iff ``det (s_r - m_r) = det s_r - m_r det`` has
+the sign of ``det``, a difference of two multilinear (shared: polynomial) functions,
+so vertices (roots) still decide.  Competitors (:func:`possible_band_box`) take no
+margin: precluding them is about feasibility, not about how far inside it they are.
+
 :func:`sampled_band` keeps the paper's method (intersection over a list of mu)
 for comparison.
 """
@@ -24,7 +31,16 @@ from itertools import product
 
 import numpy as np
 
-from qsplan.mechanics.bands.effort import Band, band_kinematics, band_rows, check_one_effort_joint, effort_band, effort_bands, intersect_rows
+from qsplan.mechanics.bands.effort import (
+    Band,
+    band_kinematics,
+    band_rows,
+    check_force_margin,
+    check_one_effort_joint,
+    effort_band,
+    effort_bands,
+    intersect_rows,
+)
 from qsplan.mechanics.model.friction import check_mu_range
 from qsplan.mechanics.model.scene import Scene
 from qsplan.mechanics.modes.contact_mode import ContactMode
@@ -44,20 +60,24 @@ def _box_vertices(scene: Scene, mode: ContactMode, lo, hi) -> np.ndarray:
     return verts
 
 
-def guaranteed_band_box(scene: Scene, mode: ContactMode, lo, hi, tol: Tolerances = DEFAULT_TOLERANCES) -> Band:
+def guaranteed_band_box(scene: Scene, mode: ContactMode, lo, hi, tol: Tolerances = DEFAULT_TOLERANCES, *,
+                        force_margin=None) -> Band:  # fmt: skip
     """Efforts for which ``mode`` is feasible for **every** mu with ``lo <= mu_i <= hi`` (exact).
 
     Parameters
     ----------
     lo, hi : float or array-like, shape (n_c,)
         Independent intervals per contact (breaking contacts' mu do not matter).
+    force_margin : ForceMargin or (float, float), optional
+        Minimum normal force and Coulomb slack (N) kept for every mu in the box (default none).
     """
     joint = check_one_effort_joint(scene)
+    force_margin = None if force_margin is None else check_force_margin(force_margin)
     verts = _box_vertices(scene, mode, lo, hi)
     mk = band_kinematics(scene, mode, tol)
     if not mk.ok:
         return Band(mode.letters, joint, np.nan, np.nan, False, f"kinematics: {mk.status}", "box-vertices")
-    s0, s1, det, scale = band_rows(scene, mk, verts)
+    s0, s1, det, scale = band_rows(scene, mk, verts, force_margin)
     if not (np.all(det > 0) or np.all(det < 0)):
         return Band(
             mode.letters, joint, np.nan, np.nan, False,
@@ -119,19 +139,22 @@ def possible_band_box(scene: Scene, mode: ContactMode, lo, hi, tol: Tolerances =
     return Band(mode.letters, joint, float(lower), float(upper), True, None, "possible-superset", False)
 
 
-def sampled_band(scene: Scene, mode: ContactMode, mu_rows, tol: Tolerances = DEFAULT_TOLERANCES) -> Band:
+def sampled_band(scene: Scene, mode: ContactMode, mu_rows, tol: Tolerances = DEFAULT_TOLERANCES, *,
+                 force_margin=None) -> Band:  # fmt: skip
     """The paper's method: intersect the point bands over the listed mu (e.g. 0, 0.01, ..., 0.2).
 
     Parameters
     ----------
     mu_rows : array-like, shape (N, n_c) or (N,)
         Friction points; a 1-D array gives one shared coefficient per sample.
+    force_margin : ForceMargin or (float, float), optional
+        As in :func:`guaranteed_band_box`.
     """
     joint = check_one_effort_joint(scene)
     mu_rows = np.asarray(mu_rows, dtype=float)
     if mu_rows.ndim == 1:
         mu_rows = np.repeat(mu_rows[:, None], scene.n_contacts, axis=1)
-    lower, upper, ok = effort_bands(scene, mode, mu_rows, tol)
+    lower, upper, ok = effort_bands(scene, mode, mu_rows, tol, force_margin=force_margin)
     if not ok.all():
         return Band(mode.letters, joint, np.nan, np.nan, False, "infeasible at some sample", "sampled", False)
     lo_, up_ = float(lower.max()), float(upper.min())
@@ -146,7 +169,8 @@ def _poly_fit_exact(x, y, degree):
     return np.linalg.solve(V, y)
 
 
-def guaranteed_band_shared(scene: Scene, mode: ContactMode, lo: float, hi: float, tol: Tolerances = DEFAULT_TOLERANCES) -> Band:
+def guaranteed_band_shared(scene: Scene, mode: ContactMode, lo: float, hi: float, tol: Tolerances = DEFAULT_TOLERANCES,
+                           *, force_margin=None) -> Band:  # fmt: skip
     """Efforts for which ``mode`` is feasible for every shared coefficient ``mu`` in ``[lo, hi]`` (exact).
 
     With one coefficient shared by all contacts, ``det Q_AI`` is a polynomial of
@@ -156,19 +180,21 @@ def guaranteed_band_shared(scene: Scene, mode: ContactMode, lo: float, hi: float
     are taken at the ends, at the real roots of ``N0' N1 - N0 N1'`` and in the
     limits at roots of ``N1`` (where the bound leaves to infinity, harmlessly if
     the row holds there and fatally if not).  A root of ``det Q_AI`` inside the
-    interval means a degenerate mode: nothing is guaranteed.
+    interval means a degenerate mode: nothing is guaranteed.  With ``force_margin``
+    (as in :func:`guaranteed_band_box`) ``N0_r`` is ``det Q_AI (s0_r - m_r)``, of the same degree.
     """
     joint = check_one_effort_joint(scene)
+    force_margin = None if force_margin is None else check_force_margin(force_margin)
     lo, hi = check_mu_range(lo, hi)
     mk = band_kinematics(scene, mode, tol)
     if not mk.ok:
         return Band(mode.letters, joint, np.nan, np.nan, False, f"kinematics: {mk.status}", "shared-roots")
     if hi == lo:
-        b = effort_band(scene, mode, np.full(scene.n_contacts, lo), tol)
+        b = effort_band(scene, mode, np.full(scene.n_contacts, lo), tol, force_margin=force_margin)
         return Band(b.mode, joint, b.lower, b.upper, b.feasible, b.reason, "shared-roots")
     deg = len(mode.sliding) + 1
     nodes = 0.5 * (lo + hi) + 0.5 * (hi - lo) * np.cos(np.pi * (np.arange(deg + 1) + 0.5) / (deg + 1))
-    s0, s1, det, scale = band_rows(scene, mk, np.repeat(nodes[:, None], scene.n_contacts, axis=1))
+    s0, s1, det, scale = band_rows(scene, mk, np.repeat(nodes[:, None], scene.n_contacts, axis=1), force_margin)
     pdet = _poly_fit_exact(nodes, det, deg)
     P = np.polynomial.Polynomial
     roots_det = [r.real for r in P(pdet).roots() if abs(r.imag) < 1e-12 and lo <= r.real <= hi]

@@ -1,8 +1,8 @@
 """Precluding a competing contact mode over uncertain friction (Section 5.2, Figs. 12-13).
 
 To guarantee a desired mode the effort must keep it feasible for every friction
-coefficient in the uncertainty set (:func:`mechanics.guaranteed_band_box`,
-:func:`mechanics.guaranteed_band_shared`) **and** make every competing mode
+coefficient in the uncertainty set (:func:`qsplan.mechanics.guaranteed_band_box`,
+:func:`qsplan.mechanics.guaranteed_band_shared`) **and** make every competing mode
 infeasible for every one of them.  :func:`competitor_torques` finds, inside a
 given effort interval ``G``, the hull ``[lower, upper]`` of the efforts for which
 a competing mode is feasible for *some* friction in the set; subtracting it from
@@ -21,12 +21,19 @@ Method (branch and bound over friction cells, exact to a tolerance):
   efforts lie in the intersection over rows.  Where ``det`` changes sign (the
   mode is singular inside the cell), a pair of rows whose numerators keep
   opposite signs on the whole cell still excludes the effort.
-* Cells are bisected best-first.  Every evaluated friction point gives a truly
-  feasible effort (an incumbent); cells whose bound cannot beat the incumbent by
-  more than the tolerance are dropped.  The reported end is the smallest bound
-  left, so it never lies inside the competitor's true set: the result is exact
-  to ``tol`` when the search finishes, and conservative (wider) when it runs out
-  of its cell budget, which is said in the result.
+* Cells are bisected best-first, each along the side where its control values
+  change most.  Every evaluated friction point whose band (from the model, eq. 28)
+  is not empty gives a truly feasible effort (an incumbent); cells whose bound
+  cannot beat the incumbent by more than the tolerance are dropped.  The reported
+  end is the smallest bound left, so it never lies inside the competitor's true
+  set: the result is exact to ``tol`` when the search finishes, and conservative
+  (wider) when it runs out of its cell budget, which is said in the result.
+* Unbounded sides are explicit: a cell may admit arbitrarily low efforts (bound
+  ``-inf``: every row falls with the effort at some control point); such a cell
+  is kept and, if the budget runs out, reported as ``-inf`` (conservative), never
+  dropped.  The end is proved infinite only by a friction point whose band is
+  itself unbounded on that side.  "Nothing possible" and "possible to infinity"
+  are different answers (``empty`` against an infinite ``lower`` / ``upper``).
 
 The hull may contain efforts where the competitor is infeasible (if its feasible
 efforts are not an interval): precluding the hull is then conservative.
@@ -72,12 +79,14 @@ class CompetitorTorques:
     ----------
     mode : str
     lower, upper : float
-        Hull of the competitor's possibly-feasible efforts inside ``G``; NaN when it
-        is infeasible for every effort in ``G`` and every friction in the set.
+        Hull of the competitor's possibly-feasible efforts inside ``G``; ``-inf`` / ``inf`` where
+        it reaches an unbounded side of ``G``; NaN when it is infeasible for every effort in ``G``
+        and every friction in the set.
     empty : bool
-        The competitor is precluded on the whole of ``G``.
+        The competitor is precluded on the whole of ``G`` (proved).
     exact : bool
-        Both ends were found to the tolerance (False: budget exhausted, the hull is wider).
+        Both ends were found to the tolerance, an infinite end proved by a friction point whose
+        band is unbounded there (False: budget exhausted, the hull is wider).
     reason : str or None
         ``"kinematics: ..."`` when the mode fails kinematically (never feasible), or why
         the answer is conservative.
@@ -168,6 +177,8 @@ class _Cells:
         widest side breaks ties (and is the choice where every side is flat).
         """
         width = chi - clo
+        if not width.shape[1]:
+            return clo, chi
         k = np.argmax(spread * (width > 0) + SPLIT_TIE * width / np.maximum(width.max(axis=1, keepdims=True), 1e-300), axis=1)
         rows = np.arange(clo.shape[0])
         mid = 0.5 * (clo[rows, k] + chi[rows, k])
@@ -184,6 +195,8 @@ def _spread(det, N0, N1, d):
     ``det`` and of every row's ``N0`` and ``N1``, each scaled by its largest magnitude on the cell.
     """
     m, K, _ = N0.shape
+    if d == 0:  # a point cell: nothing to split
+        return np.zeros((m, 0))
 
     def unit(x, axes):
         x = np.where(np.isfinite(x), x, 0.0)

@@ -29,6 +29,7 @@ from qsplan.mechanics.bands.preclusion import CompetitorTorques, competitor_torq
 from qsplan.mechanics.errors import QsplanError
 from qsplan.mechanics.model.friction import check_mu_range
 from qsplan.mechanics.modes.contact_mode import ContactMode, enumerate_modes
+from qsplan.mechanics.numerics import Status
 
 __all__ = ["TOUCH_RTOL", "RobustBand", "admissible_competitors", "robust_band", "subtract_hull"]
 
@@ -53,7 +54,9 @@ class RobustBand:
     feasible : bool
     exact : bool
         Edges exact (to :data:`qsplan.mechanics.bands.preclusion.PRECLUSION_RTOL` where competitors
-        were precluded); False where conservative (narrower than the true band).
+        were precluded); False where not proved, and ``reason`` says why: conservative (a competitor's
+        search ran out of cells: narrower than the true band) or a competitor the solver cannot decide
+        (ill-conditioned kinematics, named "undecided").
     split : bool
         A competitor's hull lay strictly inside the band: the larger piece was kept.
     desired : Band
@@ -130,7 +133,7 @@ def _check_mu_range(mu_range):
     return check_mu_range(lo, hi)
 
 
-def robust_band(scene, mode, mu_range, *, shared: bool = False, competitors=None) -> RobustBand:
+def robust_band(scene, mode, mu_range, *, shared: bool = False, competitors=None, force_margin=None) -> RobustBand:
     """The efforts that guarantee ``mode`` and preclude every competitor for all friction in the set.
 
     Parameters
@@ -145,6 +148,9 @@ def robust_band(scene, mode, mu_range, *, shared: bool = False, competitors=None
     shared : bool
     competitors : sequence of str, optional
         Competing modes; default :func:`admissible_competitors` of this scene.
+    force_margin : ForceMargin or (float, float), optional
+        Minimum normal force and Coulomb slack (N) the desired mode keeps for every friction in the set
+        (:class:`qsplan.mechanics.bands.effort.ForceMargin`; competitors are precluded without one).
 
     Returns
     -------
@@ -162,7 +168,8 @@ def robust_band(scene, mode, mu_range, *, shared: bool = False, competitors=None
     lo, hi = _check_mu_range(mu_range)
     mode = _as_mode(mode)
     comps = admissible_competitors([scene], mode) if competitors is None else tuple(competitors)
-    desired = guaranteed_band_shared(scene, mode, lo, hi) if shared else guaranteed_band_box(scene, mode, lo, hi)
+    guaranteed = guaranteed_band_shared if shared else guaranteed_band_box
+    desired = guaranteed(scene, mode, lo, hi, force_margin=force_margin)
     common = dict(mode=mode.letters, desired=desired, competitors=comps, mu_range=(lo, hi), shared=bool(shared))
     if not desired.feasible:
         return RobustBand(lower=np.nan, upper=np.nan, feasible=False, exact=bool(desired.exact), split=False,
@@ -174,6 +181,10 @@ def robust_band(scene, mode, mu_range, *, shared: bool = False, competitors=None
     for c in comps:
         ct: CompetitorTorques = competitor_torques(scene, c, lo, hi, g_lo, g_hi, shared=shared)
         if ct.empty:
+            status = (ct.reason or "").removeprefix("kinematics: ")
+            if status in Status.ILL_CONDITIONED:  # the solver cannot decide this mode either: not precluded
+                exact = False
+                notes.append(f"{c}: undecided ({status}), not precluded")
             continue
         hulls[c] = ct
         exact &= ct.exact

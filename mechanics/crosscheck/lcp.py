@@ -2,7 +2,7 @@
 
 The enumerative solver (:mod:`qsplan.mechanics.solver`) tests every mode; this module
 finds *one* solution of the quasistatic model (eqs. 2-11) directly, as an LCP
-solved by Lemke's method (:mod:`mechanics.lemke`), and maps it back to a contact
+solved by Lemke's method (:mod:`qsplan.mechanics.crosscheck.lemke`), and maps it back to a contact
 mode that :func:`~qsplan.mechanics.modes.reference.check_mode` then verifies.
 
 Derivation
@@ -62,7 +62,7 @@ are scaled to unit size before pivoting and the solution scaled back.
 
 From a solution, each contact's letter follows from its velocities (``v_n > 0``:
 B; else ``v_t != 0``: S; else R) with the tolerances of
-:class:`~mechanics.numerics.Tolerances`.  A solution whose mode does not have
+:class:`~qsplan.mechanics.numerics.Tolerances`.  A solution whose mode does not have
 ``2 n_R + n_S = 3 + |tau_I|`` constraints (eq. 29) is degenerate in the paper's
 sense (a contact with zero speed and zero force); otherwise the mode is
 re-solved and verified by :func:`~qsplan.mechanics.modes.reference.check_mode`, which also

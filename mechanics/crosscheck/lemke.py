@@ -16,7 +16,7 @@ terminates in finitely many pivots (Cottle, Pang & Stone, *The Linear
 Complementarity Problem*, Sec. 4.4; Murty, *Linear Complementarity*, Ch. 2).
 The PyPI package ``lemkelcp`` has no anti-cycling rule.
 
-This module is the method only; :mod:`mechanics.lcp` writes the quasistatic
+This module is the method only; :mod:`qsplan.mechanics.crosscheck.lcp` writes the quasistatic
 problem as an LCP (after Pang, Trinkle & Lo, the paper's ref. [26]).
 """
 

@@ -114,7 +114,7 @@ def lp_mode_feasible(scene: Scene, mode, xi, tol: float = LP_TOL) -> LPCheck:
         accepted; the utility condition (29) is not required.
     xi : array-like, shape (n_c,)
         Sliding directions ``sgn(v_it)`` (eq. 16); +1 or -1 at sliding contacts,
-        ignored elsewhere.  Take them from a :class:`~mechanics.ModeSolution` or
+        ignored elsewhere.  Take them from a :class:`~qsplan.mechanics.ModeSolution` or
         from the kinematics (eq. 24): this function decides forces only.
     tol : float
         Feasibility tolerance relative to the load scale (see :data:`LP_TOL`).

@@ -24,11 +24,20 @@ __all__ = [
     "shift_wrenches",
     "point_wrench",
     "NORMAL_LENGTH_TOL",
+    "FRAME_TOL",
+    "check_contact_frame",
 ]
 
 #: A contact normal shorter than this (m, or unitless) is rejected as "zero":
 #: normalising it would amplify rounding noise into an arbitrary direction.
 NORMAL_LENGTH_TOL = 1e-12
+
+#: Tolerance (unitless) of the contact-frame check on raw wrench columns: ``|n|`` within this of 1
+#: and ``t`` within this of ``n`` turned by +90 degrees.  The paper prints its wrenches to three
+#: significant digits, which leaves unit vectors off by up to 3e-4 (0.707, 0.707 has length
+#: 0.99985); 2e-3 accepts those and refuses real mistakes (a non-unit normal, ``wt`` equal to
+#: ``wn``, a tangent of the wrong sense).
+FRAME_TOL = 2e-3
 
 
 def cross2(a, b):
@@ -65,10 +74,51 @@ def tangent_from_normal(n):
 def _unit_normals(n):
     n = np.asarray(n, dtype=float)
     length = np.linalg.norm(n, axis=-1)
-    if np.any(~np.isfinite(length)) or np.any(length < NORMAL_LENGTH_TOL):
-        bad = int(np.flatnonzero(~(length >= NORMAL_LENGTH_TOL))[0]) if n.ndim > 1 else 0
+    ok = np.isfinite(length) & (length >= NORMAL_LENGTH_TOL)
+    if not np.all(ok):
+        bad = int(np.flatnonzero(~ok.reshape(-1))[0])
         raise SceneError(f"contacts[{bad}].n: normal must be a finite nonzero 2-vector; got {n.reshape(-1, 2)[bad].tolist()}")
     return n / length[..., None]
+
+
+def check_contact_frame(wn, wt, field: str = "contact") -> np.ndarray:
+    """Check raw wrench columns as one contact frame (eq. 1); return the contact point ``r``.
+
+    ``wn = [n, r (x) n]`` and ``wt = [t, r (x) t]`` need a unit ``n`` and ``t = n`` turned by
+    +90 degrees (within :data:`FRAME_TOL`).  The two moments then always fix exactly one point:
+    ``r (x) n = wn[2]`` and ``r (x) t = r . n = wt[2]`` give ``r = wt[2] n - wn[2] t`` (the 2x2
+    system has determinant ``n (x) t = 1``), so the moment parts are consistent with a contact
+    point as soon as the force parts are a frame; ``r`` is returned for the caller's range checks.
+
+    Parameters
+    ----------
+    wn, wt : array-like, shape (3,)
+        Normal and tangential wrench columns about the world origin.
+    field : str
+        Names the contact in errors (``"contacts[2]"``).
+
+    Returns
+    -------
+    r : ndarray, shape (2,)
+        The contact point (m) the moments imply.
+
+    Raises
+    ------
+    SceneError
+        A force part that is not a unit vector, or a tangent that is not the normal's +90 degree turn.
+    """
+    wn = np.asarray(wn, dtype=float)
+    wt = np.asarray(wt, dtype=float)
+    n, t = wn[:2], wt[:2]
+    length = float(np.hypot(*n))
+    if not abs(length - 1.0) <= FRAME_TOL:
+        raise SceneError(f"{field}.wn: the force part (first two numbers) {n.tolist()} has length {length:.6g}; "
+                         f"expected a unit normal (length 1 within {FRAME_TOL:g})")  # fmt: skip
+    turned = tangent_from_normal(n)
+    if not float(np.hypot(*(t - turned))) <= FRAME_TOL:
+        raise SceneError(f"{field}.wt: the force part (first two numbers) {t.tolist()} is not the normal turned by "
+                         f"+90 degrees, {turned.tolist()} (within {FRAME_TOL:g})")  # fmt: skip
+    return wt[2] * n - wn[2] * t
 
 
 def wrench_matrix(r, n):

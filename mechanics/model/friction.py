@@ -11,7 +11,13 @@ import numpy as np
 
 from qsplan.mechanics.errors import SceneError
 
-__all__ = ["check_friction", "check_mu_range"]
+__all__ = ["MAX_FRICTION", "check_friction", "check_mu_range"]
+
+#: Largest friction coefficient accepted anywhere.  No dry material pair exceeds about 2 (rubber on
+#: rough surfaces); at 100 a friction cone is within 0.6 degrees of a half-plane, and beyond it the
+#: coefficients dominate the mode matrices (eqs. 23-26) until the solver's answers change with
+#: rounding alone (a mu-space slice to 1e308 reported other modes than one to 1e6).
+MAX_FRICTION = 100.0
 
 
 def _shown(values: np.ndarray):
@@ -44,6 +50,9 @@ def check_friction(mu, field: str = "mu", element: str | None = None):
         vals = np.asarray(mu, dtype=float)
     except (TypeError, ValueError):
         raise SceneError(f"{field}: expected nonnegative finite friction coefficients; got {mu!r}") from None
+    if np.any(np.isfinite(vals) & (vals > MAX_FRICTION)):
+        raise SceneError(f"{field}: expected friction coefficients of at most {MAX_FRICTION:g} "
+                         f"(qsplan.mechanics.model.friction.MAX_FRICTION); got {float(np.max(vals[np.isfinite(vals)])):g}")  # fmt: skip
     bad = ~(np.isfinite(vals) & (vals >= 0))
     if vals.ndim == 0:
         if bad:
@@ -85,6 +94,9 @@ def check_mu_range(lo, hi, field: str = "mu range", n: int | None = None):
         raise SceneError(f"{field}: expected 0 <= LO <= HI (finite); got {lo!r} {hi!r}") from None
     if not (np.all(np.isfinite(a)) and np.all(np.isfinite(b))) or np.any(a < 0) or np.any(a > b):
         raise SceneError(f"{field}: expected 0 <= LO <= HI (finite); got {a.tolist()} {b.tolist()}")
+    if np.any(b > MAX_FRICTION):
+        raise SceneError(f"{field}: expected HI <= {MAX_FRICTION:g} (qsplan.mechanics.model.friction.MAX_FRICTION); "
+                         f"got {float(np.max(b)):g}")  # fmt: skip
     if n is None:
         return float(a), float(b)
     return a, b

@@ -2,7 +2,7 @@
 
 Instead of wrench columns and Jacobian rows, the document describes the
 workpiece, an optional fixed palm and a planar tree of joints with link
-polygons; contacts are found from the geometry (:func:`mechanics.geometry.find_contacts`)
+polygons; contacts are found from the geometry (:func:`qsplan.mechanics.model.geometry.find_contacts`)
 and ``W_n, W_t`` (eq. 1), ``J_n, J_t`` (eq. 5), ``g_obj`` (eq. 2) and ``g_man``
 (eq. 3) are computed.  Schema (TOML shown; JSON has the same structure)::
 
@@ -35,7 +35,7 @@ and ``W_n, W_t`` (eq. 1), ``J_n, J_t`` (eq. 5), ``g_obj`` (eq. 2) and ``g_man``
     index = 0                      # 0-based, in the order of the found contacts
     mu = 0.2
 
-Contacts are ordered as :func:`~mechanics.geometry.find_contacts` orders them
+Contacts are ordered as :func:`~qsplan.mechanics.model.geometry.find_contacts` orders them
 (palm first, then links by index; along the workpiece boundary within a body) and
 named ``"<body>:<index>"`` with the palm or joint name and the 0-based contact
 index, e.g. ``"palm:0"``, ``"left:2"``.
@@ -109,7 +109,7 @@ class GeometricScene:
     contact_mu : tuple of (int, float)
         Overrides ``(contact index, mu)``.
     contact_tolerance : float
-        Contact tolerance (m) passed to :func:`~mechanics.geometry.find_contacts`.
+        Contact tolerance (m) passed to :func:`~qsplan.mechanics.model.geometry.find_contacts`.
     """
 
     workpiece: np.ndarray
@@ -278,7 +278,7 @@ def geometric_scene_from_dict(spec: dict) -> GeometricScene:
 
 
 def find_scene_contacts(gs: GeometricScene) -> list[FoundContact]:
-    """Contacts between the workpiece and the palm and links at ``gs.q`` (see :func:`~mechanics.geometry.find_contacts`)."""
+    """Contacts between the workpiece and the palm and links at ``gs.q`` (see :func:`~qsplan.mechanics.model.geometry.find_contacts`)."""
     man = gs.manipulator
     bodies = [] if man.base_shape is None else [(-1, base_polygon(man))]
     bodies += [(k, p) for k, p in enumerate(link_polygons(man, gs.q)) if p is not None]
@@ -299,7 +299,7 @@ def scene_from_geometric_scene(gs: GeometricScene, contacts=None) -> Scene:
     -------
     Scene
         ``W_n, W_t`` from the contact points and normals (eq. 1); ``J_n, J_t``
-        from :func:`~mechanics.manipulator.contact_jacobian` (zero rows on the
+        from :func:`~qsplan.mechanics.model.manipulator.contact_jacobian` (zero rows on the
         palm, eq. 5); ``g_obj`` = the workpiece weight at ``com`` plus
         ``extra_wrench`` (eq. 2); ``g_man`` = the link weights' joint efforts (eq. 3).
 

@@ -70,7 +70,8 @@ def check_polygon(value, field: str) -> np.ndarray:
     Parameters
     ----------
     value : array-like, shape (k, 2)
-        Vertices (m), either orientation; a repeated closing vertex is dropped.
+        Vertices (m), either orientation; a repeated closing vertex, and any vertex within 1e-12 m of
+        its predecessor, is dropped.
 
     Returns
     -------
@@ -79,6 +80,9 @@ def check_polygon(value, field: str) -> np.ndarray:
     v = check_finite_array(value, field, (None, 2))
     if len(v) > 1 and np.array_equal(v[0], v[-1]):
         v = v[:-1]
+    # a vertex repeating its predecessor (to 1e-12 m) makes a zero-length edge, whose direction is 0/0
+    keep = np.linalg.norm(v - np.roll(v, 1, axis=0), axis=1) > 1e-12 if len(v) > 1 else np.ones(len(v), bool)
+    v = v[keep] if keep.any() else v[:1]
     if len(v) < 3:
         raise SceneError(f"{field}: expected at least 3 vertices [x, y]; got {len(v)}")
     if np.linalg.matrix_rank(v - v[0]) < 2:

@@ -54,7 +54,7 @@ class Scene:
     """One instant of a workpiece contacted by a manipulator.
 
     Build it with :func:`make_scene` (which validates), or load one with
-    :func:`mechanics.load_scene`.
+    :func:`qsplan.mechanics.load_scene`.
 
     Attributes
     ----------

@@ -20,7 +20,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from qsplan.mechanics.model.contact import wrench_matrices
+from qsplan.mechanics.model.contact import check_contact_frame, wrench_matrices
 from qsplan.mechanics.model.fields import check_keys, number, read_document, vector
 from qsplan.mechanics.model.friction import check_friction
 from qsplan.mechanics.errors import SceneError
@@ -123,9 +123,7 @@ def scene_from_dict(doc: dict, mu=None) -> Scene:
                     raise SceneError(f"{f}.{key}: missing")
             Wn[:, i] = vector(c["wn"], f"{f}.wn", 3)
             Wt[:, i] = vector(c["wt"], f"{f}.wt", 3)
-            for key, w in (("wn", Wn[:, i]), ("wt", Wt[:, i])):
-                if np.hypot(w[0], w[1]) < 1e-12:
-                    raise SceneError(f"{f}.{key}: the force part (first two numbers) is zero; expected a unit direction")
+            check_contact_frame(Wn[:, i], Wt[:, i], f)
         elif "r" in c or "n" in c:
             for key in ("r", "n"):
                 if key not in c:
@@ -141,7 +139,7 @@ def scene_from_dict(doc: dict, mu=None) -> Scene:
         if "mu" in c:
             mus[i] = check_friction(number(c["mu"], f"{f}.mu"), f"{f}.mu")
         elif mu is None:
-            raise SceneError(f"{f}.mu: missing (give it in the scene or override with --mu)")
+            raise SceneError(f"{f}.mu: missing (give it in the scene, or override it)")
         if has_joints:
             if "velocity" in c:
                 raise SceneError(f"{f}.velocity: only for scenes without joints (this scene has joints; give jn and jt)")

@@ -1,6 +1,6 @@
-"""Writing scenes in the raw form that :func:`mechanics.scene_from_dict` reads.
+"""Writing scenes in the raw form that :func:`qsplan.mechanics.scene_from_dict` reads.
 
-:func:`scene_to_dict` is the inverse of :func:`~mechanics.scene_from_dict` for
+:func:`scene_to_dict` is the inverse of :func:`~qsplan.mechanics.scene_from_dict` for
 raw-form scenes: ``scene_from_dict(scene_to_dict(s))`` rebuilds ``s`` with every
 array bit for bit (Python floats carry doubles exactly, and ``json`` writes them
 with ``repr``, so a JSON file round-trips too).  A scene with real joints is
@@ -24,7 +24,7 @@ def _floats(a) -> list:
 
 
 def scene_to_dict(scene: Scene) -> dict:
-    """The raw-form document of ``scene`` (see :mod:`mechanics.scene_io`).
+    """The raw-form document of ``scene`` (see :mod:`qsplan.mechanics.model.scene_io`).
 
     Parameters
     ----------

@@ -17,19 +17,29 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from itertools import combinations, product
+from math import comb
 
 import numpy as np
 
-from qsplan.mechanics.errors import ModeError
+from qsplan.mechanics.errors import ModeError, QsplanError
 from qsplan.mechanics.modes.contact_mode import ContactMode, enumerate_modes, mode_from_letters
 from qsplan.mechanics.numerics import DEFAULT_TOLERANCES, Tolerances, hadamard_ratio, rcond
 from qsplan.mechanics.model.scene import Scene
 
-__all__ = ["Partition", "effort_partitions", "partition_table", "MAX_SIGN_PATTERNS_SLIDING"]
+__all__ = ["Partition", "effort_partitions", "partition_table", "partition_table_work", "MAX_SIGN_PATTERNS_SLIDING",
+           "MAX_TABLE_TESTS"]  # fmt: skip
 
 #: Without given sliding directions, all 2**n_S sign patterns are checked; above
 #: this many sliding contacts that is too many, and ``xi`` must be given.
 MAX_SIGN_PATTERNS_SLIDING = 12
+
+#: Most matrix tests (eq. 49's modes x effort-joint sets x sliding sign patterns) a
+#: :func:`partition_table` may need: ~20 us each, so about a minute.  16-41 contacts need
+#: 1e8 and more (the table never returned); one mode (``effort_partitions``) stays cheap.
+MAX_TABLE_TESTS = 3_000_000
+
+#: Seconds per matrix test, for the estimate in the refusal.
+_TEST_SECONDS = 2e-5
 
 
 @dataclass(frozen=True, slots=True)
@@ -116,6 +126,19 @@ def effort_partitions(scene: Scene, mode: ContactMode, xi=None, tol: Tolerances 
     return out
 
 
+def partition_table_work(n_contacts: int, n_joints: int, max_effort: int | None = None) -> int:
+    """Matrix tests :func:`partition_table` needs: modes (eq. 49) x joint sets x sign patterns of the sliding contacts."""
+    top = n_joints if max_effort is None else min(max_effort, n_joints)
+    total = 0
+    for m in range(top + 1):
+        dof = 3 + m
+        for n_r in range(dof // 2 + 1):
+            n_s = dof - 2 * n_r
+            if n_r + n_s <= n_contacts:
+                total += comb(n_contacts, n_r) * comb(n_contacts - n_r, n_s) * comb(n_joints, m) * (1 + 2**n_s)
+    return total
+
+
 def partition_table(scene: Scene, tol: Tolerances = DEFAULT_TOLERANCES, max_effort: int | None = None) -> dict:
     """Which control-mode partitions admit which contact modes (eqs. 29-32).
 
@@ -126,12 +149,24 @@ def partition_table(scene: Scene, tol: Tolerances = DEFAULT_TOLERANCES, max_effo
     max_effort : int, optional
         Largest number of effort-controlled joints considered (default: all joints).
 
+    Raises
+    ------
+    QsplanError
+        The table would need more than :data:`MAX_TABLE_TESTS` matrix tests (:func:`partition_table_work`).
+
     Returns
     -------
     dict
         Maps each effort-joint tuple to the list of mode letters it admits, in
         enumeration order; partitions that admit no mode are left out.
     """
+    work = partition_table_work(scene.n_contacts, scene.n_joints, max_effort)
+    if work > MAX_TABLE_TESTS:
+        raise QsplanError(
+            f"partition: the table for {scene.n_contacts} contacts and {scene.n_joints} joints needs about "
+            f"{work:.2g} matrix tests (~{work * _TEST_SECONDS:.2g} s; limit {MAX_TABLE_TESTS:.0e}); "
+            f"rank the effort-joint sets of one mode instead (mode=LETTERS)"
+        )
     top = scene.n_joints if max_effort is None else min(max_effort, scene.n_joints)
     table: dict = {}
     for m in range(top + 1):

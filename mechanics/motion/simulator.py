@@ -17,7 +17,7 @@ contact rolls (sticks), the kinetic one while it slides, switched at events.
 
 Mode selection rule.  Keep the current mode while it stays feasible.  At an
 event (and at the start) the *candidates* are the modes feasible at that instant,
-each with its own friction (:func:`mechanics.check_mode`); a candidate is kept only
+each with its own friction (:func:`qsplan.mechanics.check_mode`); a candidate is kept only
 if it *persists*, i.e. stays feasible a short probe along its own motion (a
 condition on its bound must not decrease).  This drops the mode whose condition
 just ran out, and any mode that would fail at once (Section 5.1: "the mode must
@@ -140,10 +140,10 @@ def simulate(
         How to resolve an ambiguous choice (several persistent candidates).  None stops
         the run and reports it; ``"first"`` takes the first in enumeration order (eq. 49);
         a callable ``policy(time, state, candidates)`` gets the candidates as a tuple of
-        :class:`~mechanics.ModeSolution` and returns one of them, its mode letters, or None
+        :class:`~qsplan.mechanics.ModeSolution` and returns one of them, its mode letters, or None
         (unresolved: the run stops as ``ambiguous``).
     tol : Tolerances
-        Per-instant feasibility tolerances (:func:`mechanics.check_mode`).
+        Per-instant feasibility tolerances (:func:`qsplan.mechanics.check_mode`).
 
     Returns
     -------

@@ -3,7 +3,7 @@
 The kinematic stage of every mode (eqs. 24-25, 16) does not depend on mu, so
 it runs once; only the equilibrium and Coulomb stage (26)-(28) is repeated, for
 all kinematically admissible modes and all mu points together, in bounded
-batches.  The answer at every point is exactly what :func:`mechanics.solve`
+batches.  The answer at every point is exactly what :func:`qsplan.mechanics.solve`
 gives for the scene with that mu.
 
 Two paths give that answer: :func:`feasibility_map` repeats the solver's
@@ -135,7 +135,7 @@ def feasibility_map(scene: Scene, mu_points, tol: Tolerances = DEFAULT_TOLERANCE
     workers : int or None
         Local processes (``None``: all cores, 1: in-process); the points are split into
         chunks of rows, each of at least :data:`MIN_CHUNK_ROWS` mode-point rows, so a
-        small map stays in-process.  See :func:`mechanics.parallel.map_chunks`.
+        small map stays in-process.  See :func:`qsplan.mechanics.parallel.map_chunks`.
     scheduler : str or dask.distributed.Client, optional
         Send the chunks to a Dask cluster instead.
 
@@ -330,7 +330,7 @@ def polynomial_map(scene: Scene, mu_points, tol: Tolerances = DEFAULT_TOLERANCES
     :mod:`qsplan.mechanics.muspace.multilinear`); coefficients that do not vary over the points are
     folded in first, so a 2-D slice costs a few multiply-adds per point and mode.
     The singularity test and the Coulomb tolerances are the solver's, so the map
-    equals :func:`feasibility_map` (and :func:`mechanics.solve`) except, through
+    equals :func:`feasibility_map` (and :func:`qsplan.mechanics.solve`) except, through
     rounding, at points within about ``1e-12`` relative of a tolerance threshold.
 
     Parameters

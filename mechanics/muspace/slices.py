@@ -116,7 +116,7 @@ def mu_slice(scene: Scene, x: int, y: int, xs, ys, base_mu=None, method: str = "
         the modes into chunks (each of at least :data:`MIN_CHUNK_POLYNOMIAL_ROWS`
         mode-point rows), ``"solver"`` the points; a small slice stays in-process.
     scheduler : str or dask.distributed.Client, optional
-        Send the chunks to a Dask cluster instead (:func:`mechanics.parallel.map_chunks`).
+        Send the chunks to a Dask cluster instead (:func:`qsplan.mechanics.parallel.map_chunks`).
 
     Returns
     -------

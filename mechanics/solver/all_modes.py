@@ -4,9 +4,11 @@
 scene's control-mode partition (their number is eq. (49)), in batches
 (:func:`qsplan.mechanics.solver.batch.solve_batches`), on local processes or a Dask
 cluster when there are enough of them (:mod:`qsplan.mechanics.solver.chunks`).  From
-:data:`SEARCH_MIN_MODES` modes on it tests only the modes that survive the exact
-pruning of :mod:`qsplan.mechanics.solver.search` (same solutions; ``search="all"``
-tests every mode).
+:data:`SEARCH_MIN_MODES` modes on, ``search="auto"`` tries the exact pruning of
+:mod:`qsplan.mechanics.solver.search` (same solutions) within a budget of breaking-set
+programmes worth the plain test of every mode (:func:`estimate_seconds`), and tests every
+mode when the pruning would cost more: so ``auto`` costs at most about 1.5 times ``all``
+(:data:`AUTO_PROGRAMME_SHARE`) and 3 times ``prune``.
 """
 
 from __future__ import annotations
@@ -18,9 +20,11 @@ from qsplan.mechanics.numerics import DEFAULT_TOLERANCES, Tolerances
 from qsplan.mechanics.solver.batch import DEFAULT_BATCH, solve_batches
 from qsplan.mechanics.solver.chunks import solve_in_chunks
 from qsplan.mechanics.solver.result import SolveResult
-from qsplan.mechanics.solver.search import search_solve
+from qsplan.mechanics.solver.breaking_sets import feasible_breaking_sets
+from qsplan.mechanics.solver.search import modes_with_breaking_sets, search_solve
 
-__all__ = ["SEARCH_MIN_MODES", "solve"]
+__all__ = ["SEARCH_MIN_MODES", "AUTO_PROGRAMME_SHARE", "MODE_SECONDS_PER_CONSTRAINT", "PROGRAMME_SECONDS", "SET_SECONDS",
+           "estimate_seconds", "solve"]  # fmt: skip
 
 #: Fewest modes (eq. 49) for which ``search="auto"`` prunes breaking sets
 #: (:mod:`qsplan.mechanics.solver.search`).  Measured on planted scenes with dof = n_c, one core:
@@ -28,6 +32,50 @@ __all__ = ["SEARCH_MIN_MODES", "solve"]
 #: 7x at 212,941 (n_c = 13).  Small scenes, solved in loops by mu-space maps and bands,
 #: keep the plain path and its full per-status counts.
 SEARCH_MIN_MODES = 20_000
+
+#: Seconds to test one mode, per applicable constraint (``dof``), one core: measured 3.3 us at
+#: dof = 4 (n_c = 12), 6.3 us at dof = 6 (n_c = 16), 17 us at dof = 12 (n_c = 12).
+MODE_SECONDS_PER_CONSTRAINT = 1.4e-6
+
+#: Seconds of one breaking-set programme (highspy, warm-started): 0.19-0.95 ms measured at n_c = 12-16.
+PROGRAMME_SECONDS = 4e-4
+
+#: Share of the plain path's estimated time that ``search="auto"`` may spend on breaking-set
+#: programmes before it gives up pruning: when it gives up, pruning would have cost more than
+#: this share, so ``auto`` stays within 1.5x the plain path and 3x the pruned one.
+AUTO_PROGRAMME_SHARE = 0.5
+
+#: Seconds of the pruned test stage per surviving breaking set (the reduced solve of
+#: :func:`qsplan.mechanics.solver.search.penetrates`): ~130 us measured at n_c = 16.
+SET_SECONDS = 1.3e-4
+
+
+def estimate_seconds(n_contacts: int, dof: int, workers: int = 1) -> float:
+    """Seconds, roughly, to test every mode of eq. (49) on ``workers`` cores (``search="all"``).
+
+    ``search="auto"`` stays within about 1.5 times this: its breaking-set programmes are
+    budgeted to :data:`AUTO_PROGRAMME_SHARE` of it.
+    """
+    return count_modes(n_contacts, dof) * dof * MODE_SECONDS_PER_CONSTRAINT / max(1, workers)
+
+
+def _auto(scene, tol, workers, scheduler):
+    """The breaking sets for the pruned test, or None when testing every mode is cheaper."""
+    n_c, dof = scene.n_contacts, scene.dof
+    n_modes = count_modes(n_c, dof)
+    if n_modes < SEARCH_MIN_MODES:
+        return None
+    plain = estimate_seconds(n_c, dof)
+    budget = int(AUTO_PROGRAMME_SHARE * plain / PROGRAMME_SECONDS)  # both run in chunks alike: compare one core
+    if budget <= n_c:
+        return None
+    sets, _ = feasible_breaking_sets(scene, tol, workers=workers, scheduler=scheduler, max_programmes=budget)
+    if sets is None:
+        return None
+    tested = modes_with_breaking_sets(n_c, dof, sets)
+    if tested * dof * MODE_SECONDS_PER_CONSTRAINT + len(sets) * SET_SECONDS > plain:
+        return None
+    return sets
 
 
 def solve(
@@ -41,6 +89,7 @@ def solve(
     scheduler=None,
     batches: tuple[int, int] | None = None,
     search: str = "auto",
+    progress=None,
 ) -> SolveResult:
     """Find every feasible contact mode of ``scene`` (Sections 3.1-3.2).
 
@@ -65,23 +114,39 @@ def solve(
     search : {"auto", "prune", "all"}
         ``"all"`` tests every mode; ``"prune"`` tests only the modes whose breaking
         set admits equilibrium (:func:`qsplan.mechanics.solver.search.search_solve`, the same
-        solutions, the untested modes counted under ``PRUNED``); ``"auto"`` prunes
-        from :data:`SEARCH_MIN_MODES` modes on.  ``keep_statuses`` and ``batches``
-        always test every mode.
+        solutions, the untested modes counted under ``PRUNED``); ``"auto"``, from
+        :data:`SEARCH_MIN_MODES` modes on, prunes unless the breaking-set programmes would
+        cost more than testing every mode (:func:`estimate_seconds`).  ``keep_statuses``
+        and ``batches`` always test every mode.
+    progress : callable, optional
+        ``progress(done, total, unit)`` as the work advances (``unit``: ``"modes"`` or
+        ``"chunks"``), for a command's progress lines.
 
     Returns
     -------
     SolveResult
         The same (bit for bit) however it was split.
+
+    Raises
+    ------
+    QsplanError
+        ``search="prune"`` on a scene whose breaking-set search would hold more than
+        :data:`qsplan.mechanics.solver.breaking_sets.MAX_LEVEL_SETS` sets in one level.
+    ParallelError
+        The processes running chunks failed (:func:`qsplan.mechanics.parallel.map_chunks`).
     """
     if search not in ("auto", "prune", "all"):
         raise QsplanError(f"search: expected 'auto', 'prune' or 'all'; got {search!r}")
-    if search == "auto":
-        search = "prune" if count_modes(scene.n_contacts, scene.dof) >= SEARCH_MIN_MODES else "all"
-    if search == "prune" and batches is None and not keep_statuses:
-        return search_solve(scene, tol, batch, residuals, workers=workers, scheduler=scheduler)
+    if search == "auto" and batches is None and not keep_statuses:
+        sets = _auto(scene, tol, workers, scheduler)
+        if sets is not None:
+            return search_solve(scene, tol, batch, residuals, workers=workers, scheduler=scheduler, sets=sets,
+                                progress=progress)  # fmt: skip
+    elif search == "prune" and batches is None and not keep_statuses:
+        return search_solve(scene, tol, batch, residuals, workers=workers, scheduler=scheduler, progress=progress)
     if batches is None and (workers != 1 or scheduler is not None):
-        chunked = solve_in_chunks(scene, tol, batch, residuals, keep_statuses, workers=workers, scheduler=scheduler)
+        chunked = solve_in_chunks(scene, tol, batch, residuals, keep_statuses, workers=workers, scheduler=scheduler,
+                                  progress=progress)  # fmt: skip
         if chunked is not None:
             return chunked
-    return solve_batches(scene, tol, batch, residuals, keep_statuses, batches)
+    return solve_batches(scene, tol, batch, residuals, keep_statuses, batches, progress=progress)

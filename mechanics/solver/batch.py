@@ -76,11 +76,12 @@ def solve_batch(scene: Scene, codes: np.ndarray, tol: Tolerances = DEFAULT_TOLER
 
 def solve_batches(scene: Scene, tol: Tolerances = DEFAULT_TOLERANCES, batch: int = DEFAULT_BATCH,
                   residuals: bool = True, keep_statuses: bool = False, batches: tuple[int, int] | None = None,
-                  ) -> SolveResult:  # fmt: skip
+                  progress=None) -> SolveResult:  # fmt: skip
     """Test every mode of eq. (49) in this process, batch after batch (or batches ``lo <= i < hi``).
 
     Same arguments and result as :func:`qsplan.mechanics.solver.all_modes.solve` with
     ``workers=1, search="all"``; a chunk of a parallel solve is one call with ``batches``.
+    ``progress(done, total, "modes")`` is called after every batch.
     """
     n_c, dof = scene.n_contacts, scene.dof
     total = count_modes(n_c, dof)
@@ -96,6 +97,8 @@ def solve_batches(scene: Scene, tol: Tolerances = DEFAULT_TOLERANCES, batch: int
             counts[Status.ORDER[code]] += int(cnt)
         if keep_statuses:
             kept.extend(Status.ORDER[c] for c in status)
+        if progress:
+            progress(sum(counts.values()), total, "modes")
     return SolveResult(
         scene=scene, modes_tested=total, solutions=tuple(sols), counts=counts, tolerances=tol,
         statuses=tuple(kept) if keep_statuses else None,

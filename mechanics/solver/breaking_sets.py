@@ -34,6 +34,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from qsplan.mechanics.errors import QsplanError
 from qsplan.mechanics.numerics import DEFAULT_TOLERANCES, Tolerances
 from qsplan.mechanics.parallel import chunk_count, map_chunks, split_range
 from qsplan.mechanics.model.scene import Scene
@@ -42,6 +43,7 @@ __all__ = [
     "CONE_WIDENING",
     "FORCE_RATIO",
     "MIN_LP_CHUNK",
+    "MAX_LEVEL_SETS",
     "EquilibriumRelaxation",
     "equilibrium_relaxation",
     "admits_equilibrium",
@@ -61,6 +63,13 @@ FORCE_RATIO = 1e6
 #: Fewest candidate breaking sets (one programme of ~0.5 ms each with highspy) worth a chunk in
 #: another process (~0.1 s of work, several times a local pool's start-up).
 MIN_LP_CHUNK = 200
+
+
+#: Most candidate breaking sets one Apriori level may hold (memory: ~250 bytes a set as tuples
+#: and hash entries, so ~125 MB; time: ~100 s of programmes).  With few effort joints the
+#: breaking sets of the modes are large (``|B| >= n_c - dof``) and the levels below them hold
+#: up to C(n_c, n_c / 2) sets: at n_c = 40 an unbounded search reached 9.5 GB.
+MAX_LEVEL_SETS = 500_000
 
 
 class EquilibriumRelaxation:
@@ -182,18 +191,22 @@ def breaking_set_sizes(n_c: int, dof: int) -> tuple[int, int]:
     return max(0, n_c - dof), (2 * n_c - dof) // 2
 
 
-def _candidates(level: list[tuple], feasible: set) -> list[tuple]:
-    """Sets one larger whose every subset one smaller is in ``feasible`` (Apriori join), sorted."""
-    out = []
+def _candidates(level: list[tuple], feasible: set, cap: int) -> list[tuple] | None:
+    """Sets one larger whose every subset one smaller is in ``feasible`` (Apriori join), sorted;
+    None as soon as there are more than ``cap`` of them (or ``8 cap`` joins were tried)."""
+    out, joins = [], 0
     for a in range(len(level)):
         pa = level[a]
         for b in range(a + 1, len(level)):
             pb = level[b]
             if pa[:-1] != pb[:-1]:
                 break  # level is sorted: sets sharing a prefix are consecutive
+            joins += 1
             cand = pa + (pb[-1],)
             if all(cand[:j] + cand[j + 1 :] in feasible for j in range(len(cand) - 2)):
                 out.append(cand)
+        if len(out) > cap or joins > 8 * cap:
+            return None
     return out
 
 
@@ -205,13 +218,22 @@ def _check_sets(rel, sets, workers, scheduler) -> list[bool]:
     return [ok for part in map_chunks(_lp_chunk, jobs, workers=workers, scheduler=scheduler) for ok in part]
 
 
-def feasible_breaking_sets(scene: Scene, tol: Tolerances = DEFAULT_TOLERANCES, *, workers=1, scheduler=None):
+def feasible_breaking_sets(scene: Scene, tol: Tolerances = DEFAULT_TOLERANCES, *, workers=1, scheduler=None,
+                           max_programmes: int | None = None):  # fmt: skip
     """Breaking sets of the scene's modes that admit equilibrium, level by level (Apriori).
+
+    Parameters
+    ----------
+    max_programmes : int, optional
+        Give up (``sets`` None) rather than solve more programmes than this in all: the
+        budget of ``solve(search="auto")``.  Without it, a level of more than
+        :data:`MAX_LEVEL_SETS` candidates is refused with a ``QsplanError``.
 
     Returns
     -------
-    sets : list of tuple of int
-        Sorted 0-based breaking sets with sizes of the scene's modes (eq. 29) that admit equilibrium.
+    sets : list of tuple of int, or None
+        Sorted 0-based breaking sets with sizes of the scene's modes (eq. 29) that admit
+        equilibrium; None when ``max_programmes`` would be exceeded.
     programmes : int
         Linear programmes solved.
     """
@@ -226,10 +248,18 @@ def feasible_breaking_sets(scene: Scene, tol: Tolerances = DEFAULT_TOLERANCES, *
             out.extend(level)
         if size == hi:
             break
+        room = MAX_LEVEL_SETS if max_programmes is None else max_programmes - programmes
         if size == 0:
-            cands = [(i,) for i in range(n_c)]
+            cands = [(i,) for i in range(n_c)] if n_c <= room else None
         else:
-            cands = _candidates(level, set(level))
+            cands = _candidates(level, set(level), room)
+        if cands is None:
+            if max_programmes is not None:
+                return None, programmes
+            raise QsplanError(
+                f"search: the pruned search would test more than {MAX_LEVEL_SETS:,} breaking sets of "
+                f"{size + 1} contacts (n_c = {n_c}, {dof} constraints per mode); use search='auto' or 'all'"
+            )
         if not cands:
             break
         ok = _check_sets(rel, cands, workers, scheduler)

@@ -1,9 +1,9 @@
 """The batch solve of every contact mode (eqs. 24-28, 49) split into chunks of consecutive batches.
 
 :func:`qsplan.mechanics.solve` streams the modes in batches
-(:func:`mechanics.modes.iter_mode_batches`).  Here the batches are numbered, split
+(:func:`qsplan.mechanics.modes.contact_mode.iter_mode_batches`).  Here the batches are numbered, split
 into contiguous ranges, and each range is solved by ``solve_batches(..., batches=(lo, hi))``
-in its own process (:func:`mechanics.parallel.map_chunks`).  Every batch is the
+in its own process (:func:`qsplan.mechanics.parallel.map_chunks`).  Every batch is the
 same one the single-process solve would form, so every mode gets bit-identical
 numbers, and merging in range order keeps the enumeration order of the solutions
 and statuses.
@@ -30,10 +30,10 @@ def _solve_chunk(job):
     return solve_batches(scene, tol, batch, residuals, keep_statuses, (lo, hi))
 
 
-def solve_in_chunks(scene, tol, batch, residuals, keep_statuses, *, workers=None, scheduler=None):
+def solve_in_chunks(scene, tol, batch, residuals, keep_statuses, *, workers=None, scheduler=None, progress=None):
     """``solve(scene, ...)`` over chunks of batches, or None when it should run in-process.
 
-    None means the rule of :func:`mechanics.parallel.chunk_count` gave one chunk
+    None means the rule of :func:`qsplan.mechanics.parallel.chunk_count` gave one chunk
     (fewer than ``2 * MIN_CHUNK_MODES`` modes) and no scheduler was given.
     """
     n_modes = count_modes(scene.n_contacts, scene.dof)
@@ -45,5 +45,5 @@ def solve_in_chunks(scene, tol, batch, residuals, keep_statuses, *, workers=None
     if n_batches == 0 or (n_chunks == 1 and scheduler is None):
         return None
     jobs = [(scene, tol, batch, residuals, keep_statuses, lo, hi) for lo, hi in split_range(n_batches, n_chunks)]
-    return merge_results(map_chunks(_solve_chunk, jobs, workers=workers, scheduler=scheduler))
+    return merge_results(map_chunks(_solve_chunk, jobs, workers=workers, scheduler=scheduler, progress=progress))
 

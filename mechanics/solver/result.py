@@ -50,13 +50,23 @@ class SolveResult:
         return len(self.solutions) > 1
 
     @property
-    def jammed(self) -> bool:
-        """No mode is feasible (the paper's "Jam")."""
+    def no_feasible_mode(self) -> bool:
+        """No mode was found feasible (a jam only if no mode was left undecided: :attr:`jammed`)."""
         return not self.solutions
 
     @property
+    def jammed(self) -> bool:
+        """A proven jam (the paper's "Jam"): no mode is feasible and none was left undecided.
+
+        With undecided (degenerate or ill-conditioned) modes and no feasible one, the scene may
+        or may not jam: :attr:`no_feasible_mode` is True and this is False.  The one definition
+        used by the text and JSON outputs alike.
+        """
+        return not self.solutions and self.degenerate == 0
+
+    @property
     def degenerate(self) -> int:
-        """Number of modes rejected as degenerate."""
+        """Number of modes not decided: rejected as degenerate or ill-conditioned (:data:`Status.DEGENERATE`)."""
         return sum(v for k, v in self.counts.items() if k in Status.DEGENERATE)
 
     def solution(self, letters: str) -> ModeSolution | None:

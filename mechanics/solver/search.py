@@ -20,7 +20,7 @@ in three steps, each exact:
 Modes of steps 1 and 2 are counted under :data:`PRUNED` and
 :data:`PRUNED_KINEMATIC`; the counts still sum to eq. (49).  Both the
 programmes and the tests of step 3 run in chunks on local processes or a Dask
-cluster (:func:`mechanics.parallel.map_chunks`).
+cluster (:func:`qsplan.mechanics.parallel.map_chunks`).
 """
 
 from __future__ import annotations
@@ -45,6 +45,7 @@ __all__ = [
     "penetrates",
     "MIN_TEST_CHUNK",
     "codes_with_breaking_sets",
+    "modes_with_breaking_sets",
     "search_solve",
 ]
 
@@ -201,16 +202,24 @@ def _test_chunk(job):
     return counts, sols
 
 
+def modes_with_breaking_sets(n_c: int, dof: int, sets) -> int:
+    """Number of modes with ``2 n_R + n_S = dof`` whose breaking set is in ``sets`` (the modes the search tests)."""
+    return sum(_n_modes(n_c, dof, B) for B in sets)
+
+
 def search_solve(scene: Scene, tol: Tolerances = DEFAULT_TOLERANCES, batch: int = 8192, residuals: bool = True, *,
-                 workers=1, scheduler=None):  # fmt: skip
+                 workers=1, scheduler=None, sets=None, progress=None):  # fmt: skip
     """Every feasible mode of ``scene``, testing only modes whose breaking set admits equilibrium.
 
     Same arguments and result as :func:`qsplan.mechanics.solve`; the counts carry
-    :data:`PRUNED` for the modes never tested, and still sum to eq. (49).
+    :data:`PRUNED` for the modes never tested, and still sum to eq. (49).  ``sets``: the
+    breaking sets of :func:`feasible_breaking_sets`, when already found; ``progress``: see
+    :func:`qsplan.mechanics.parallel.map_chunks`.
     """
     n_c, dof = scene.n_contacts, scene.dof
     total = count_modes(n_c, dof)
-    sets, _ = feasible_breaking_sets(scene, tol, workers=workers, scheduler=scheduler)
+    if sets is None:
+        sets, _ = feasible_breaking_sets(scene, tol, workers=workers, scheduler=scheduler)
     n_modes = [_n_modes(n_c, dof, B) for B in sets]
     tested = sum(n_modes)
     n_chunks = chunk_count(tested, MIN_TEST_CHUNK, workers=workers, scheduler=scheduler)
@@ -220,7 +229,7 @@ def search_solve(scene: Scene, tol: Tolerances = DEFAULT_TOLERANCES, batch: int 
         edges = np.searchsorted(np.cumsum(n_modes), [tested * k / n_chunks for k in range(1, n_chunks)], side="left")
         bounds = [0, *(int(e) + 1 for e in edges), len(sets)]
         jobs = [(scene, tol, batch, residuals, sets[a:b]) for a, b in zip(bounds[:-1], bounds[1:]) if b > a]
-        parts = map_chunks(_test_chunk, jobs, workers=workers, scheduler=scheduler)
+        parts = map_chunks(_test_chunk, jobs, workers=workers, scheduler=scheduler, progress=progress)
     counts = dict.fromkeys((*Status.ORDER, PRUNED_KINEMATIC), 0)
     sols = []
     for c, s in parts:

@@ -13,6 +13,9 @@ Subcommands, one module each in :mod:`qsplan.planner.cli` (``add_parser(subparse
 
 Bad input prints one line on stderr naming the field and the problem and
 exits with status 2; so does valid input without an answer (no plan, no band).
+Ctrl-C prints ``qsplan: interrupted`` and exits 130; every output is written to a
+temporary name and renamed (:func:`qsplan.planner.export.files.atomic_write`), so an
+interrupted run leaves no half-written file.
 Library messages name library fields; they are printed with this command's
 options instead (:func:`qsplan.planner.cli.options.cli_message`).
 """
@@ -24,10 +27,12 @@ import sys
 
 from qsplan.planner.cli import band, count, demo, modes, muspace, paper, partition, plan, simulate, sweep, verify
 from qsplan.planner.cli.options import (
+    EXIT_INTERRUPTED,
     EXIT_USAGE,
     Parser,
     UsageError,
     add_parallel_options,
+    check_counts,
     cli_message,
     overwrite_message,
     parallel_options,
@@ -49,29 +54,50 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def main(argv=None) -> int:
-    """Entry point of the ``qsplan`` console script; returns the exit status."""
-    from qsplan.mechanics.errors import NoAnswerError, QsplanError
+    """Entry point of the ``qsplan`` console script; returns the exit status.
+
+    0: done; 1: ran, but the result failed a check; 2: bad input or no answer (one line on
+    stderr); 130: interrupted (Ctrl-C, one line on stderr, no partial file).
+    """
+    try:
+        return _dispatch(argv)
+    except KeyboardInterrupt:
+        _say("qsplan: interrupted")
+        return EXIT_INTERRUPTED
+
+
+def _say(message: str) -> None:
+    """One line on stderr, whatever the message holds (newlines are folded: one error, one line)."""
+    print(" | ".join(line.strip() for line in str(message).splitlines() if line.strip()), file=sys.stderr)
+
+
+def _dispatch(argv) -> int:
+    from qsplan.mechanics.errors import NoAnswerError, ParallelError, QsplanError
 
     from qsplan.planner.export.files import OutputExistsError
 
     flags = {}
     try:
         args = build_parser().parse_args(argv)
+        check_counts(args)
         module = COMMANDS[args.command]
         flags = getattr(module, "FLAGS", {})
         return module.run(args, sys.stdout)
     except UsageError as exc:
-        print(str(exc), file=sys.stderr)
+        _say(str(exc))
         return EXIT_USAGE
     except OutputExistsError as exc:
-        print(f"qsplan: error: {overwrite_message(exc)}", file=sys.stderr)
+        _say(f"qsplan: error: {overwrite_message(exc)}")
         return EXIT_USAGE
     except QsplanError as exc:
-        print(f"qsplan: error: {cli_message(str(exc), flags)}", file=sys.stderr)
+        _say(f"qsplan: error: {cli_message(str(exc), flags)}")
+        return EXIT_USAGE
+    except ParallelError as exc:  # the processes computing failed: say so in one line, exit 2
+        _say(f"qsplan: error: {cli_message(str(exc), flags)}")
         return EXIT_USAGE
     except NoAnswerError as exc:
         path = getattr(exc, "report_path", None)
-        print(f"qsplan: error: {exc}" + (f" (report: {path})" if path else ""), file=sys.stderr)
+        _say(f"qsplan: error: {exc}" + (f" (report: {path})" if path else ""))
         return EXIT_USAGE
     except BrokenPipeError:
         return 0

@@ -7,6 +7,8 @@
 
 ``--method enumerate`` (default) tests every mode of eq. 49 (:func:`qsplan.mechanics.solve`);
 ``--method lcp`` finds one by Lemke's method, fast, and says that others may exist.
+When the estimated work exceeds :data:`LONG_WORK_SECONDS`, an estimate line and progress
+lines go to stderr (stdout, a format others parse, is unchanged).
 """
 
 from __future__ import annotations
@@ -17,10 +19,17 @@ import time
 
 from qsplan.planner.cli.options import add_parallel_options, parallel_options
 
-__all__ = ["FLAGS", "add_parser", "run"]
+__all__ = ["FLAGS", "LONG_WORK_SECONDS", "PROGRESS_SECONDS", "add_parser", "run"]
 
 #: Library fields of :func:`qsplan.mechanics.load_scene` and this command's options.
-FLAGS = {"mu": "--mu"}
+FLAGS = {"mu": "--mu", "search": "--search"}
+
+#: Estimated seconds above which the command says up front how long it expects to take: past
+#: ~10 s a silent command looks hung.
+LONG_WORK_SECONDS = 10.0
+
+#: Seconds between two progress lines on stderr.
+PROGRESS_SECONDS = 10.0
 
 
 def add_parser(subparsers):
@@ -33,7 +42,7 @@ def add_parser(subparsers):
     add_parallel_options(m)
     m.add_argument("--search", choices=("auto", "prune", "all"), default="auto",
                    help="prune: skip modes whose breaking set admits no equilibrium (same result); all: test "
-                        "every mode; auto (default): prune from 20,000 modes on")  # fmt: skip
+                        "every mode; auto (default): prune when its programmes cost less than testing every mode")  # fmt: skip
     m.add_argument("--stats", action="store_true", help="time, modes tested/pruned and peak memory on stderr")
     return m
 
@@ -48,8 +57,9 @@ def run(args, out) -> int:
     scene = load_scene(args.scene, mu=args.mu)
     if getattr(args, "method", "enumerate") == "lcp":
         return _run_lcp(scene, args, out)
+    options = parallel_options(args)
     started = time.perf_counter()
-    result = solve(scene, search=args.search, **parallel_options(args))
+    result = solve(scene, search=args.search, progress=_announce(scene, args, options, started), **options)
     if args.stats:
         _modes_stats(result, time.perf_counter() - started)
     from qsplan.mechanics.numerics import conditioning_verdict
@@ -69,6 +79,40 @@ def run(args, out) -> int:
     return 0
 
 
+def _announce(scene, args, options, started):
+    """For long work: an estimate line on stderr now, and a progress callback printing every
+    :data:`PROGRESS_SECONDS`; None for short work."""
+    from qsplan.mechanics import count_modes
+    from qsplan.mechanics.parallel import resolve_workers
+    from qsplan.mechanics.solver.all_modes import estimate_seconds
+
+    n_c, dof = scene.n_contacts, scene.dof
+    if options["scheduler"] is None:
+        workers = resolve_workers(options["workers"])
+        where = f"{workers} local process{'es' if workers > 1 else ''}"
+    else:
+        workers = options["workers"] or 1
+        where = f"{workers} cluster worker(s) assumed"
+    seconds = estimate_seconds(n_c, dof, workers)
+    if seconds <= LONG_WORK_SECONDS:
+        return None
+    how = {"all": "every mode tested", "prune": "breaking sets pruned first: often far less, or far more",
+           "auto": "pruning may cut it; at most about 1.5x"}[args.search]  # fmt: skip
+    print(f"qsplan modes: {count_modes(n_c, dof):,} modes (eq. 49: n_c = {n_c}, {dof} constraints per mode); "
+          f"testing all of them takes about {seconds:.0f} s on {where} ({how}); progress every "
+          f"{PROGRESS_SECONDS:g} s", file=sys.stderr, flush=True)  # fmt: skip
+    last = [started]
+
+    def progress(done, total, unit):
+        now = time.perf_counter()
+        if now - last[0] >= PROGRESS_SECONDS and total:
+            last[0] = now
+            print(f"qsplan modes: {done:,} of {total:,} {unit} done ({100 * done / total:.0f}%), "
+                  f"{now - started:.0f} s", file=sys.stderr, flush=True)  # fmt: skip
+
+    return progress
+
+
 def _modes_stats(result, seconds):
     """``qsplan modes --stats``: one line on stderr (time, modes tested and pruned, peak memory)."""
     import resource
@@ -84,7 +128,7 @@ def _modes_stats(result, seconds):
 
 
 def _run_lcp(scene, args, out):
-    """``qsplan modes --method lcp``: one mode from the LCP (mechanics.lcp), or why there is none."""
+    """``qsplan modes --method lcp``: one mode from the LCP (qsplan.mechanics.crosscheck.lcp), or why there is none."""
     from qsplan.mechanics import SolveResult
     from qsplan.mechanics.crosscheck.lcp import solve_lcp
 

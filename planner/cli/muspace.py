@@ -2,7 +2,7 @@
 
 ::
 
-    qsplan muspace SCENE --x muI --y muJ [--fix muK=V ...] --range LO HI --n N [--json] [--out FILE.png]
+    qsplan muspace SCENE --x muI --y muJ [--fix muK=V ...] --range LO HI --n N [--json] [--out FILE.png [--force]]
                    [--workers N] [--scheduler ADDRESS]
 
 Both axes sample ``np.linspace(LO, HI, N)``; contacts are numbered from 1 as
@@ -15,7 +15,8 @@ the paper's ``mu_i``; coefficients not named keep the scene's values.  With
 where ``cells[j][i]`` lists, sorted, the letters (``"RBS"``) of the modes feasible at
 ``(x[i], y[j])`` and the legend is every mode tested, in enumeration order (3S=1,
 R1S2=2, ... for three contacts).  ``--out`` writes the map with the exact region
-boundaries.  Bad arguments raise a :class:`mechanics.QsplanError` naming the option.
+boundaries; an existing file is replaced only with ``--force``, and never the scene itself or
+through a symbolic link (checked before any work).  Bad arguments raise a :class:`qsplan.mechanics.QsplanError` naming the option.
 """
 
 from __future__ import annotations
@@ -43,6 +44,7 @@ def add_parser(subparsers):
     p.add_argument("--n", type=int, required=True, metavar="N", help=f"samples per axis (2..{MAX_N})")
     p.add_argument("--json", action="store_true", help="machine-readable cells on stdout")
     p.add_argument("--out", metavar="FILE.png", help="write the map (png, svg or pdf)")
+    p.add_argument("--force", action="store_true", help="replace an existing --out file (never the scene)")
     add_parallel_options(p)
     return p
 
@@ -64,6 +66,7 @@ def _parse(args, scene):
     import numpy as np
 
     from qsplan.mechanics import QsplanError
+    from qsplan.mechanics.model.friction import MAX_FRICTION
 
     n_c = scene.n_contacts
     if n_c < 2:
@@ -88,8 +91,9 @@ def _parse(args, scene):
             v = float(value)
         except ValueError:
             raise QsplanError(f"--fix: expected a number after '='; got {item!r}") from None
-        if not np.isfinite(v) or v < 0:
-            raise QsplanError(f"--fix: expected a finite nonnegative friction coefficient; got {item!r}")
+        if not np.isfinite(v) or v < 0 or v > MAX_FRICTION:
+            raise QsplanError(f"--fix: expected a finite nonnegative friction coefficient, at most {MAX_FRICTION:g} "
+                              f"(MAX_FRICTION); got {item!r}")  # fmt: skip
         base[k] = v
     lo, hi = args.range
     if not (np.isfinite(lo) and np.isfinite(hi)):
@@ -98,14 +102,20 @@ def _parse(args, scene):
         raise QsplanError(f"--range: expected LO >= 0 (friction coefficients are nonnegative); got LO = {lo}")
     if lo > hi:
         raise QsplanError(f"--range: expected LO <= HI; got {lo} > {hi}")
+    if hi > MAX_FRICTION:
+        raise QsplanError(f"--range: expected HI <= {MAX_FRICTION:g} (friction coefficients; MAX_FRICTION); got {hi:g}")
     if not 2 <= args.n <= MAX_N:
         raise QsplanError(f"--n: expected 2..{MAX_N} samples per axis; got {args.n}")
     if args.out is not None and not str(args.out).lower().endswith(_OUT_FORMATS):
         raise QsplanError(f"--out: expected a file name ending in {', '.join(_OUT_FORMATS)}; got {args.out!r}")
+    if args.out is not None:
+        from qsplan.planner.export.files import check_outputs
+
+        check_outputs([args.out], args.force, inputs=(args.scene,))
     return x, y, base, np.linspace(lo, hi, args.n)
 
 
-def _write_figure(sl, path, source):
+def _write_figure(sl, path, source, force):
     from pathlib import Path
 
 
@@ -117,7 +127,7 @@ def _write_figure(sl, path, source):
     plot_mu_map(sl, ax=axes[0, 0], title=f"{Path(source).name}" + (f": {fixed}" if fixed else ""))
     from qsplan.planner.plotting.style import save_figure
 
-    save_figure(fig, path, option="--out")
+    save_figure(fig, path, option="--out", force=force, inputs=(source,))
 
 
 def run(args, out) -> int:
@@ -128,7 +138,7 @@ def run(args, out) -> int:
     x, y, base, xs = _parse(args, scene)
     sl = mu_slice(scene, x, y, xs, xs, base_mu=base, **parallel_options(args))
     if args.out is not None:
-        _write_figure(sl, args.out, args.scene)
+        _write_figure(sl, args.out, args.scene, args.force)
     modes = sl.modes
     if args.json:
         doc = {

@@ -21,7 +21,7 @@ def add_parser(subparsers):
 
 
 def run(args, out) -> int:
-    from qsplan.mechanics import SceneError, effort_partitions, load_scene, mode_from_letters, partition_table
+    from qsplan.mechanics import QsplanError, SceneError, effort_partitions, load_scene, mode_from_letters, partition_table
 
     scene = load_scene(args.scene)
     if scene.virtual_joints:
@@ -42,7 +42,10 @@ def run(args, out) -> int:
             for r in rows:
                 out.write(f"  effort {{{', '.join(r['effort_joints'])}}}  rcond P {r['rcond_P']:.3g}  Q {r['rcond_Q']:.3g}\n")
         return 0
-    table = partition_table(scene)
+    try:
+        table = partition_table(scene)
+    except QsplanError as exc:  # the size refusal names the library's argument; the command has --mode
+        raise QsplanError(str(exc).replace("(mode=LETTERS)", "(--mode LETTERS)")) from None
     if args.json:
         json.dump({"partitions": [{"effort_joints": [names[i] for i in k], "modes": v} for k, v in table.items()]}, out)
         out.write("\n")

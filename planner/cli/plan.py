@@ -33,7 +33,7 @@ FLAGS = {"verify": "--verify", "time_limit": "--time-limit"}
 
 def add_parser(subparsers):
     p = subparsers.add_parser("plan", help="plan a two-finger task (TOML) through OMPL with guaranteed torque bands")
-    p.add_argument("task", help="task file (.toml; see planner.task)")
+    p.add_argument("task", help="task file (.toml; see qsplan.planner.planning.task)")
     add_plan_options(p, "out/plan")
     return p
 
@@ -58,6 +58,7 @@ def run_task(task, args, out) -> int:
     out.write(f"planning: {plan.seconds:.3g} s, {plan.validity_checks} validity checks "
               f"({plan.checks_per_second:.4g} per second inside OMPL)\n")  # fmt: skip
     out.write(f"narrowest guaranteed band: {w:.6g} N m at t = {t:.4g} s (resolution {task.torque_resolution:g} N m)\n")
+    out.write(f"{result.certificate.summary()}\n")
     for r in result.replays:
         out.write(f"re-simulated at {r.summary()}\n")
     for f in result.files:

@@ -4,7 +4,7 @@
 
     qsplan simulate rod --l1 A --l2 B --mu-static M1 M2 --mu-kinetic K1 K2 --speed V --duration T
                         [--initial-mode RS|SR] [--max-step S] [--min-segment S] [--max-switches N]
-                        [--json] [--out FILE.png]
+                        [--json] [--out FILE.png [--force]]
 
 The rod of Fig. 7: supports start at horizontal distances A (left, contact 1) and
 B (right, contact 2) from the rod's centre of mass and each moves toward the
@@ -31,7 +31,8 @@ the start when ``mu_1S/mu_2R < l1/l2 < mu_1R/mu_2S``; pass ``--initial-mode``),
 meet at ``t* = (A + B) / (2V)``; a segment shorter than ``--min-segment``),
 ``limit`` or ``max_switches``.  ``--out`` writes l1(t), l2(t) with the sliding
 support drawn thick, and the mu-space picture with the partition line at each
-switch.  Bad arguments raise a :class:`mechanics.QsplanError` naming the option.
+switch (an existing file is replaced only with ``--force``, never through a symbolic
+link; checked before the run).  Bad arguments raise a :class:`qsplan.mechanics.QsplanError` naming the option.
 """
 
 from __future__ import annotations
@@ -39,13 +40,22 @@ from __future__ import annotations
 import json
 import math
 
-__all__ = ["add_parser", "run"]
+__all__ = ["add_parser", "run", "SIM_RANGES", "MAX_STEPS"]
 
 _OUT_FORMATS = (".png", ".svg", ".pdf")
 
 #: Shortest ``--min-segment`` accepted (s): a thousand times the root finder's time
 #: tolerance (``MotionOptions.event_xtol``), so that segments stay resolvable.
 MIN_SEGMENT_FLOOR = 1e-9
+
+#: Plausible range ``(lo, hi)`` of each input of the rod (SI).  Outside it the answer is not slow but
+#: wrong: supports 1e300 m away reported a jam, a speed of 1e300 m/s "no persistent mode", both
+#: from overflow.  Lengths from 0.1 mm to 1 km, speeds from 1 um/s to 1 km/s, durations from the
+#: shortest segment to 10^6 s cover any rod a quasistatic model describes.
+SIM_RANGES = {"length": (1e-4, 1e3), "speed": (1e-6, 1e3), "duration": (MIN_SEGMENT_FLOOR, 1e6)}
+
+#: Most integration steps of one run (``duration / max_step``): a tiny ``--max-step`` otherwise runs forever.
+MAX_STEPS = 10_000_000
 
 
 def add_parser(subparsers):
@@ -66,30 +76,39 @@ def add_parser(subparsers):
     p.add_argument("--max-switches", type=int, metavar="N", help="cap on mode switches; default 10000")
     p.add_argument("--json", action="store_true", help="machine-readable segments on stdout")
     p.add_argument("--out", metavar="FILE.png", help="write the plots (png, svg or pdf)")
+    p.add_argument("--force", action="store_true", help="replace an existing --out file")
     return p
 
 
 def _check(args):
     from qsplan.mechanics import QsplanError
+    from qsplan.mechanics.model.friction import MAX_FRICTION
 
-    def positive(value, option, unit):
+    def positive(value, option, unit, kind=None):
         if not (math.isfinite(value) and value > 0):
             raise QsplanError(f"{option}: expected a positive finite {unit}; got {value}")
+        if kind is not None and not SIM_RANGES[kind][0] <= value <= SIM_RANGES[kind][1]:
+            lo, hi = SIM_RANGES[kind]
+            raise QsplanError(f"{option}: expected a {unit} from {lo:g} to {hi:g} (SIM_RANGES); got {value:g}")
 
-    positive(args.l1, "--l1", "length (m)")
-    positive(args.l2, "--l2", "length (m)")
+    positive(args.l1, "--l1", "length (m)", "length")
+    positive(args.l2, "--l2", "length (m)", "length")
     for option, values in (("--mu-static", args.mu_static), ("--mu-kinetic", args.mu_kinetic)):
         for i, v in enumerate(values):
-            if not (math.isfinite(v) and v >= 0):
-                raise QsplanError(f"{option}: expected nonnegative finite coefficients; got {v} for contact {i + 1}")
+            if not (math.isfinite(v) and 0 <= v <= MAX_FRICTION):
+                raise QsplanError(f"{option}: expected nonnegative finite coefficients, at most {MAX_FRICTION:g} "
+                                  f"(MAX_FRICTION); got {v} for contact {i + 1}")  # fmt: skip
     for i, (s, k) in enumerate(zip(args.mu_static, args.mu_kinetic)):
         if k > s:
             raise QsplanError(f"--mu-kinetic: contact {i + 1} has kinetic {k} above its static {s}; "
                               "kinetic friction must not exceed static (equal is allowed)")  # fmt: skip
-    positive(args.speed, "--speed", "speed (m/s)")
-    positive(args.duration, "--duration", "duration (s)")
+    positive(args.speed, "--speed", "speed (m/s)", "speed")
+    positive(args.duration, "--duration", "duration (s)", "duration")
     if args.max_step is not None:
         positive(args.max_step, "--max-step", "step (s)")
+        if args.duration / args.max_step > MAX_STEPS:
+            raise QsplanError(f"--max-step: expected at least --duration / {MAX_STEPS:g} = "
+                              f"{args.duration / MAX_STEPS:g} s (at most {MAX_STEPS:g} steps); got {args.max_step:g}")  # fmt: skip
     if args.min_segment is not None:
         positive(args.min_segment, "--min-segment", "duration (s)")
         if args.min_segment < MIN_SEGMENT_FLOOR:
@@ -99,6 +118,10 @@ def _check(args):
         raise QsplanError(f"--max-switches: expected a nonnegative integer; got {args.max_switches}")
     if args.out is not None and not str(args.out).lower().endswith(_OUT_FORMATS):
         raise QsplanError(f"--out: expected a file name ending in {', '.join(_OUT_FORMATS)}; got {args.out!r}")
+    if args.out is not None:
+        from qsplan.planner.export.files import check_outputs
+
+        check_outputs([args.out], args.force)
 
 
 def _options(args):
@@ -162,7 +185,7 @@ def _document(args, motion, cf):
     }
 
 
-def _write_figure(motion, cf, path):
+def _write_figure(motion, cf, path, force):
 
 
     from qsplan.planner.plotting.motion import rod_motion_figure
@@ -170,7 +193,7 @@ def _write_figure(motion, cf, path):
     fig = rod_motion_figure(motion, closed_form=cf)
     from qsplan.planner.plotting.style import save_figure
 
-    save_figure(fig, path, option="--out")
+    save_figure(fig, path, option="--out", force=force)
 
 
 def run(args, out) -> int:
@@ -186,7 +209,7 @@ def run(args, out) -> int:
         cf = rod_closed_form(**params, initial_mode=args.initial_mode, min_segment=options.min_segment,
                              max_switches=options.max_switches)  # fmt: skip
     if args.out is not None:
-        _write_figure(motion, cf, args.out)
+        _write_figure(motion, cf, args.out, args.force)
     doc = _document(args, motion, cf)
     if args.json:
         json.dump(doc, out)

@@ -4,6 +4,7 @@
 
     qsplan sweep [--segment 1] [--mu-range LO HI] [--shared-mu] [--samples N] [--duration T]
                  [--effort-joint left|right] [--paper-samples K] [--safety-margin M] [--max-margin M]
+                 [--min-normal N] [--min-slack N]
                  [--display-limit L] [--out DIR] [--force] [--no-plots] [--json]
                  [--workers N] [--scheduler ADDRESS]
 
@@ -15,7 +16,10 @@ at mu = HI (Fig. 11), the competing modes' bands at mu = HI (Fig. 12) and the
 band guaranteeing the mode and precluding every competitor for friction in
 [LO, HI] (Fig. 13; independent per contact, or with ``--shared-mu`` one shared
 coefficient), exactly, beside the paper's sampled method with K values: all by
-:func:`qsplan.planner.reports.segment.sweep_segment`.
+:func:`qsplan.planner.reports.segment.sweep_segment`.  ``--min-normal`` and
+``--min-slack`` (N, default 0) narrow Fig. 13's bands (exact and sampled) to efforts
+that keep every loaded contact's normal force and every rolling contact's cone
+slacks at least that large for all friction in the range (Figs. 10-12 stay eq. 28 as is).
 
 Into DIR (default ``out/sweep``) it writes ``segment1.csv`` and ``segment1.json``
 (the torque schedule: see :mod:`qsplan.planner.export.schedule`) and, unless ``--no-plots``,
@@ -30,9 +34,10 @@ stdout: a summary; with ``--json`` one object::
      "frictionless_upper_infinite": [[t0, t1], ...], "mu_high_upper_infinite": [[t0, t1], ...],
      "guaranteed": {"exact", "points_without_band", "split_points", "narrowest": {"t", "width", "lower", "upper"}},
      "paper_method": {"samples", "narrowest": {...}, "wider_than_exact_points"},
-     "safety_margin", "max_margin", "command_max", "files": [...]}
+     "safety_margin", "max_margin", "force_margin": {"min_normal_force_N", "min_coulomb_slack_N"},
+     "command_max", "files": [...]}
 
-Efforts in N m, times in s.  Bad arguments raise a :class:`mechanics.QsplanError` naming the option (exit 2).
+Efforts in N m, times in s.  Bad arguments raise a :class:`qsplan.mechanics.QsplanError` naming the option (exit 2).
 """
 
 from __future__ import annotations
@@ -40,6 +45,7 @@ from __future__ import annotations
 import json
 import math
 
+from qsplan.planner.cli.band import add_force_margin_options, force_margin_option
 from qsplan.planner.cli.options import add_parallel_options, parallel_options
 
 __all__ = ["add_parser", "run"]
@@ -62,6 +68,7 @@ def add_parser(subparsers):
                    help="N m kept from a finite edge where the band is unbounded (default: half the narrowest band)")  # fmt: skip
     p.add_argument("--max-margin", type=float, metavar="M",
                    help="N m cap on the command's margin: a wider band gets lower + M (default: midpoints)")  # fmt: skip
+    add_force_margin_options(p)
     p.add_argument("--display-limit", type=float, metavar="L", help="N m at which plotted bands are truncated (default: per figure)")
     p.add_argument("--out", default="out/sweep", metavar="DIR", help="output directory (default out/sweep)")
     p.add_argument("--force", action="store_true", help="overwrite existing files in DIR")
@@ -88,6 +95,7 @@ def _check(args):
                       ("--display-limit", args.display_limit)):  # fmt: skip
         if v is not None and not (math.isfinite(v) and v > 0):
             raise QsplanError(f"{option}: expected a positive finite torque (N m); got {v}")
+    force_margin_option(args)
     return parallel
 
 
@@ -102,7 +110,7 @@ def run(args, out) -> int:
     result = sweep_segment(samples, args.out, tuple(args.mu_range), shared=args.shared_mu,
                            paper_samples=args.paper_samples, safety_margin=args.safety_margin,
                            max_margin=args.max_margin, display_limit=args.display_limit, force=args.force,
-                           plots=not args.no_plots, **parallel)  # fmt: skip
+                           plots=not args.no_plots, force_margin=force_margin_option(args), **parallel)  # fmt: skip
     if args.json:
         json.dump(result.document, out)
         out.write("\n")
@@ -129,7 +137,10 @@ def _summary(doc, out):
         out.write(f"Fig. 12: competitor {c} {d['name']}: feasible at mu = {hi:g} {_when(runs)}\n")
     kind = "one shared mu" if doc["shared_mu"] else "each contact's mu"
     n = g["narrowest"]
-    out.write(f"Fig. 13 ({kind} in [{lo:g}, {hi:g}]): " + ("exact" if g["exact"] else "conservative at some points")
+    fm = doc["force_margin"]
+    kept = (f"; c_n >= {fm['min_normal_force_N']:g} N, Coulomb slacks >= {fm['min_coulomb_slack_N']:g} N"
+            if fm["min_normal_force_N"] or fm["min_coulomb_slack_N"] else "")  # fmt: skip
+    out.write(f"Fig. 13 ({kind} in [{lo:g}, {hi:g}]{kept}): " + ("exact" if g["exact"] else "conservative at some points")
               + f"; {g['points_without_band']} samples without a guaranteed band; {g['split_points']} split\n")
     if n:
         out.write(f"  narrowest guaranteed band: [{n['lower']:.6g}, {n['upper']:.6g}] N m, width {n['width']:.6g} N m "

@@ -26,7 +26,7 @@ from qsplan.planner.cli.options import EXIT_FAILED, EXIT_USAGE, cli_message
 __all__ = ["FLAGS", "MAX_LINES", "add_parser", "run"]
 
 #: Library fields of :func:`qsplan.planner.planning.certify.certify_plan` and this command's options.
-FLAGS = {"n_random": "--random", "seed": "--seed", "force_margin": "--force-margin", "plan": "PLAN_DIR"}
+FLAGS = {"n_random": "--random", "seed": "--seed", "force_margin": "--force-margin", "plan": "PLAN_DIR", "task": "--task"}
 
 #: Violations listed one per line before the rest are counted.
 MAX_LINES = 20
@@ -40,8 +40,9 @@ def add_parser(subparsers):
     p.add_argument("--random", type=int, default=8, metavar="N",
                    help="seeded random friction vectors per row besides the friction set's vertices (default 8)")  # fmt: skip
     p.add_argument("--seed", type=int, default=0, metavar="S", help="seed of the random friction vectors (default 0)")
-    p.add_argument("--force-margin", type=float, default=0.0, metavar="N",
-                   help="minimum normal force (N) of the planned mode at every contact (default 0)")  # fmt: skip
+    p.add_argument("--force-margin", type=float, default=None, metavar="N",
+                   help="minimum normal force (N) of the planned mode at every contact "
+                        "(default: the task's min_normal_force)")  # fmt: skip
     return p
 
 
@@ -55,7 +56,7 @@ def _task(args):
     if meta is None:
         from qsplan.mechanics import QsplanError
 
-        raise QsplanError("--task: the plan has no plan.json metadata recording its task; name the task file")
+        raise QsplanError("task: the plan has no plan.json metadata recording its task; name the task file")
     task = task_from_metadata(meta, cols)
     return task, f"task {task.name!r} as recorded in plan.json (palm thickness not recorded: the default)"
 
@@ -67,7 +68,8 @@ def run(args, out) -> int:
 
     try:
         task, source = _task(args)
-        cert = certify_plan(args.plan, task, n_random=args.random, seed=args.seed, force_margin=args.force_margin)
+        margin = task.force_margin.normal if args.force_margin is None else args.force_margin
+        cert = certify_plan(args.plan, task, n_random=args.random, seed=args.seed, force_margin=margin)
     except QsplanError as exc:
         sys.stderr.write(f"qsplan: error: {cli_message(str(exc), FLAGS)}\n")
         return EXIT_USAGE

@@ -1,19 +1,39 @@
-"""Writing output files safely: the one overwrite check, and the cell formats shared by the exports.
+"""Writing output files safely: the one overwrite check, the one atomic writer, and the cell formats.
 
 A controller file silently replaced is worse than an error: every writer in qsplan (the
-schedule and plan exports, the plan pipeline, the CLI) checks its outputs with
-:func:`check_outputs` before writing anything.  Messages name the library's fields
-(``out_dir``, ``force``); the CLI translates them into its options.
+schedule and plan exports, the plan pipeline, the figures, the paper's outputs, the CLI)
+
+* checks its outputs with :func:`check_outputs` before writing anything: an existing file is
+  replaced only with ``force``; a symbolic link is never written through and an input file
+  never replaced, ``force`` or not;
+* writes every file with :func:`atomic_write`: to a temporary name in the same directory, then
+  renamed over the target, so an interrupted run (Ctrl-C, a crash, a full disk) leaves either
+  the old file or the new one, never half of one;
+* removes with :func:`remove_stale` what an earlier run left that this run did not rewrite,
+  so a directory never holds outputs of two runs that look like one result.
+
+Messages name the library's fields (``out_dir``, ``force``); the CLI translates them into its options.
 """
 
 from __future__ import annotations
 
 import math
+import os
+import tempfile
 from pathlib import Path
 
 from qsplan.mechanics.errors import QsplanError
 
-__all__ = ["OutputExistsError", "check_out_dir", "check_outputs", "csv_cell", "json_value"]
+__all__ = [
+    "OutputExistsError",
+    "atomic_write",
+    "check_out_dir",
+    "check_output_path",
+    "check_outputs",
+    "csv_cell",
+    "json_value",
+    "remove_stale",
+]
 
 
 class OutputExistsError(QsplanError):
@@ -41,21 +61,127 @@ def check_out_dir(out_dir) -> Path:
     return out
 
 
-def check_outputs(paths, force: bool = False) -> None:
+def check_output_path(path, inputs=(), field: str = "out_dir") -> Path:
+    """``path`` as a Path, refused (always, whatever ``force``) when it cannot be a safe output.
+
+    Refused: an existing directory, a symbolic link (writing would go through it into its
+    target), and any of ``inputs`` (compared as resolved paths, so ``./scene.json`` and
+    ``scene.json`` are the same file).
+
+    Raises
+    ------
+    QsplanError
+        Naming ``field`` and the path.
+    """
+    p = Path(path)
+    if p.is_symlink():
+        raise QsplanError(f"{field}: {str(p)!r} is a symbolic link; refusing to write through it (remove the link "
+                          "or choose another path)")  # fmt: skip
+    if p.is_dir():
+        raise QsplanError(f"{field}: {str(p)!r} is a directory; cannot write the file there")
+    target = p.resolve()
+    for source in inputs:
+        if source is not None and Path(source).resolve() == target:
+            raise QsplanError(f"{field}: {str(p)!r} is an input of this run; refusing to replace it, even with force")
+    return p
+
+
+def check_outputs(paths, force: bool = False, inputs=()) -> None:
     """Refuse to overwrite: raise :class:`OutputExistsError` if any of ``paths`` exists (unless ``force``).
 
-    Also refuses (always) a path that is an existing directory.  Nothing is written.
+    Also refuses (always) a path that is an existing directory, a symbolic link or one of
+    ``inputs`` (:func:`check_output_path`).  Nothing is written.
     """
-    paths = [Path(p) for p in paths]
-    for p in paths:
-        if p.is_dir():
-            raise QsplanError(f"out_dir: {str(p)!r} is a directory; cannot write the file there")
+    paths = [check_output_path(p, inputs) for p in paths]
     clash = [p for p in paths if p.exists()]
     if clash and not force:
         message = f"out_dir: {str(clash[0])!r} exists; pass force=True to overwrite it or choose another directory"
         if len(clash) > 1:
             message += f" ({len(clash)} of the {len(paths)} output files exist)"
         raise OutputExistsError(clash[0], len(clash), message)
+
+
+def atomic_write(path, content, *, binary: bool = False, force: bool = True, inputs=(), field: str = "out_dir") -> Path:
+    """Write a file atomically: to a temporary name in its directory, then renamed over ``path``.
+
+    Parameters
+    ----------
+    path : str or Path
+        The target; its parent folders are created.
+    content : str, bytes or callable
+        The text (bytes with ``binary``), or ``content(f)`` writing into an open file object
+        (text mode with ``newline=""``, or binary with ``binary``).
+    force : bool
+        Replace an existing file.  The default is True because writers check all their outputs
+        with :func:`check_outputs` first; a lone writer passes its caller's ``force``.
+    inputs : sequence of paths
+        Files this run reads: never replaced (:func:`check_output_path`).
+    field : str
+        Names the path in errors.
+
+    Returns
+    -------
+    Path
+
+    Raises
+    ------
+    QsplanError
+        The path is refused (:func:`check_output_path`), exists without ``force``
+        (:class:`OutputExistsError`), or cannot be written (naming ``field`` and the OS reason).
+        On any error or interruption (KeyboardInterrupt included) the temporary file is removed
+        and ``path`` is untouched.
+    """
+    path = check_output_path(path, inputs, field)
+    check_outputs([path], force)
+    tmp = None
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
+        with open(fd, "wb" if binary else "w", **({} if binary else {"newline": "", "encoding": "utf-8"})) as f:
+            if callable(content):
+                content(f)
+            else:
+                f.write(content)
+            f.flush()
+            os.fsync(f.fileno())
+        os.chmod(tmp, 0o666 & ~_umask())  # mkstemp makes 0600; outputs get the usual permissions
+        os.replace(tmp, path)
+        tmp = None
+    except OSError as exc:
+        raise QsplanError(f"{field}: cannot write {str(path)!r}: {exc.strerror or exc}") from None
+    finally:
+        if tmp is not None:
+            try:
+                os.unlink(tmp)
+            except OSError:
+                pass
+    return path
+
+
+def _umask() -> int:
+    mask = os.umask(0o022)
+    os.umask(mask)
+    return mask
+
+
+def remove_stale(out_dir, names) -> list:
+    """Remove the files ``names`` from ``out_dir`` that an earlier run left; returns the removed paths.
+
+    Called by a run that replaces its outputs (``force``) before it writes, and by a run that
+    fails, so that a directory never shows an old ``plan.csv`` beside a new ``failure.json``.
+    Only regular files and symbolic links (the link, never its target) are removed.
+    """
+    out = Path(out_dir)
+    removed = []
+    for name in names:
+        p = out / name
+        if p.is_symlink() or p.is_file():
+            try:
+                p.unlink()
+            except OSError as exc:
+                raise QsplanError(f"out_dir: cannot remove the stale {str(p)!r}: {exc.strerror or exc}") from None
+            removed.append(p)
+    return removed
 
 
 def csv_cell(v) -> str:

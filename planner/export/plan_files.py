@@ -30,9 +30,8 @@ import math
 
 import numpy as np
 
-from qsplan.mechanics.errors import QsplanError
 
-from qsplan.planner.export.files import check_out_dir, check_outputs, csv_cell, json_value
+from qsplan.planner.export.files import atomic_write, check_out_dir, check_outputs, csv_cell, json_value
 from qsplan.planner.export.schedule import FORMAT, VERSION
 
 __all__ = ["PLAN_FORMAT", "plan_columns", "plan_metadata", "export_plan", "read_plan_csv"]
@@ -105,6 +104,10 @@ def plan_metadata(plan) -> dict:
         "friction": {"range": list(task.mu_range), "model": "one coefficient shared by all contacts" if task.shared_mu
                      else "each contact's coefficient independently in the range"},
         "torque_resolution_N_m": task.torque_resolution,
+        "force_margin": dict(task.force_margin.to_dict(),
+                             meaning="inside every band, for every friction in the range, every loaded contact's "
+                                     "normal force and every rolling contact's friction-cone slacks are at least "
+                                     "these (eq. 28 made strict)"),
         "limits": {"joints_rad": task.joint_limits.tolist(), "joint_speed_rad_s": task.joint_speed,
                    "workpiece_speed_m_s": task.workpiece_speed},
         "narrowest_band": {"phase": name, "t_s": _num(t), "width_N_m": _num(w)},
@@ -135,17 +138,14 @@ def export_plan(plan, out_dir, stem: str = "plan", force: bool = False) -> list:
            "null": "tau_<joint>_min: unbounded below; tau_<joint>_max: unbounded above; elsewhere: not applicable "
                    "(the joint is velocity-controlled, or a regrasp row)"}  # fmt: skip
     text = json.dumps(doc, indent=1, allow_nan=False) + "\n"  # before writing anything: no half-written files
-    try:
-        out.mkdir(parents=True, exist_ok=True)
-        with open(paths[0], "w", newline="") as f:
-            w = csv.writer(f, lineterminator="\n")
-            w.writerow(names)
-            for row in zip(*(cols[n] for n in names)):
-                w.writerow([csv_cell(v) for v in row])
-        with open(paths[1], "w") as f:
-            f.write(text)
-    except OSError as exc:
-        raise QsplanError(f"out_dir: cannot write into {str(out)!r}: {exc.strerror or exc}") from None
+    def write_csv(f):
+        w = csv.writer(f, lineterminator="\n")
+        w.writerow(names)
+        for row in zip(*(cols[n] for n in names)):
+            w.writerow([csv_cell(v) for v in row])
+
+    atomic_write(paths[0], write_csv, force=True)
+    atomic_write(paths[1], text, force=True)
     return paths
 
 

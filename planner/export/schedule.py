@@ -33,9 +33,8 @@ import csv
 import json
 from pathlib import Path
 
-from qsplan.mechanics.errors import QsplanError
 
-from qsplan.planner.export.files import check_out_dir, check_outputs, csv_cell, json_value
+from qsplan.planner.export.files import atomic_write, check_out_dir, check_outputs, csv_cell, json_value
 
 __all__ = ["FORMAT", "VERSION", "export_schedule", "schedule_columns", "schedule_metadata", "write_csv", "write_json"]
 
@@ -85,6 +84,7 @@ def schedule_columns(bands) -> tuple:
 
 def schedule_metadata(bands) -> dict:
     """What a controller engineer needs to trust the schedule (all SI)."""
+    from qsplan.mechanics.bands.effort import check_force_margin
     from qsplan.mechanics.modes.contact_mode import ContactMode
 
     from qsplan.planner.torque.pointwise import narrowest
@@ -117,6 +117,10 @@ def schedule_metadata(bands) -> dict:
             "split_points": int(g.split.sum()),
             "competitors": list(g.competitors),
             "tolerance_relative": PRECLUSION_RTOL,
+            "force_margin": dict(check_force_margin(g.force_margin).to_dict(),
+                                 meaning="inside the band, for every friction in the range, every loaded contact's "
+                                         "normal force and every rolling contact's friction-cone slacks are at least "
+                                         "these (eq. 28 made strict)"),
             "narrowest": None if k is None else {"t_s": float(S.t[k]), "width_N_m": w, "lower_N_m": float(band.lower[k]),
                                                  "upper_N_m": float(band.upper[k])},
         },
@@ -142,16 +146,13 @@ def write_csv(bands, path, force: bool = False) -> Path:
     check_outputs([path], force)
     cols, _ = schedule_columns(bands)
     names = list(cols)
-    try:
-        path.parent.mkdir(parents=True, exist_ok=True)
-        with open(path, "w", newline="") as f:
-            w = csv.writer(f, lineterminator="\n")
-            w.writerow(names)
-            for row in zip(*(cols[n] for n in names)):
-                w.writerow([csv_cell(v) for v in row])
-    except OSError as exc:
-        raise QsplanError(f"out_dir: cannot write {str(path)!r}: {exc.strerror or exc}") from None
-    return path
+    def write(f):
+        w = csv.writer(f, lineterminator="\n")
+        w.writerow(names)
+        for row in zip(*(cols[n] for n in names)):
+            w.writerow([csv_cell(v) for v in row])
+
+    return atomic_write(path, write, force=True)
 
 
 def write_json(bands, path, force: bool = False) -> Path:
@@ -168,14 +169,7 @@ def write_json(bands, path, force: bool = False) -> Path:
         "metadata": schedule_metadata(bands),
         "null": "tau_<joint>_min: unbounded below; tau_<joint>_max: unbounded above; elsewhere: no guaranteed band",
     }
-    try:
-        path.parent.mkdir(parents=True, exist_ok=True)
-        with open(path, "w") as f:
-            json.dump(doc, f, indent=1, allow_nan=False)
-            f.write("\n")
-    except OSError as exc:
-        raise QsplanError(f"out_dir: cannot write {str(path)!r}: {exc.strerror or exc}") from None
-    return path
+    return atomic_write(path, json.dumps(doc, indent=1, allow_nan=False) + "\n", force=True)
 
 
 def export_schedule(bands, out_dir, stem: str = "segment1", force: bool = False) -> list:

@@ -230,7 +230,7 @@ def read_plan(path) -> tuple:
     if p.suffix == ".json":
         cols, meta = _read_json(p)
     else:
-        from qsplan.planner import read_plan_csv
+        from qsplan.planner.export.plan_files import read_plan_csv
 
         try:
             cols = read_plan_csv(p)
@@ -256,9 +256,9 @@ def task_from_metadata(meta, cols=None):
     Raises
     ------
     QsplanError
-        Naming ``--task`` when the metadata does not record the task.
+        Naming ``task`` when the metadata does not record the task.
     """
-    from qsplan.planner import make_task
+    from qsplan.planner.planning.task import make_task
 
     try:
         h, lim = meta["hand"], meta["limits"]
@@ -273,11 +273,13 @@ def task_from_metadata(meta, cols=None):
             x, contact = cols["x_workpiece"], cols["mode"] != "free"
             ends = [i for i in range(x.size) if contact[i] and (i + 1 == x.size or not contact[i + 1])]
             start, waypoints = float(x[0]), [float(x[i]) for i in ends]
+        fm = meta.get("force_margin")  # recorded since force margins exist; older plans: the default
+        margin = None if fm is None else (fm["min_normal_force_N"], fm["min_coulomb_slack_N"])
         return make_task(hand, start, waypoints, friction["range"], meta["torque_resolution_N_m"], shared,
                          lim["joints_rad"], lim["joint_speed_rad_s"], lim["workpiece_speed_m_s"],
-                         name=meta.get("task", "task"))  # fmt: skip
+                         name=meta.get("task", "task"), force_margin=margin)  # fmt: skip
     except (KeyError, TypeError) as exc:
-        raise QsplanError(f"--task: the plan's metadata does not record the task ({exc}); name the task file") from None
+        raise QsplanError(f"task: the plan's metadata does not record the task ({exc}); name the task file") from None
 
 
 def _xdot_rows(cols, k) -> float:

@@ -137,7 +137,7 @@ def find_collisions(hand, pose, q, first: bool = False) -> list:
 
     q = np.asarray(q, float)
     man, housings = _structure(hand)
-    # the bodies of hands.two_finger_scene.hand_polygons, from the cached manipulator (building it is 2/3 of the cost)
+    # the bodies of qsplan.hands.two_finger_scene.hand_polygons, from the cached manipulator (building it is 2/3 of the cost)
     polys = {"palm": Polygon(man.base_shape), "workpiece": Polygon(workpiece_world(hand, pose))}
     polys.update((j.name, p) for j, p in zip(man.joints, link_polygons(man, q)) if p is not None)
     axes = None

@@ -41,11 +41,11 @@ def hand_scene_at(task, x, effort_joint, velocity):
 
 def contact_samples(task, xs, effort_joint, speed, name="segment"):
     """The configurations at workpiece ``xs`` (m, shape (n,)) moving at ``speed`` (m/s, signed) as
-    :class:`hands.segments.SegmentSamples` (times 0, 1, ...: bands do not depend on them).
+    :class:`qsplan.hands.segments.SegmentSamples` (times 0, 1, ...: bands do not depend on them).
 
     Raises
     ------
-    mechanics.SceneError
+    qsplan.mechanics.SceneError
         Where a configuration has no four-contact grasp.
     """
     from qsplan.hands.segments import ManipulationSegment, SegmentSamples
@@ -115,7 +115,7 @@ def check_contact_state(task: Task, x: float, effort_joint: str, direction: floa
         return StateCheck(float(x), False, why)
     if not band_kinematics(S.scenes[0], ContactMode(MODE)).ok:
         return StateCheck(float(x), False, "the 4S kinematics fail (eqs. 24-25)")
-    g = guaranteed_sweep(S, task.mu_range, task.shared_mu, MODE, competitors)
+    g = guaranteed_sweep(S, task.mu_range, task.shared_mu, MODE, competitors, force_margin=task.force_margin)
     b, d = g.band, g.desired
     cut = tuple(c for c, (lo, hi) in g.competitors.items() if np.isfinite(lo[0]))
     lo, hi = float(b.lower[0]), float(b.upper[0])

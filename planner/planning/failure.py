@@ -200,7 +200,7 @@ def _edge_corners(task, x, effort, direction):
     scene = contact_samples(task, [x], effort, direction * task.workpiece_speed).scenes[0]
     n = scene.n_contacts
     rows = np.array([[lo] * n, [hi] * n]) if task.shared_mu else np.array(list(product((lo, hi), repeat=n)))
-    low, up, ok = effort_bands(scene, ContactMode(MODE), rows)
+    low, up, ok = effort_bands(scene, ContactMode(MODE), rows, force_margin=task.force_margin)
     if not np.any(ok):
         return None, None
     i = int(np.nanargmax(np.where(ok, low, -np.inf)))

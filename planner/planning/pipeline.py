@@ -6,7 +6,10 @@ script calls: it checks its outputs before planning (nothing is overwritten with
 ``plan.json`` (:func:`qsplan.planner.export.plan_files.export_plan`), the operator plots
 (:func:`qsplan.planner.plotting.plan.plan_figures`) and ``replay.json``: the exported file
 re-simulated (:func:`qsplan.planner.planning.replay.replay_plan`) at ``verify`` friction
-vectors of the interval.  When no plan exists it writes ``failure.json`` (the report of
+vectors of the interval.  Before anything is presented as a plan, the exported file is
+certified row by row from the task alone (:func:`qsplan.planner.planning.certify.certify_plan`,
+``certificate.json``): a plan that fails is removed, ``failure.json`` names the rows and
+reasons, and :class:`~qsplan.planner.planning.results.PlanFailure` is raised.  When no plan exists it writes ``failure.json`` (the report of
 where the band closes, which mode closes it, at which friction) and raises
 :class:`qsplan.planner.planning.results.PlanFailure`.
 """
@@ -19,14 +22,35 @@ from pathlib import Path
 
 from qsplan.mechanics.errors import QsplanError
 
-from qsplan.planner.export.files import check_out_dir, check_outputs
+from qsplan.planner.export.files import atomic_write, check_out_dir, check_outputs, remove_stale
 from qsplan.planner.planning.plan import DEFAULT_OPTIONS, plan_task
 from qsplan.planner.planning.results import Plan, PlanFailure
 
-__all__ = ["PLAN_FILES", "PLAN_PLOTS", "PlanRun", "plan_outputs", "run_plan"]
+__all__ = ["PLAN_FILES", "PLAN_PLOTS", "CertificationReport", "PlanRun", "plan_outputs", "run_plan"]
 
 #: Files :func:`run_plan` writes into its directory (``replay.json`` only when ``verify`` > 0).
-PLAN_FILES = ("plan.csv", "plan.json", "replay.json")
+PLAN_FILES = ("plan.csv", "plan.json", "certificate.json", "replay.json")
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class CertificationReport:
+    """Why a plan the planner produced is not presented: its independent certificate failed.
+
+    Attributes
+    ----------
+    certificate : qsplan.planner.planning.certify.Certificate
+    """
+
+    certificate: object
+
+    @property
+    def message(self) -> str:
+        first = self.certificate.violations[0] if self.certificate.violations else None
+        return (f"no plan: the planned motion failed its independent certification ({self.certificate.summary()})"
+                + (f"; first: {first}" if first else ""))  # fmt: skip
+
+    def as_dict(self) -> dict:
+        return {"kind": "certification", "message": self.message, "certificate": self.certificate.to_dict()}
 
 #: Plots it writes (``<name>.png``) unless ``plots=False``.
 PLAN_PLOTS = ("plan_bands", "mode_timeline", "hand_snapshots")
@@ -44,12 +68,16 @@ class PlanRun:
         Files written, in order.
     replays : tuple of qsplan.planner.planning.replay.Replay
         The exported plan re-simulated, one per friction vector.
+    certificate : qsplan.planner.planning.certify.Certificate
+        The exported plan checked row by row from the task alone (always certified: a plan
+        that is not is never returned).
     """
 
     plan: Plan
     out_dir: Path
     files: tuple
     replays: tuple
+    certificate: object = None
 
     @property
     def followed(self) -> bool:
@@ -81,7 +109,8 @@ def run_plan(task, out_dir, *, seed: int = 1, planner: str = "RRTConnect", time_
         Friction vectors to re-simulate the exported plan at (the two uniform extremes, then seeded
         random ones: :func:`qsplan.planner.planning.replay.friction_samples`); 0 skips.
     force : bool
-        Overwrite existing files.
+        Replace existing outputs; an earlier run's outputs (``failure.json`` included) are removed first,
+        so the directory never mixes two runs. Without it any existing output is refused.
     plots : bool
         Draw ``plan_bands.png``, ``mode_timeline.png`` and ``hand_snapshots.png``.
     progress : callable, optional
@@ -103,6 +132,9 @@ def run_plan(task, out_dir, *, seed: int = 1, planner: str = "RRTConnect", time_
         raise QsplanError(f"verify: expected a nonnegative number of friction vectors; got {verify}")
     out = check_out_dir(out_dir)
     check_outputs(plan_outputs(out, plots), force)
+    check_outputs([out / "failure.json"], force)  # an earlier run's report is an output too
+    # with force: no output of an earlier run stays beside this run's (a failure, --no-plots, Ctrl-C)
+    remove_stale(out, [*PLAN_FILES, *(f"{n}.png" for n in PLAN_PLOTS), "failure.json"])
     limit = DEFAULT_OPTIONS.time_limit if time_limit is None else time_limit
     if not (limit > 0 and limit < float("inf")):
         raise QsplanError(f"time_limit: expected a positive number of seconds; got {time_limit}")
@@ -113,14 +145,12 @@ def run_plan(task, out_dir, *, seed: int = 1, planner: str = "RRTConnect", time_
     try:
         plan = plan_task(task, options, progress)
     except PlanFailure as exc:
-        out.mkdir(parents=True, exist_ok=True)
-        path = out / "failure.json"
-        with open(path, "w") as f:
-            json.dump(exc.report.as_dict(), f, indent=1)
+        path = atomic_write(out / "failure.json", json.dumps(exc.report.as_dict(), indent=1))
         raise PlanFailure(exc.report, report_path=path) from None
     from qsplan.planner.export.plan_files import export_plan
 
     files = [str(p) for p in export_plan(plan, out, force=True)]
+    certificate = _certify(plan, out, files, progress)
     if plots:
         progress("drawing the plots")
         from qsplan.planner.plotting.plan import plan_figures
@@ -132,10 +162,27 @@ def run_plan(task, out_dir, *, seed: int = 1, planner: str = "RRTConnect", time_
             files.append(str(path))
     replays = _verify(plan, out / "plan.csv", int(verify), seed, progress)
     if replays:
-        with open(out / "replay.json", "w") as f:
-            json.dump([r.as_dict() for r in replays], f, indent=1)
+        atomic_write(out / "replay.json", json.dumps([r.as_dict() for r in replays], indent=1))
         files.append(str(out / "replay.json"))
-    return PlanRun(plan, out, tuple(files), tuple(replays))
+    return PlanRun(plan, out, tuple(files), tuple(replays), certificate)
+
+
+def _certify(plan, out, files, progress):
+    """Certify the exported ``plan.csv``; on failure remove the plan files, write ``failure.json`` and raise."""
+    from qsplan.planner.planning.certify import certify_plan
+
+    progress("certifying the exported plan row by row from the task alone")
+    certificate = certify_plan(out / "plan.csv", plan.task, force_margin=plan.task.force_margin.normal)
+    atomic_write(out / "certificate.json", json.dumps(certificate.to_dict(), indent=1))
+    files.append(str(out / "certificate.json"))
+    progress(certificate.summary())
+    if certificate.ok:
+        return certificate
+    for name in ("plan.csv", "plan.json"):  # never left where it looks like a plan
+        (out / name).unlink(missing_ok=True)
+    report = CertificationReport(certificate)
+    path = atomic_write(out / "failure.json", json.dumps(report.as_dict(), indent=1))
+    raise PlanFailure(report, report_path=path)
 
 
 def _verify(plan, csv_path, n, seed, progress) -> list:

@@ -5,7 +5,7 @@
 1. **In-contact segments.**  Segment ``i`` slides the workpiece along the palm from
    the previous waypoint to the next in mode 4S (``"SSSS"``); its configuration
    variable is the workpiece's ``x`` (the fingers follow by tangency,
-   :func:`hands.two_finger.finger_angles`).  OMPL (:func:`qsplan.planner.planning.ompl_bridge.plan_path`)
+   :func:`qsplan.hands.two_finger.finger_angles`).  OMPL (:func:`qsplan.planner.planning.ompl_bridge.plan_path`)
    plans over ``x`` with the validity checker of :func:`check_contact_state`: no
    two bodies overlapping (every pair of fingers, palm and workpiece:
    :mod:`qsplan.planner.planning.collision`), the same four contacts as at the segment's start and the
@@ -249,7 +249,7 @@ def _segment(task, i, x0, x1, t0, options, progress, counters):
             raise PlanFailure(configuration_report(task, name, f"x = {x[k]:.4g} m on the path between OMPL's states",
                                                    x[k], S.q[k], reason, res.status))  # fmt: skip
     progress(f"  sweeping {len(x)} configurations for the guaranteed band")
-    band = guaranteed_sweep(S, task.mu_range, task.shared_mu, MODE, comps).band
+    band = guaranteed_sweep(S, task.mu_range, task.shared_mu, MODE, comps, force_margin=task.force_margin).band
     if not band.feasible.all() or np.nanmin(band.width) < task.torque_resolution:
         raise PlanFailure(failure_report(task, name, x0, x1, effort, direction, comps, res, xs=x))
     try:

@@ -4,7 +4,7 @@ A plan promises that, for every friction coefficient in the task's interval, the
 commands of its torque file make the workpiece slide in the planned mode (4S) along
 each in-contact segment.  :func:`replay_plan` checks the promise the hard way: it
 reads the commands back from the exported columns (:func:`qsplan.planner.export.plan_files.read_plan_csv`),
-drives the hand with them through :func:`mechanics.motion.simulate` at a friction
+drives the hand with them through :func:`qsplan.mechanics.motion.simulator.simulate` at a friction
 vector, and compares the simulated mode sequence and workpiece path with the plan's.
 
 Nothing of the planner's band computation is used: the simulator chooses the mode
@@ -17,7 +17,7 @@ the finger angles and the plan's clock, which indexes the commands.  The
 velocity-controlled finger follows the plan's joint-velocity column and the
 effort-controlled finger's torque column, both interpolated linearly in time
 between rows.  Between segments the plan's regrasp puts both fingers back on the
-workpiece where it is (tangency, :func:`hands.two_finger.finger_angles`), so each
+workpiece where it is (tangency, :func:`qsplan.hands.two_finger.finger_angles`), so each
 segment starts from the simulated end of the previous one: errors carry over.
 """
 
@@ -56,16 +56,16 @@ def _stop_message(motion, planned) -> str | None:
 
 @dataclass(frozen=True, slots=True, eq=False)
 class ReplaySystem:
-    """The two-finger hand driven by one in-contact segment's commands (a :class:`mechanics.motion.MotionSystem`).
+    """The two-finger hand driven by one in-contact segment's commands (a :class:`qsplan.mechanics.motion.system.MotionSystem`).
 
     Attributes
     ----------
-    hand : hands.two_finger.TwoFingerHand
+    hand : qsplan.hands.two_finger.TwoFingerHand
     effort_joint : str
         ``"left"`` or ``"right"``: torque-controlled; the other finger is velocity-controlled.
     t, velocity, effort : ndarray, shape (n,)
         Command rows: time (s), the velocity-controlled joint's speed (rad/s), the effort (N m).
-    friction : mechanics.motion.Friction
+    friction : qsplan.mechanics.motion.system.Friction
         Of the four potential contacts (palm, palm, left finger, right finger).
     """
 
@@ -114,7 +114,7 @@ class SegmentReplay:
         Largest distance (m) between the simulated and the planned workpiece x at the plan's rows.
     x_end : float
         Simulated workpiece x at the end (m).
-    motion : mechanics.motion.Motion or None
+    motion : qsplan.mechanics.motion.trajectory.Motion or None
         None when the segment could not start in its planned mode.
     """
 
@@ -223,11 +223,11 @@ def replay_plan(columns, hand, mu, options=None) -> Replay:
     ----------
     columns : dict
         The plan's columns as read by :func:`qsplan.planner.export.plan_files.read_plan_csv`.
-    hand : hands.two_finger.TwoFingerHand
+    hand : qsplan.hands.two_finger.TwoFingerHand
         The task's hand.
     mu : float or array-like, shape (4,)
         Friction of the contacts palm:0, palm:1, left, right (static = kinetic).
-    options : mechanics.motion.MotionOptions, optional
+    options : qsplan.mechanics.motion.simulator.MotionOptions, optional
         Default ``max_step`` :data:`REPLAY_STEP` and ``max_switches = 0`` (stop at the first mode change).
 
     Returns

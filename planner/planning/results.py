@@ -181,7 +181,7 @@ class Plan:
         return best or (None, np.nan, np.inf)
 
     def check(self) -> None:
-        """Raise :class:`mechanics.QsplanError` unless every command lies in its band with a positive margin."""
+        """Raise :class:`qsplan.mechanics.QsplanError` unless every command lies in its band with a positive margin."""
         for s in self.segments:
             bad = ~((s.command > s.lower) & (s.command < s.upper) & (s.margin > 0))
             if bad.any():

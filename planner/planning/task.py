@@ -14,7 +14,7 @@ rest height, ``theta = 0``), so its pose in a task is its centre-of-mass ``x``.
 TOML form (all SI: m, kg, rad, s, N m)::
 
     name = "regrasp like Fig. 9"
-    [hand]                       # hands.two_finger.make_two_finger_hand's arguments
+    [hand]                       # qsplan.hands.two_finger.make_two_finger_hand's arguments
     workpiece = [[0.0, 0.0], [0.080, 0.0], [0.085, 0.080], [0.008, 0.100]]
     workpiece_mass = 0.2         # optional from here on, with make_two_finger_hand's defaults
     finger_base = 0.09
@@ -27,6 +27,8 @@ TOML form (all SI: m, kg, rad, s, N m)::
     shared = false               # true: one coefficient shared by all contacts
     [controller]
     torque_resolution = 0.02     # N m: the narrowest band the controller can hold
+    min_normal_force = 0.05      # N, optional: every contact's normal force at least this, for all friction
+    min_coulomb_slack = 0.05     # N, optional: rolling contacts' cone slacks at least this (qsplan.planner.torque.command.PLAN_FORCE_MARGIN)
     [limits]
     left = [0.05, 3.09]          # joint range (rad) of each finger
     right = [0.05, 3.09]
@@ -34,7 +36,7 @@ TOML form (all SI: m, kg, rad, s, N m)::
     workpiece_speed = 0.01       # m/s
 
 :func:`load_task` reads it; :func:`make_task` is the Python equivalent.  Errors
-are :class:`mechanics.QsplanError` naming the field.
+are :class:`qsplan.mechanics.QsplanError` naming the field.
 """
 
 from __future__ import annotations
@@ -45,10 +47,59 @@ from pathlib import Path
 
 import numpy as np
 
+from qsplan.mechanics.bands.effort import ForceMargin, check_force_margin
 from qsplan.mechanics.errors import QsplanError
 from qsplan.mechanics.model.friction import check_mu_range
+from qsplan.planner.torque.command import PLAN_FORCE_MARGIN, plan_force_margin
 
-__all__ = ["Task", "load_task", "make_task", "demo_task_path", "task_paths"]
+__all__ = ["Task", "load_task", "make_task", "demo_task_path", "task_paths", "TASK_RANGES", "MAX_WAYPOINTS",
+           "MIN_SEGMENT_LENGTH"]
+
+#: Plausible physical range ``(lo, hi)`` of every number of a task, with its unit; outside it a value is
+#: a mistake (a unit slip, a typo), not a hand.  Reasons:
+#:
+#: * ``size`` (m): finger and palm dimensions and workpiece coordinates of a hand-scale gripper lie
+#:   between a millimetre and a metre; the contact tolerance (1e-6 m) and the planner's steps
+#:   assume that scale (finger sizes of 1e21 m overflowed the geometry).
+#: * ``position`` (m): workpiece ``x`` on a palm at most a metre wide.
+#: * ``mass`` (kg) and ``gravity`` (m/s^2): a workpiece two fingers can hold; Earth is 9.81, 100 is 10 g.
+#: * ``friction``: no dry material pair exceeds a coefficient of about 2; 5 leaves room.
+#: * ``torque_resolution`` (N m): finger motors resolve between 1e-6 and 10 N m; the loads of a hand
+#:   this size are below 1 N m, so a resolution of 10 already leaves nothing plannable.
+#: * ``joint_limit`` (rad): finger angles are measured from the palm's +x axis; above the palm is
+#:   (0, pi), and a limit beyond a half turn either way (e.g. +-100 rad) describes no finger.
+#: * ``joint_speed`` (rad/s): from 1e-3 (slower is holding still) to 10 (a fast servo).
+#: * ``workpiece_speed`` (m/s): from 1e-4 (a 4 cm segment then takes 7 minutes; 1e-300 m/s gave joint
+#:   velocities of 1e11 rad/s) to 0.5 (beyond, the inertial forces of a workpiece turning over a 5 cm
+#:   corner, v^2/r, exceed gravity and the quasistatic model no longer holds).
+TASK_RANGES = {
+    "size": (1e-3, 1.0, "m"),
+    "position": (-1.0, 1.0, "m"),
+    "mass": (1e-3, 100.0, "kg"),
+    "finger_mass": (0.0, 100.0, "kg"),
+    "gravity": (0.0, 100.0, "m/s^2"),
+    "friction": (0.0, 5.0, "friction coefficient"),
+    "torque_resolution": (1e-6, 10.0, "N m"),
+    "joint_limit": (-np.pi, np.pi, "rad"),
+    "joint_speed": (1e-3, 10.0, "rad/s"),
+    "workpiece_speed": (1e-4, 0.5, "m/s"),
+}
+
+#: Most in-contact segments a task may have: each is one OMPL query of up to its time limit, so
+#: 50 segments already mean an hour of planning in the worst case (a long zig-zag hung the planner).
+MAX_WAYPOINTS = 50
+
+#: Shortest in-contact segment (m): a tenth of a millimetre, below any hand's positioning accuracy;
+#: shorter segments make a time grid of vanishing steps.
+MIN_SEGMENT_LENGTH = 1e-4
+
+#: The keys of each table of a task file (unknown keys are refused at every level).
+_TABLE_KEYS = {
+    "motion": {"start_x", "waypoints"},
+    "friction": {"range", "shared"},
+    "controller": {"torque_resolution", "min_normal_force", "min_coulomb_slack"},
+    "limits": {"left", "right", "joint_speed", "workpiece_speed"},
+}
 
 _DATA = Path(__file__).parent.parent / "data"  # planner/data, installed as qsplan.planner package data
 
@@ -60,7 +111,7 @@ class Task:
     Attributes
     ----------
     name : str
-    hand : hands.two_finger.TwoFingerHand
+    hand : qsplan.hands.two_finger.TwoFingerHand
     start_x : float
         Workpiece centre-of-mass ``x`` at the start (m).
     waypoints : ndarray, shape (k,)
@@ -77,6 +128,9 @@ class Task:
         rad/s, positive: limit on each joint's speed.
     workpiece_speed : float
         m/s, positive: limit on the workpiece's speed.
+    force_margin : ForceMargin
+        Minimum normal force and Coulomb slack (N) every guaranteed band keeps for all friction in the range
+        (default :data:`qsplan.planner.torque.command.PLAN_FORCE_MARGIN`, with its reason).
     """
 
     name: str
@@ -89,6 +143,7 @@ class Task:
     joint_limits: np.ndarray
     joint_speed: float
     workpiece_speed: float
+    force_margin: ForceMargin = PLAN_FORCE_MARGIN
 
     def pose(self, x) -> np.ndarray:
         """Workpiece pose ``(x, rest height, 0)`` (m, m, rad), shape (3,)."""
@@ -96,16 +151,72 @@ class Task:
 
 
 def _number(value, field, unit, positive=False, nonnegative=False) -> float:
-    if isinstance(value, bool):
-        raise QsplanError(f"{field}: expected a number ({unit}); got {value!r}")
+    if isinstance(value, (bool, str)):
+        raise QsplanError(f"{field}: expected a number ({unit}); got {_short(value)}")
     try:
         x = float(value)
+    except OverflowError:
+        x = float("inf")
     except (TypeError, ValueError):
-        raise QsplanError(f"{field}: expected a number ({unit}); got {value!r}") from None
+        raise QsplanError(f"{field}: expected a number ({unit}); got {_short(value)}") from None
     if not np.isfinite(x) or (positive and x <= 0) or (nonnegative and x < 0):
         kind = "positive finite" if positive else ("nonnegative finite" if nonnegative else "finite")
-        raise QsplanError(f"{field}: expected a {kind} number ({unit}); got {value!r}")
+        raise QsplanError(f"{field}: expected a {kind} number ({unit}); got {_short(value)}")
     return x
+
+
+def _in_range(x: float, field: str, kind: str) -> float:
+    lo, hi, unit = TASK_RANGES[kind]
+    if not lo <= x <= hi:
+        raise QsplanError(f"{field}: expected {lo:g} to {hi:g} {unit} (qsplan.planner.planning.task.TASK_RANGES[{kind!r}]); "
+                          f"got {x:g}")  # fmt: skip
+    return x
+
+
+def _check_hand(hand) -> None:
+    """Every size, mass and coefficient of a TwoFingerHand inside :data:`TASK_RANGES`."""
+    for name in ("finger_base", "finger_length", "finger_width", "palm_halfwidth", "palm_thickness"):
+        _in_range(float(getattr(hand, name)), f"hand.{name}", "size")
+    span = float(np.max(np.ptp(hand.workpiece, axis=0)))
+    _in_range(span, "hand.workpiece (its width or height)", "size")
+    _in_range(float(hand.workpiece_mass), "hand.workpiece_mass", "mass")
+    _in_range(float(hand.finger_mass), "hand.finger_mass", "finger_mass")
+    _in_range(float(hand.gravity), "hand.gravity", "gravity")
+    _in_range(float(hand.mu), "hand.mu", "friction")
+
+
+def _hand_from_table(table: dict):
+    """A TwoFingerHand from a ``[hand]`` table: keys checked, numbers checked before the geometry."""
+    import inspect
+
+    from qsplan.hands.two_finger import make_two_finger_hand
+
+    allowed = set(inspect.signature(make_two_finger_hand).parameters)
+    unknown = sorted(set(table) - allowed)
+    if unknown:
+        raise QsplanError(f"hand.{unknown[0]}: unknown field; expected some of {', '.join(sorted(allowed))}")
+    if "workpiece" not in table:
+        raise QsplanError("hand.workpiece: expected the workpiece polygon [[x, y], ...] (m); it is missing")
+    wp = table["workpiece"]
+    if not isinstance(wp, (list, tuple, np.ndarray)) or not 3 <= len(wp) <= 64:
+        raise QsplanError(f"hand.workpiece: expected a polygon of 3 to 64 vertices [[x, y], ...] (m); got {_short(wp)}")
+    for i, v in enumerate(wp):
+        if not isinstance(v, (list, tuple, np.ndarray)) or len(v) != 2:
+            raise QsplanError(f"hand.workpiece[{i}]: expected a vertex [x, y] (m); got {_short(v)}")
+        for c in v:
+            _in_range(_number(c, f"hand.workpiece[{i}]", "m"), f"hand.workpiece[{i}]", "position")
+    for key, value in table.items():
+        if key != "workpiece":
+            _number(value, f"hand.{key}", "SI units")
+    try:
+        return make_two_finger_hand(**table)
+    except QsplanError as exc:
+        raise QsplanError(f"hand.{exc}") from None
+
+
+def _short(value) -> str:
+    text = repr(value)
+    return text if len(text) <= 40 else text[:20] + "..." + text[-10:]
 
 
 def _pair(value, field, unit) -> tuple:
@@ -119,46 +230,64 @@ def _pair(value, field, unit) -> tuple:
 
 def make_task(hand, start_x, waypoints, mu_range=(0.0, 0.2), torque_resolution=0.02, shared_mu=False,
               joint_limits=((0.05, 3.09), (0.05, 3.09)), joint_speed=0.5, workpiece_speed=0.01,
-              name="task") -> Task:  # fmt: skip
+              name="task", force_margin=None) -> Task:  # fmt: skip
     """Validate and build a :class:`Task` (parameters as its attributes; ``hand`` a TwoFingerHand or a dict of
-    :func:`hands.two_finger.make_two_finger_hand` arguments).
+    :func:`qsplan.hands.two_finger.make_two_finger_hand` arguments).
 
     Raises
     ------
     QsplanError
         Naming the field, what was expected and what was received.
     """
-    from qsplan.hands.two_finger import TwoFingerHand, make_two_finger_hand
+    from qsplan.hands.two_finger import TwoFingerHand
 
     if isinstance(hand, dict):
-        if "workpiece" not in hand:
-            raise QsplanError("hand.workpiece: expected the workpiece polygon [[x, y], ...] (m); it is missing")
-        try:
-            hand = make_two_finger_hand(**hand)
-        except TypeError as exc:
-            raise QsplanError(f"hand: {exc}") from None
+        hand = _hand_from_table(hand)
     if not isinstance(hand, TwoFingerHand):
         raise QsplanError(f"hand: expected a TwoFingerHand or a table of its parameters; got {type(hand).__name__}")
-    start_x = _number(start_x, "motion.start_x", "m")
-    if not isinstance(waypoints, (list, tuple, np.ndarray)) or len(waypoints) < 1:
-        raise QsplanError(f"motion.waypoints: expected a nonempty list of workpiece x (m); got {waypoints!r}")
-    wp = np.array([_number(v, "motion.waypoints", "m") for v in waypoints])
+    _check_hand(hand)
+    if not isinstance(name, str) or len(name) > 200:
+        raise QsplanError(f"name: expected a string of at most 200 characters; got {_short(name)}")
+    start_x = _in_range(_number(start_x, "motion.start_x", "m"), "motion.start_x", "position")
+    if not isinstance(waypoints, (list, tuple, np.ndarray)) or not 1 <= len(waypoints) <= MAX_WAYPOINTS:
+        raise QsplanError(f"motion.waypoints: expected a list of 1 to {MAX_WAYPOINTS} workpiece x (m); "
+                          f"got {_short(waypoints)}")  # fmt: skip
+    wp = np.array([_in_range(_number(v, f"motion.waypoints[{i}]", "m"), f"motion.waypoints[{i}]", "position")
+                   for i, v in enumerate(waypoints)])  # fmt: skip
     prev = np.concatenate([[start_x], wp[:-1]])
-    if np.any(wp == prev):
-        k = int(np.flatnonzero(wp == prev)[0])
-        raise QsplanError(f"motion.waypoints: segment {k + 1} does not move the workpiece (x = {wp[k]})")
+    short = np.abs(wp - prev) < MIN_SEGMENT_LENGTH
+    if np.any(short):
+        k = int(np.flatnonzero(short)[0])
+        raise QsplanError(f"motion.waypoints[{k}]: segment {k + 1} moves the workpiece {abs(wp[k] - prev[k]):g} m "
+                          f"(x {prev[k]:g} to {wp[k]:g}); expected at least {MIN_SEGMENT_LENGTH:g} m")  # fmt: skip
     lo, hi = check_mu_range(*_pair(mu_range, "friction.range", "friction coefficients"), "friction.range")
+    _in_range(hi, "friction.range", "friction")
+    if not lo < hi:
+        raise QsplanError(f"friction.range: expected lo < hi (plans are guaranteed over an interval of friction; for "
+                          f"one known coefficient give a small interval around it); got [{lo:g}, {hi:g}]")  # fmt: skip
+    if not isinstance(joint_limits, (list, tuple, np.ndarray)) or len(joint_limits) != 2:
+        raise QsplanError(f"limits: expected the ranges of the left and right finger; got {_short(joint_limits)}")
     limits = np.array([_pair(joint_limits[k], f"limits.{side}", "rad") for k, side in enumerate(("left", "right"))])
+    for k, side in enumerate(("left", "right")):
+        for v in limits[k]:
+            _in_range(float(v), f"limits.{side}", "joint_limit")
+        if not limits[k, 0] < limits[k, 1]:
+            raise QsplanError(f"limits.{side}: expected lo < hi (the finger must move); got {limits[k].tolist()}")
     base = hand.workpiece[:2, 0]
     if not base.min() < 0.0 < base.max():
         raise QsplanError("hand.workpiece: its centre of mass must lie over its bottom edge, so that it rests on the "
                           "palm while the fingers regrasp")  # fmt: skip
     wp.setflags(write=False)
     limits.setflags(write=False)
-    return Task(str(name), hand, start_x, wp, (lo, hi), bool(shared_mu),
-                _number(torque_resolution, "controller.torque_resolution", "N m", positive=True), limits,
-                _number(joint_speed, "limits.joint_speed", "rad/s", positive=True),
-                _number(workpiece_speed, "limits.workpiece_speed", "m/s", positive=True))  # fmt: skip
+    if not isinstance(shared_mu, (bool, np.bool_)):
+        raise QsplanError(f"friction.shared: expected true or false; got {_short(shared_mu)}")
+    checked = {key: _in_range(_number(value, field, TASK_RANGES[key][2], positive=True), field, key)
+               for key, field, value in (("torque_resolution", "controller.torque_resolution", torque_resolution),
+                                         ("joint_speed", "limits.joint_speed", joint_speed),
+                                         ("workpiece_speed", "limits.workpiece_speed", workpiece_speed))}  # fmt: skip
+    force_margin = PLAN_FORCE_MARGIN if force_margin is None else check_force_margin(force_margin)
+    return Task(name, hand, start_x, wp, (lo, hi), bool(shared_mu), checked["torque_resolution"], limits,
+                checked["joint_speed"], checked["workpiece_speed"], force_margin)  # fmt: skip
 
 
 _KNOWN = {"name", "hand", "motion", "friction", "controller", "limits"}
@@ -167,7 +296,7 @@ _KNOWN = {"name", "hand", "motion", "friction", "controller", "limits"}
 def _table(doc, key):
     v = doc.get(key, {})
     if not isinstance(v, dict):
-        raise QsplanError(f"{key}: expected a table; got {v!r}")
+        raise QsplanError(f"{key}: expected a table; got {_short(v)}")
     return v
 
 
@@ -179,18 +308,26 @@ def load_task(path) -> Task:
     QsplanError
         File missing or unreadable, bad TOML, or a bad field (named).
     """
+    from qsplan.mechanics.model.fields import read_text
+
     path = Path(path)
     try:
-        doc = tomllib.loads(path.read_text())
-    except OSError as exc:
-        raise QsplanError(f"task: cannot read {str(path)!r}: {exc.strerror or exc}") from None
-    except tomllib.TOMLDecodeError as exc:
-        raise QsplanError(f"task: {str(path)!r} is not valid TOML: {exc}") from None
+        doc = tomllib.loads(read_text(path, "task", QsplanError))
+    except RecursionError:
+        raise QsplanError(f"task: {str(path)!r} is not valid TOML: nested too deeply") from None
+    except ValueError as exc:  # TOMLDecodeError, and integers of thousands of digits
+        if isinstance(exc, QsplanError):
+            raise
+        raise QsplanError(f"task: {str(path)!r} is not valid TOML: {' '.join(str(exc).split())}") from None
     unknown = sorted(set(doc) - _KNOWN)
     if unknown:
         raise QsplanError(f"{unknown[0]}: unknown task field; expected one of {', '.join(sorted(_KNOWN))}")
     motion, friction = _table(doc, "motion"), _table(doc, "friction")
     controller, limits = _table(doc, "controller"), _table(doc, "limits")
+    for key, table in (("motion", motion), ("friction", friction), ("controller", controller), ("limits", limits)):
+        extra = sorted(set(table) - _TABLE_KEYS[key])
+        if extra:
+            raise QsplanError(f"{key}.{extra[0]}: unknown field; expected some of {', '.join(sorted(_TABLE_KEYS[key]))}")
     for key, table in (("motion.start_x", motion), ("motion.waypoints", motion)):
         if key.split(".")[1] not in table:
             raise QsplanError(f"{key}: missing")
@@ -201,13 +338,14 @@ def load_task(path) -> Task:
         kw["mu_range"] = friction["range"]
     if "shared" in friction:
         if not isinstance(friction["shared"], bool):
-            raise QsplanError(f"friction.shared: expected true or false; got {friction['shared']!r}")
+            raise QsplanError(f"friction.shared: expected true or false; got {_short(friction['shared'])}")
         kw["shared_mu"] = friction["shared"]
     if "left" in limits or "right" in limits:
         kw["joint_limits"] = (limits.get("left", (0.05, 3.09)), limits.get("right", (0.05, 3.09)))
     for key in ("joint_speed", "workpiece_speed"):
         if key in limits:
             kw[key] = limits[key]
+    kw["force_margin"] = plan_force_margin(controller.get("min_normal_force"), controller.get("min_coulomb_slack"))
     return make_task(_table(doc, "hand"), motion["start_x"], motion["waypoints"],
                      torque_resolution=controller["torque_resolution"], name=doc.get("name", path.stem), **kw)  # fmt: skip
 

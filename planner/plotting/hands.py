@@ -19,7 +19,7 @@ def plot_hand(hand, pose, q=None, ax=None, alpha=1.0, contacts=True, label_joint
 
     Parameters
     ----------
-    hand : hands.two_finger.TwoFingerHand
+    hand : qsplan.hands.two_finger.TwoFingerHand
     pose : array-like, shape (3,)
         Workpiece ``(x, y, theta)`` (m, m, rad).
     q : array-like, shape (2,), optional
@@ -66,7 +66,7 @@ def hand_strip_figure(samples, n=5, title=None):
 
     Parameters
     ----------
-    samples : hands.segments.SegmentSamples
+    samples : qsplan.hands.segments.SegmentSamples
     n : int
         At least 2.
 

@@ -1,6 +1,6 @@
 """Plots of finite motions (Section 5.1): the rod's distances and mu-space (Figs. 7-8), pushing snapshots.
 
-Compute lives in :mod:`mechanics.motion` and :mod:`hands`; this module only draws.
+Compute lives in :mod:`qsplan.mechanics.motion` and :mod:`hands`; this module only draws.
 Every ``plot_*`` function takes ``ax=None`` (a new figure is made) and returns the
 axes; the ``*_figure`` functions compose panels and return a
 ``matplotlib.figure.Figure`` (no pyplot).  matplotlib is imported inside.
@@ -37,10 +37,10 @@ def plot_rod_distances(motion, ax=None, closed_form=None):
 
     Parameters
     ----------
-    motion : mechanics.motion.Motion
-        Of a :class:`hands.rod.RodOnSupports`.
+    motion : qsplan.mechanics.motion.trajectory.Motion
+        Of a :class:`qsplan.hands.rod.RodOnSupports`.
     ax : matplotlib Axes, optional
-    closed_form : hands.rod.RodClosedForm, optional
+    closed_form : qsplan.hands.rod.RodClosedForm, optional
         Its switch points are marked with dots, for comparison.
 
     Returns
@@ -91,8 +91,8 @@ def plot_rod_mu_space(motion, ax=None, max_lines=20):
 
     Parameters
     ----------
-    motion : mechanics.motion.Motion
-        Of a :class:`hands.rod.RodOnSupports`.
+    motion : qsplan.mechanics.motion.trajectory.Motion
+        Of a :class:`qsplan.hands.rod.RodOnSupports`.
     max_lines : int
         Draw at most this many switch lines (the first ones; later ones crowd the corners).
 
@@ -170,7 +170,7 @@ def plot_mode_timeline(motion, ax=None):
 
 
 def plot_push_snapshots(motion, ax=None, n_frames=6):
-    """Snapshots of a pushed polygon (:class:`hands.pushing.PushedPolygon`), the floor and the tip's path.
+    """Snapshots of a pushed polygon (:class:`qsplan.hands.pushing.PushedPolygon`), the floor and the tip's path.
 
     Frames are evenly spaced in time, plus every event; points in contact at each
     frame are marked.

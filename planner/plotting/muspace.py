@@ -1,7 +1,7 @@
 """Pictures of mu-space (Figs. 3, 6, 8) and of the graphical test (Fig. 4).
 
-Compute lives in ``mechanics`` (:func:`mechanics.muspace.mu_slice`,
-:mod:`mechanics.graphical`); this module only draws.  Every function takes
+Compute lives in ``mechanics`` (:func:`qsplan.mechanics.muspace.slices.mu_slice`,
+:mod:`qsplan.mechanics.muspace.graphical`); this module only draws.  Every function takes
 ``ax=None`` (a new figure is made) and returns the axes; matplotlib is imported
 inside the functions.
 """
@@ -39,12 +39,12 @@ def _label_regions(ax, sl, min_fraction=0.01):
 
 
 def plot_mu_map(sl, ax=None, curves=True, numbers=True, title=None, colours=None, samples=400):
-    """Draw a :class:`mechanics.muspace.MuSlice`: cells by mode set, exact region boundaries on top.
+    """Draw a :class:`qsplan.mechanics.muspace.slices.MuSlice`: cells by mode set, exact region boundaries on top.
 
     Cells take the colour of their set of feasible modes (jams light grey, overlaps
     their own colour, see :func:`qsplan.planner.plotting.style.plot_mu_slice`).  The boundary of each
     mode's region is drawn from the zero sets of its boundary polynomials
-    (:meth:`mechanics.regions.MuRegion.boundary_curves`), not from the cells.
+    (:meth:`qsplan.mechanics.muspace.regions.MuRegion.boundary_curves`), not from the cells.
 
     Parameters
     ----------

@@ -34,7 +34,7 @@ def plot_plan_bands(plan, axes=None):
 
     Parameters
     ----------
-    plan : planner.plan.Plan
+    plan : qsplan.planner.planning.plan.Plan
     axes : sequence of matplotlib Axes, optional
         One per segment; default a new figure with one row each.
 

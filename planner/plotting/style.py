@@ -32,22 +32,30 @@ def axes_or_new(ax, size=(6.4, 3.6)):
     return axes[0, 0]
 
 
-def save_figure(fig, path, option: str = "path", dpi: int = 110) -> None:
-    """Write ``fig`` to ``path`` (parent folders created); an unwritable path raises a
-    :class:`~qsplan.mechanics.QsplanError` naming ``option`` (the caller's name for the path)."""
+def save_figure(fig, path, option: str = "path", dpi: int = 110, force: bool = True, inputs=()) -> None:
+    """Write ``fig`` to ``path`` atomically (parent folders created; the format from the suffix).
+
+    Written by :func:`qsplan.planner.export.files.atomic_write`: a temporary file renamed over
+    ``path``, never through a symbolic link, never over one of ``inputs``; an existing file is
+    replaced only with ``force`` (True by default for callers that checked their outputs first).
+    An unwritable or refused path raises a :class:`~qsplan.mechanics.QsplanError` naming ``option``
+    (the caller's name for the path).
+    """
     from pathlib import Path
 
     from qsplan.mechanics import QsplanError
+    from qsplan.planner.export.files import atomic_write
 
+    fmt = Path(path).suffix.lstrip(".").lower() or "png"
     try:
-        Path(path).parent.mkdir(parents=True, exist_ok=True)
-        fig.savefig(path, dpi=dpi, bbox_inches="tight")
+        atomic_write(path, lambda f: fig.savefig(f, format=fmt, dpi=dpi, bbox_inches="tight"), binary=True,
+                     force=force, inputs=inputs, field=option)  # fmt: skip
     except OSError as exc:
         raise QsplanError(f"{option}: cannot write {str(path)!r}: {exc.strerror or exc}") from None
 
 
 def plot_mu_slice(mumap, xs, ys, ax=None, xlabel="$\\mu_1$", ylabel="$\\mu_2$", title=None, names=True, colours=None):
-    """Draw a 2-D slice of a :class:`mechanics.muspace.MuMap` as labelled regions.
+    """Draw a 2-D slice of a :class:`qsplan.mechanics.muspace.maps.MuMap` as labelled regions.
 
     Each cell gets the colour of its *set* of feasible modes; jammed cells (no
     mode) are light grey and overlaps (ambiguity) are their own sets, so both

@@ -3,7 +3,7 @@
 Writes ``fig3_eq37.png`` (four slices perpendicular to mu3), ``fig6_eq42.png``,
 ``fig8_rod.png``, ``table1.txt`` and ``paper_results.json`` with the modes found
 and the checks of the paper's statements.  The maps come from
-:func:`mechanics.muspace.mu_slice` (the polynomial path, equal to the solver) and
+:func:`qsplan.mechanics.muspace.slices.mu_slice` (the polynomial path, equal to the solver) and
 show each region's exact boundary; every slice also records how its cell labels
 agree with those boundaries.
 """
@@ -12,7 +12,6 @@ from __future__ import annotations
 
 import json
 import time
-from pathlib import Path
 
 import numpy as np
 
@@ -21,7 +20,10 @@ from qsplan.mechanics import count_modes, scene_from_dict
 from qsplan.mechanics.muspace.maps import polynomial_map
 from qsplan.mechanics.muspace.slices import boundary_agreement, mu_slice
 
-__all__ = ["reproduce_paper", "TABLE1"]
+__all__ = ["reproduce_paper", "PAPER_FILES", "TABLE1"]
+
+#: The files :func:`reproduce_paper` writes into its folder.
+PAPER_FILES = ("fig3_eq37.png", "fig6_eq42.png", "fig8_rod.png", "table1.txt", "paper_results.json")
 
 #: The paper's Table 1: contact modes tested for n_c = 3..8 (rows dof = n_c - 1, n_c, n_c + 1).
 TABLE1 = {
@@ -50,13 +52,17 @@ def _summary(mm, n):
     }
 
 
-def reproduce_paper(out_dir, n: int = 161, progress=None) -> str:
+def reproduce_paper(out_dir, n: int = 161, progress=None, force: bool = False) -> str:
     """Run the examples, write figures and results to ``out_dir``; return a text summary.
 
     Parameters
     ----------
     out_dir : str or Path
-        Created if missing; existing files of the same names are replaced, nothing else is touched.
+        Created if missing; nothing but :data:`PAPER_FILES` is touched.  Each file is written
+        atomically (a temporary name, then renamed).
+    force : bool
+        Replace existing files of those names (checked before any work; without it an existing
+        one raises :class:`~qsplan.planner.export.files.OutputExistsError`).
     n : int
         Grid points per mu axis.
     progress : file-like, optional
@@ -65,7 +71,11 @@ def reproduce_paper(out_dir, n: int = 161, progress=None) -> str:
     from qsplan.planner.plotting.muspace import plot_mu_map
     from qsplan.planner.plotting.style import new_axes
 
-    out = Path(out_dir)
+    from qsplan.planner.export.files import atomic_write, check_out_dir, check_outputs
+    from qsplan.planner.plotting.style import save_figure
+
+    out = check_out_dir(out_dir)
+    check_outputs([out / name for name in PAPER_FILES], force)
     out.mkdir(parents=True, exist_ok=True)
     say = (lambda s: print(s, file=progress, flush=True)) if progress else (lambda s: None)
     results = {}
@@ -84,7 +94,7 @@ def reproduce_paper(out_dir, n: int = 161, progress=None) -> str:
         agreement.append(slices[f"mu3={mu3}"]["boundary_agreement"])
         plot_mu_map(sl, ax=ax, title=f"eq. (37), $\\mu_3$ = {mu3}", colours=colours)
     fig.suptitle("Fig. 3 reproduced: 3S shrinks as $\\mu_3$ grows, R1S2 unchanged")
-    fig.savefig(out / "fig3_eq37.png", dpi=110)
+    save_figure(fig, out / "fig3_eq37.png", option="out_dir")
     modes37 = sorted({m for s in slices.values() for m in s["modes_feasible_somewhere"]})
     areas3s = [s["area_fraction"].get("3S", 0.0) for s in slices.values()]
     areasrs = [s["area_fraction"].get("R1S2", 0.0) for s in slices.values()]
@@ -112,7 +122,7 @@ def reproduce_paper(out_dir, n: int = 161, progress=None) -> str:
         plot_mu_map(sl, ax=ax, title=f"eq. (42), $\\mu_3$ = {mu3}", colours=colours)
     diag = polynomial_map(scene, np.repeat(np.linspace(0, 1.5, n)[:, None], 3, axis=1))
     fig.suptitle("Fig. 6 reproduced: four modes, up to three feasible at once")
-    fig.savefig(out / "fig6_eq42.png", dpi=110)
+    save_figure(fig, out / "fig6_eq42.png", option="out_dir")
     modes42 = sorted({m for s in slices.values() for m in s["modes_feasible_somewhere"]})
     first = int(np.flatnonzero(~diag.jammed)[0])
     results["eq42"] = {
@@ -134,7 +144,7 @@ def reproduce_paper(out_dir, n: int = 161, progress=None) -> str:
     mm = sl.mumap
     fig, axes = new_axes(1, 1, size=(5.0, 4.5))
     plot_mu_map(sl, ax=axes[0, 0], title=f"rod, $l_1$ = {l1}, $l_2$ = {l2}: boundary $l_1 \\mu_2 = l_2 \\mu_1$")
-    fig.savefig(out / "fig8_rod.png", dpi=110)
+    save_figure(fig, out / "fig8_rod.png", option="out_dir")
     curve_pts = np.vstack([c.points for c in sl.boundary_curves()])
     names = [m.name for m in mm.modes]
     r2s1 = mm.feasible[:, names.index("R2S1")]
@@ -159,10 +169,10 @@ def reproduce_paper(out_dir, n: int = 161, progress=None) -> str:
         rows.append(f"3+|tau_I| = n_c{off:+d}: " + " ".join(f"{v:>6d}" for v in ours) + ("" if ours == paper else "  MISMATCH"))
     table = "n_c:              " + " ".join(f"{v:>6d}" for v in range(3, 9)) + "\n" + "\n".join(rows) + "\n"
     table += f"n_c = 20, dof = 20: {count_modes(20, 20):,}\n"
-    (out / "table1.txt").write_text(table)
+    atomic_write(out / "table1.txt", table)
     results["table1"] = {"check_matches_paper": ok, "n20_dof20": count_modes(20, 20)}
     results["seconds"] = round(time.perf_counter() - t0, 3)
-    (out / "paper_results.json").write_text(json.dumps(results, indent=2) + "\n")
+    atomic_write(out / "paper_results.json", json.dumps(results, indent=2) + "\n")
 
     checks = {f"{ex}.{k}": v for ex, r in results.items() if isinstance(r, dict) for k, v in r.items() if k.startswith("check_")}
     lines = [f"wrote {out}/fig3_eq37.png, fig6_eq42.png, fig8_rod.png, table1.txt, paper_results.json"]

@@ -67,6 +67,7 @@ def segment_document(sb: SegmentBands, paper_samples: int, files=()) -> dict:
     Efforts in N m, times in s; ``paper_method.wider_than_exact_points`` counts the samples where the
     paper's sampled band reaches outside the exact one (:func:`qsplan.planner.torque.sweep.paper_method_wider`).
     """
+    from qsplan.mechanics.bands.effort import check_force_margin
     from qsplan.mechanics.modes.contact_mode import ContactMode
 
     S = sb.samples
@@ -88,6 +89,7 @@ def segment_document(sb: SegmentBands, paper_samples: int, files=()) -> dict:
         "paper_method": {"samples": paper_samples, "narrowest": _narrow(sb.sampled),
                          "wider_than_exact_points": int(paper_method_wider(sb).sum())},
         "safety_margin": sb.safety_margin, "max_margin": sb.max_margin,
+        "force_margin": check_force_margin(g.force_margin).to_dict(),
         "command_max": float(np.nanmax(sb.command)) if np.isfinite(sb.command).any() else None,
         "files": [str(f) for f in files],
     }  # fmt: skip
@@ -95,16 +97,19 @@ def segment_document(sb: SegmentBands, paper_samples: int, files=()) -> dict:
 
 def sweep_segment(samples, out_dir, mu_range=DEFAULT_MU_RANGE, *, shared: bool = False,
                   paper_samples: int = PAPER_MU_SAMPLES, safety_margin=None, max_margin=None, display_limit=None,
-                  force: bool = False, plots: bool = True, workers=None, scheduler=None) -> SweepRun:  # fmt: skip
+                  force: bool = False, plots: bool = True, workers=None, scheduler=None,
+                  force_margin=None) -> SweepRun:  # fmt: skip
     """Compute Figs. 10-13 for a sampled segment and write the schedule and figures into ``out_dir``.
 
-    Parameters as in :func:`qsplan.planner.torque.sweep.segment_bands`; ``display_limit`` (N m) truncates
-    the plotted bands (default per figure); ``force`` overwrites existing files (checked before computing).
+    Parameters as in :func:`qsplan.planner.torque.sweep.segment_bands` (``force_margin``: the minimum
+    normal force and Coulomb slack, N, of the guaranteed and sampled bands, default none);
+    ``display_limit`` (N m) truncates the plotted bands (default per figure); ``force`` overwrites
+    existing files (checked before computing).
     """
     out = check_out_dir(out_dir)
     check_outputs(segment_outputs(out, plots), force)
     sb = segment_bands(samples, tuple(mu_range), shared, paper_samples, safety_margin, max_margin,
-                       workers=workers, scheduler=scheduler)  # fmt: skip
+                       workers=workers, scheduler=scheduler, force_margin=force_margin)  # fmt: skip
     from qsplan.planner.export.schedule import export_schedule
 
     files = [str(p) for p in export_schedule(sb, out, force=True)]

@@ -47,6 +47,8 @@ def solve_result_to_dict(result: SolveResult) -> dict:
         "counts": result.counts,
         "ambiguous": result.ambiguous,
         "jammed": result.jammed,
+        "no_feasible_mode": result.no_feasible_mode,
+        "undecided": result.degenerate,
         "units": {"qdot": "m/s, m/s, rad/s (workpiece point at the world origin)", "forces": "N",
                   "joint_velocities": "rad/s or m/s", "joint_efforts": "N m or N"},
     }  # fmt: skip
@@ -58,8 +60,8 @@ def format_solve_result(result: SolveResult, source: str = "") -> str:
     lines = []
     joints = "contact velocities given" if scene.virtual_joints else f"{scene.n_joints} joint{'s' if scene.n_joints != 1 else ''} ({len(scene.effort_joints)} effort-controlled)"
     lines.append(f"scene {source}: {scene.n_contacts} contacts, {joints}; modes tested: {result.modes_tested} (eq. 49)")
-    undecided = sum(result.counts.get(k, 0) for k in Status.DEGENERATE)
-    if result.jammed and undecided:
+    undecided = result.degenerate
+    if result.no_feasible_mode and not result.jammed:
         lines.append(f"no feasible mode found, but {undecided} mode(s) were not decided (degenerate or ill-conditioned, "
                      "see below): not a proven jam")  # fmt: skip
     elif result.jammed:

@@ -2,16 +2,55 @@
 
 The paper notes that "the narrowest portion of the region specifies the resolution
 of the torque controller"; the command exported for a controller sits where a
-torque error is least likely to leave the band.
+torque error is least likely to leave the band.  :data:`PLAN_FORCE_MARGIN` keeps the
+band itself away from the brink of eq. (28) for what the torque does not cover.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
+from qsplan.mechanics.bands.effort import ForceMargin
 from qsplan.mechanics.errors import NoAnswerError, QsplanError
 
-__all__ = ["choose_command", "default_safety_margin"]
+__all__ = ["PLAN_FORCE_MARGIN", "choose_command", "default_safety_margin", "plan_force_margin"]
+
+#: The force margin of plans (task files' ``[controller] min_normal_force`` and
+#: ``min_coulomb_slack``), N.  At a band edge of eq. (28) some normal force or cone slack is
+#: zero, and near steep edges the model's normal forces are a few mN: any load the model
+#: leaves out lifts that contact.  The torque error is covered by the band's width (the
+#: command sits mid-band, at least the torque resolution wide); the margin covers the
+#: rest.  0.05 N is 2.5 % of the demo workpiece's weight (0.2 kg, 1.96 N): the weight of
+#: a 5 g mass error, or the inertial force of the workpiece accelerating at 0.25 m/s^2
+#: (reaching the 0.01 m/s default speed limit in 40 ms), and ten times the few mN seen
+#: near steep edges.  It costs the demo little: its narrowest guaranteed band goes from
+#: 0.164 to 0.139 N m (normal forces change by ~2-4 N per N m of finger torque there),
+#: still seven times the 0.02 N m torque resolution.
+#: The slack margin binds only rolling contacts (the planner's 4S mode has none: a sliding
+#: contact is on its cone's edge by definition, eq. 17).
+PLAN_FORCE_MARGIN = ForceMargin(normal=0.05, slack=0.05)
+
+
+def plan_force_margin(min_normal_force=None, min_coulomb_slack=None, field: str = "controller") -> ForceMargin:
+    """A plan's :class:`ForceMargin` (N), :data:`PLAN_FORCE_MARGIN`'s value where one is not given.
+
+    Errors name ``<field>.min_normal_force`` / ``<field>.min_coulomb_slack`` (the task file's keys).
+    """
+    values = []
+    for name, v, default in (("min_normal_force", min_normal_force, PLAN_FORCE_MARGIN.normal),
+                             ("min_coulomb_slack", min_coulomb_slack, PLAN_FORCE_MARGIN.slack)):  # fmt: skip
+        v = default if v is None else v
+        try:
+            x = float(v) if not isinstance(v, (bool, str)) else np.nan
+        except OverflowError:  # an integer of hundreds of digits
+            x = np.inf
+        except (TypeError, ValueError):
+            x = np.nan
+        if not (np.isfinite(x) and x >= 0):
+            text = repr(v) if len(repr(v)) <= 40 else repr(v)[:20] + "..."
+            raise QsplanError(f"{field}.{name}: expected a nonnegative finite force (N); got {text}")
+        values.append(x)
+    return ForceMargin(*values)
 
 
 def choose_command(lower, upper, safety_margin, max_margin=None):

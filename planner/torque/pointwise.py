@@ -120,6 +120,8 @@ class GuaranteedSweep:
     mu_range : (float, float)
     shared : bool
         One coefficient shared by all contacts (else independent per contact).
+    force_margin : ForceMargin or None
+        Minimum normal force and Coulomb slack (N) the desired mode keeps (None: eq. 28 as is).
     """
 
     band: BandSweep
@@ -128,6 +130,7 @@ class GuaranteedSweep:
     split: np.ndarray
     mu_range: tuple
     shared: bool
+    force_margin: object = None
 
 
 
@@ -172,7 +175,7 @@ def point_band_sweep(samples, mu, mode=None, label=None) -> BandSweep:
 
     Parameters
     ----------
-    samples : hands.segments.SegmentSamples
+    samples : qsplan.hands.segments.SegmentSamples
     mu : float or array-like, shape (n_c,)
     mode : str or ContactMode, optional
     label : str, optional
@@ -188,12 +191,13 @@ def point_band_sweep(samples, mu, mode=None, label=None) -> BandSweep:
     return _sweep(label, mode, samples, bands, "point")
 
 
-def guaranteed_sweep(samples, mu_range=DEFAULT_MU_RANGE, shared=False, mode=None, competitors=None) -> GuaranteedSweep:
+def guaranteed_sweep(samples, mu_range=DEFAULT_MU_RANGE, shared=False, mode=None, competitors=None, *,
+                     force_margin=None) -> GuaranteedSweep:  # fmt: skip
     """The band guaranteeing ``mode`` and precluding every competitor for all friction in the set (Fig. 13).
 
     Parameters
     ----------
-    samples : hands.segments.SegmentSamples
+    samples : qsplan.hands.segments.SegmentSamples
     mu_range : (float, float)
         ``0 <= lo <= hi``: each contact's coefficient independently in ``[lo, hi]``, or
         with ``shared=True`` one coefficient for all contacts.
@@ -203,6 +207,8 @@ def guaranteed_sweep(samples, mu_range=DEFAULT_MU_RANGE, shared=False, mode=None
     competitors : sequence of str, optional
         Default: every mode kinematically admissible at some sample
         (:func:`qsplan.mechanics.bands.robust.admissible_competitors`; in chunks: :func:`qsplan.planner.torque.sweep.competing_modes`).
+    force_margin : ForceMargin or (float, float), optional
+        Minimum normal force and Coulomb slack (N) kept for all friction in the set (:func:`qsplan.mechanics.robust_band`).
 
     Returns
     -------
@@ -213,7 +219,8 @@ def guaranteed_sweep(samples, mu_range=DEFAULT_MU_RANGE, shared=False, mode=None
     lo, hi = check_mu_range(*mu_range)
     mode = _mode(samples, mode)
     comps = admissible_competitors(samples.scenes, mode) if competitors is None else tuple(competitors)
-    robust = [robust_band(s, mode, (lo, hi), shared=shared, competitors=comps) for s in samples.scenes]
+    robust = [robust_band(s, mode, (lo, hi), shared=shared, competitors=comps, force_margin=force_margin)
+              for s in samples.scenes]  # fmt: skip
     desired = [r.desired for r in robust]
     method = desired[0].method
     where = f"mu in [{lo:g}, {hi:g}]" + (" (shared)" if shared else " (each contact)")
@@ -226,19 +233,19 @@ def guaranteed_sweep(samples, mu_range=DEFAULT_MU_RANGE, shared=False, mode=None
                      frozen_array([r.feasible for r in robust]), frozen_array([r.exact for r in robust]), method,
                      tuple(r.reason for r in robust))  # fmt: skip
     split = frozen_array(np.array([r.split for r in robust], dtype=bool))
-    return GuaranteedSweep(band, dsweep, hulls, split, (lo, hi), bool(shared))
+    return GuaranteedSweep(band, dsweep, hulls, split, (lo, hi), bool(shared), force_margin)
 
 
-def sampled_guaranteed_sweep(samples, mu_values, mode=None, competitors=None) -> BandSweep:
+def sampled_guaranteed_sweep(samples, mu_values, mode=None, competitors=None, *, force_margin=None) -> BandSweep:
     """The paper's method: at each listed friction, the mode's band minus the competitors', intersected.
 
     Parameters
     ----------
-    samples : hands.segments.SegmentSamples
+    samples : qsplan.hands.segments.SegmentSamples
     mu_values : array-like, shape (m,) or (m, n_c)
         Friction points: one shared coefficient per row, or one per contact.
-    mode, competitors
-        As in :func:`guaranteed_sweep`.
+    mode, competitors, force_margin
+        As in :func:`guaranteed_sweep` (the margin binds the desired mode only).
 
     Returns
     -------
@@ -256,7 +263,7 @@ def sampled_guaranteed_sweep(samples, mu_values, mode=None, competitors=None) ->
     n = len(samples)
     lower, upper, feas = np.full(n, -np.inf), np.full(n, np.inf), np.ones(n, dtype=bool)
     for k, scene in enumerate(samples.scenes):
-        l, u, ok = effort_bands(scene, mode, mus)
+        l, u, ok = effort_bands(scene, mode, mus, force_margin=force_margin)
         for c in comps:
             cl, cu, cok = effort_bands(scene, c, mus)
             for j in np.flatnonzero(ok & cok):  # at each friction sample: the mode's band minus the competitor's

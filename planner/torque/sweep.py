@@ -15,6 +15,7 @@ from dataclasses import dataclass, fields, replace
 
 import numpy as np
 
+from qsplan.mechanics.bands.effort import check_force_margin
 from qsplan.mechanics.bands.robust import TOUCH_RTOL, admissible_competitors
 from qsplan.mechanics.errors import QsplanError
 from qsplan.mechanics.modes.contact_mode import ContactMode, enumerate_modes
@@ -68,7 +69,7 @@ class SegmentBands:
 
     Attributes
     ----------
-    samples : hands.segments.SegmentSamples
+    samples : qsplan.hands.segments.SegmentSamples
     frictionless : BandSweep
         Desired mode, mu = 0 (Fig. 10).
     at_high_mu : BandSweep
@@ -139,12 +140,13 @@ def _concat_sweeps(parts) -> BandSweep:
 
 def _bands_chunk(job):
     """The pointwise sweeps of :func:`segment_bands` on one range of samples."""
-    samples, lo, hi, shared, paper_samples, mode, comps = job
+    samples, lo, hi, shared, paper_samples, mode, comps, force_margin = job
     frictionless = point_band_sweep(samples, 0.0, mode, f"{mode.name}, frictionless (mu = 0)")
     at_hi = point_band_sweep(samples, hi, mode, f"{mode.name}, mu = {hi:g}")
     comp_hi = {c: point_band_sweep(samples, hi, c, f"{ContactMode(c).name} ({c}), mu = {hi:g}") for c in comps}
-    guaranteed = guaranteed_sweep(samples, (lo, hi), shared, mode, comps)
-    sampled = sampled_guaranteed_sweep(samples, np.linspace(lo, hi, int(paper_samples)), mode, comps)
+    guaranteed = guaranteed_sweep(samples, (lo, hi), shared, mode, comps, force_margin=force_margin)
+    sampled = sampled_guaranteed_sweep(samples, np.linspace(lo, hi, int(paper_samples)), mode, comps,
+                                       force_margin=force_margin)  # fmt: skip
     return frictionless, at_hi, comp_hi, guaranteed, sampled
 
 
@@ -164,12 +166,13 @@ def _merge_chunks(parts):
 
 
 def segment_bands(samples, mu_range=DEFAULT_MU_RANGE, shared=False, paper_samples=PAPER_MU_SAMPLES,
-                  safety_margin=None, max_margin=None, *, workers=None, scheduler=None) -> SegmentBands:  # fmt: skip
+                  safety_margin=None, max_margin=None, *, workers=None, scheduler=None,
+                  force_margin=None) -> SegmentBands:  # fmt: skip
     """Figs. 10-13 for a sampled segment, and the command to export.
 
     Parameters
     ----------
-    samples : hands.segments.SegmentSamples
+    samples : qsplan.hands.segments.SegmentSamples
     mu_range : (float, float)
         Friction uncertainty ``[lo, hi]``; Figs. 11-12 use ``hi``.
     shared : bool
@@ -180,22 +183,26 @@ def segment_bands(samples, mu_range=DEFAULT_MU_RANGE, shared=False, paper_sample
         N m; default :func:`qsplan.planner.torque.command.default_safety_margin`.
     max_margin : float, optional
         N m; cap on the command's margin (default none: the midpoint of every bounded band).
+    force_margin : ForceMargin or (float, float), optional
+        Minimum normal force and Coulomb slack (N) of Fig. 13's bands, exact and sampled
+        (:class:`qsplan.mechanics.bands.effort.ForceMargin`; default none: eq. 28 as is).
     workers : int or None
         Local processes for chunks of consecutive samples (``None``: all cores, 1:
         in-process); fewer than ``2 * MIN_CHUNK_SAMPLES`` samples stay in-process.
     scheduler : str or dask.distributed.Client, optional
-        Send the chunks to a Dask cluster instead (:func:`mechanics.parallel.map_chunks`).
+        Send the chunks to a Dask cluster instead (:func:`qsplan.mechanics.parallel.map_chunks`).
         Every sample is computed alone, so the result is the same however it was split.  The pointwise
 sweeps are re-exported here, so this module is the one to import.
     """
     lo, hi = check_mu_range(*mu_range)
     if isinstance(paper_samples, bool) or not isinstance(paper_samples, (int, np.integer)) or paper_samples < 1:
         raise QsplanError(f"paper samples: expected a positive integer; got {paper_samples!r}")
+    force_margin = None if force_margin is None else check_force_margin(force_margin)
     mode = ContactMode(samples.segment.mode)
     comps = competing_modes(samples, mode, workers=workers, scheduler=scheduler)
     n_chunks = chunk_count(len(samples), MIN_CHUNK_SAMPLES, workers=workers, scheduler=scheduler)
-    jobs = [(_sample_range(samples, a, b) if n_chunks > 1 else samples, lo, hi, shared, paper_samples, mode, comps)
-            for a, b in split_range(len(samples), n_chunks)]  # fmt: skip
+    jobs = [(_sample_range(samples, a, b) if n_chunks > 1 else samples, lo, hi, shared, paper_samples, mode, comps,
+             force_margin) for a, b in split_range(len(samples), n_chunks)]  # fmt: skip
     parts = map_chunks(_bands_chunk, jobs, workers=workers, scheduler=scheduler)
     frictionless, at_hi, comp_hi, guaranteed, sampled = _merge_chunks(parts)
     band = guaranteed.band

@@ -20,6 +20,7 @@ from scipy.optimize import minimize
 
 from qsplan.mechanics import effort_bands, enumerate_modes, guaranteed_band_box, guaranteed_band_shared, planted_scene, robust_band, solve
 from qsplan.mechanics.bands.effort import band_kinematics, band_rows
+from qsplan.mechanics.bands.preclusion import competitor_torques
 from qsplan.mechanics.numerics import Status
 
 N_SCENES = 300
@@ -48,19 +49,24 @@ def scenes(n=N_SCENES, seed=SEED):
     set is not empty (feasible somewhere), those unbounded on a side first: the hard cases for preclusion.
     """
     for k in range(n):
-        rng = np.random.default_rng([seed, k])
-        n_c = int(rng.integers(4, 7))
-        scene, planted = planted_scene(rng, n_c, 1, n_joints=int(rng.integers(2, 4)))
-        shared = bool(k % 2)
-        lo, hi = MU_BOX
-        others = []
-        for m in enumerate_modes(n_c, scene.dof):
-            if m.letters == planted.letters:
-                continue
-            b = guaranteed_band_shared(scene, m, lo, hi) if shared else guaranteed_band_box(scene, m, lo, hi)
-            if b.feasible:
-                others.append((np.isfinite(b.width), float(rng.uniform()), m.letters))
-        yield k, scene, [planted.letters] + [m for *_, m in sorted(others)[:2]], shared
+        yield (k,) + scene_case(k, seed)
+
+
+def scene_case(k, seed=SEED):
+    """Scene ``k`` of :func:`scenes`: ``(scene, desired modes, shared)``."""
+    rng = np.random.default_rng([seed, k])
+    n_c = int(rng.integers(4, 7))
+    scene, planted = planted_scene(rng, n_c, 1, n_joints=int(rng.integers(2, 4)))
+    shared = bool(k % 2)
+    lo, hi = MU_BOX
+    others = []
+    for m in enumerate_modes(n_c, scene.dof):
+        if m.letters == planted.letters:
+            continue
+        b = guaranteed_band_shared(scene, m, lo, hi) if shared else guaranteed_band_box(scene, m, lo, hi)
+        if b.feasible:
+            others.append((np.isfinite(b.width), float(rng.uniform()), m.letters))
+    return scene, [planted.letters] + [m for *_, m in sorted(others)[:2]], shared
 
 
 def _mu_points(scene, shared, rng, n_random=N_RANDOM_MU):
@@ -227,6 +233,36 @@ def survey(n=N_SCENES, seed=SEED, verbose=False):
             else:
                 out["conservative"] += 1
     return out
+
+
+@pytest.mark.parametrize(("k", "mode", "competitor"), [(55, "RSBSB", "SSBSS"), (52, "BSSSSB", None), (237, "BRBSSB", "SSBRBB")])
+def test_cases_that_were_unsafe_or_wrongly_exact(k, mode, competitor):
+    """Scene 55: SSBSS is feasible from 1.347 N m to +inf at mu = 0.4, but its search stopped at the first cell
+    and the band [1.347, inf) was called exact.  Scene 52: a band unbounded below.  Scene 237: a nearly singular
+    competitor (det Q_AI ~ 3e-7 near mu = 0.296) was called feasible from fitted polynomials and split the band."""
+    scene, modes, shared = scene_case(k)
+    assert mode in modes
+    band = robust_band(scene, mode, MU_BOX, shared=shared)
+    unsafe, confirmed = check_band(scene, band, shared, np.random.default_rng([SEED, k, 1]))
+    assert unsafe == [] and confirmed in (None, True)
+    if k == 55:
+        ct = band.precluded[competitor]
+        assert ct.upper == np.inf and ct.exact and not band.feasible
+    if k == 237:
+        assert not band.exact and "budget" in band.reason
+
+
+def test_empty_and_unbounded_are_distinct_answers():
+    scene, _, _ = scene_case(55)
+    inf = competitor_torques(scene, "SSBSS", *MU_BOX, 1.0, np.inf, shared=True)
+    assert not inf.empty and inf.exact and inf.upper == np.inf
+    # competitors precluded on the whole unbounded band: proved empty, not "unbounded" (before: NaN for both)
+    band = robust_band(scene, "RSBSB", MU_BOX, shared=True)
+    empty = [c for c in band.competitors if c not in band.precluded and band_kinematics(scene, c).ok]
+    assert empty
+    for c in empty:
+        ct = competitor_torques(scene, c, *MU_BOX, band.desired.lower, np.inf, shared=True)
+        assert ct.empty and ct.exact and np.isnan(ct.lower) and ct.reason is None
 
 
 @pytest.mark.slow

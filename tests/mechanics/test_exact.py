@@ -1,4 +1,4 @@
-"""Exact rational ground truth (mechanics.exact) against the float reference check_mode."""
+"""Exact rational ground truth (qsplan.mechanics.crosscheck.exact) against the float reference check_mode."""
 
 from fractions import Fraction
 

@@ -1,4 +1,4 @@
-"""The quasistatic LCP (mechanics.lcp): its solutions are the model's, and solve_lcp's mode is feasible."""
+"""The quasistatic LCP (qsplan.mechanics.crosscheck.lcp): its solutions are the model's, and solve_lcp's mode is feasible."""
 
 import numpy as np
 import pytest

@@ -1,4 +1,4 @@
-"""Lemke's method (mechanics.lemke): solutions verified, anti-cycling, ray termination, brute force."""
+"""Lemke's method (qsplan.mechanics.crosscheck.lemke): solutions verified, anti-cycling, ray termination, brute force."""
 
 from itertools import product
 

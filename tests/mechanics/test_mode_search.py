@@ -179,3 +179,59 @@ def test_n16_planted_scene_same_set_as_the_plain_path():
     assert pruned.feasible_modes == plain.feasible_modes and planted.letters in pruned.feasible_modes
     assert sum(pruned.counts.values()) == pruned.modes_tested == 5_196_627
     assert pruned.counts[PRUNED] + pruned.counts[PRUNED_KINEMATIC] > 0.99 * pruned.modes_tested
+
+
+# --- the choice of search (issue 12: a collapse on the default path) ---------------------------
+
+
+def test_auto_gives_up_pruning_when_breaking_sets_are_large():
+    # one effort joint: breaking sets of >= 22 of 26 contacts; the Apriori climb took > 120 s and 418 MB
+    import time
+
+    scene, planted = planted_scene(np.random.default_rng([1995, 26, 1]), 26, 1)
+    t = time.perf_counter()
+    auto = solve(scene, workers=1)
+    took = time.perf_counter() - t
+    assert planted.letters in auto.feasible_modes and auto.counts.get(PRUNED, 0) == 0  # every mode tested
+    assert took < 10
+
+
+def test_auto_prunes_where_it_pays():
+    scene, planted = _planted(7, 12, 9)  # 73,789 modes; the pruning needs ~200 programmes
+    auto = solve(scene, workers=1)
+    assert auto.counts[PRUNED] > 0.5 * auto.modes_tested and planted.letters in auto.feasible_modes
+
+
+def test_explicit_prune_bounds_its_memory(monkeypatch):
+    from qsplan.mechanics.solver import breaking_sets
+
+    monkeypatch.setattr(breaking_sets, "MAX_LEVEL_SETS", 300)
+    scene, _ = planted_scene(np.random.default_rng([1995, 26, 1]), 26, 1)
+    with pytest.raises(QsplanError, match="search: the pruned search would test more than 300 breaking sets of 2 contacts"):
+        solve(scene, search="prune", workers=1)
+
+
+def test_breaking_set_budget_gives_up():
+    scene, _ = planted_scene(np.random.default_rng([1995, 26, 1]), 26, 1)
+    sets, programmes = feasible_breaking_sets(scene, max_programmes=100)
+    assert sets is None and programmes <= 100
+
+
+def test_long_work_announces_itself_on_stderr(monkeypatch, tmp_path, capsys):
+    from qsplan.mechanics.model.scene_io_write import scene_to_dict
+    from qsplan.planner.cli import modes
+    from qsplan.planner.cli.main import main
+
+    scene, _ = planted_scene(np.random.default_rng([1995, 26, 1]), 26, 1)
+    path = tmp_path / "n26.json"
+    path.write_text(json.dumps(scene_to_dict(scene)))
+    assert main(["modes", str(path), "--json", "--workers", "1"]) == 0
+    quiet = capsys.readouterr()
+    monkeypatch.setattr(modes, "LONG_WORK_SECONDS", 0.0)
+    monkeypatch.setattr(modes, "PROGRESS_SECONDS", 0.0)
+    assert main(["modes", str(path), "--json", "--workers", "1"]) == 0
+    loud = capsys.readouterr()
+    assert quiet.err == "" and json.loads(loud.out) == json.loads(quiet.out)  # stdout unchanged
+    lines = loud.err.splitlines()
+    assert lines[0].startswith("qsplan modes: 23,075 modes (eq. 49: n_c = 26, 4 constraints per mode)")
+    assert any(" of 23,075 modes done (" in line for line in lines[1:])

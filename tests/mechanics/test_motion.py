@@ -286,7 +286,7 @@ def test_the_current_mode_is_kept_while_feasible():
 
 
 def test_pushed_scene_matches_the_shared_geometric_scene(pushed):
-    """Cross-check against mechanics.geometry.find_contacts / geometric_scene along the motion."""
+    """Cross-check against qsplan.mechanics.model.geometry.find_contacts / geometric_scene along the motion."""
     from qsplan.mechanics import scene_from_dict
 
     system, _, motion = pushed

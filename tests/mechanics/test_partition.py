@@ -63,3 +63,31 @@ def test_bad_xi_rejected():
     scene, _ = planted_scene(np.random.default_rng(2), 3, 0, 2)
     with pytest.raises(ModeError, match="xi"):
         effort_partitions(scene, ContactMode("SSS"), xi=[1, 0, 1])
+
+
+def test_partition_table_refuses_large_scenes_with_an_estimate(tmp_path, capsys):
+    import json
+    import time
+
+    from qsplan.mechanics import QsplanError
+    from qsplan.mechanics.model.scene_io_write import scene_to_dict
+    from qsplan.mechanics.modes.partition import MAX_TABLE_TESTS, partition_table_work
+    from qsplan.planner.cli.main import main
+
+    scene, _ = planted_scene(np.random.default_rng(5), 16, 3, 5)
+    assert partition_table_work(16, 5) > MAX_TABLE_TESTS
+    with pytest.raises(QsplanError, match=r"partition: the table for 16 contacts and 5 joints needs about .* matrix tests"):
+        partition_table(scene)
+    path = tmp_path / "n16.json"
+    path.write_text(json.dumps(scene_to_dict(scene)))
+    t = time.perf_counter()
+    assert main(["partition", str(path)]) == 2
+    err = capsys.readouterr().err
+    assert time.perf_counter() - t < 5 and err.count("\n") == 1 and "(--mode LETTERS)" in err
+
+
+def test_partition_table_work_counts_the_small_table():
+    # 3 contacts, 2 joints: eq. 49's modes for 3, 4, 5 constraints, times joint sets, times (1 + 2^n_S)
+    from qsplan.mechanics.modes.partition import partition_table_work
+
+    assert partition_table_work(3, 2) == 78

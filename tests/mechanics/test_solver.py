@@ -171,14 +171,15 @@ def test_zero_sliding_speed_is_degenerate_not_feasible():
     # supports not moving: no sliding direction is defined for the sliding contact
     scene = _two_contact_scene(Jt=[[0.0], [0.0]])
     res = solve(scene)
-    assert res.jammed and res.counts[Status.ZERO_SLIDING_SPEED] == 2 and res.degenerate == 2
+    assert res.no_feasible_mode and res.counts[Status.ZERO_SLIDING_SPEED] == 2 and res.degenerate == 2
+    assert not res.jammed  # undecided modes: not a proven jam (one definition for text and JSON)
 
 
 def test_coincident_contacts_make_kinematics_singular():
     # both contacts at the same point with the same normal: W_A has rank < 3 (eq. 30)
     scene = _two_contact_scene(Wn=[[0, 0], [1, 1], [0, 0]], Wt=[[-1, -1], [0, 0], [0, 0]])
     res = solve(scene)
-    assert res.counts[Status.KINEMATICS_SINGULAR] == 2 and res.jammed
+    assert res.counts[Status.KINEMATICS_SINGULAR] == 2 and res.no_feasible_mode and not res.jammed
 
 
 def test_breaking_contact_that_does_not_separate_is_degenerate():
@@ -236,3 +237,15 @@ def test_frictionless_rolling_contact_cannot_pull():
     mm = feasibility_map(scene, [[0.0, 0.0], [0.0, 0.3]])
     names = [m.letters for m in mm.modes]
     assert not mm.feasible[0, names.index("RS")]
+
+
+def test_text_and_json_share_one_definition_of_jammed():
+    from qsplan.planner.reports.solve_report import format_solve_result, solve_result_to_dict
+
+    undecided = solve(_two_contact_scene(Jt=[[0.0], [0.0]]))  # no feasible mode, two undecided
+    doc, text = solve_result_to_dict(undecided), format_solve_result(undecided)
+    assert doc["jammed"] is False and doc["no_feasible_mode"] is True and doc["undecided"] == 2
+    assert "not a proven jam" in text and "the scene jams" not in text
+    proven = solve(scene_from_dict(eq42_scene(mu=0.1)))  # eq. (42) at mu = 0.1 jams
+    assert proven.jammed and proven.degenerate == 0
+    assert solve_result_to_dict(proven)["jammed"] is True and "the scene jams" in format_solve_result(proven)

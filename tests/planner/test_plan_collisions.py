@@ -15,8 +15,18 @@ from qsplan.planner.planning.task import load_task, make_task, task_paths
 
 from tests.planner.overlaps import row_overlaps
 
-#: A pentagon whose grasp at x = 0 crosses the 16 cm fingers above it (the bundled pentagon task's).
+#: A pentagon whose grasp at x = 0 crosses the 16 cm fingers above it (the bundled pentagon task's
+#: workpiece; the bundled task uses 11 cm fingers for that reason).
 PENTAGON = [[0.0, 0.0], [0.070, 0.0], [0.070, 0.060], [0.035, 0.090], [0.0, 0.060]]
+
+
+def crossing_pentagon_file(tmp_path):
+    """The bundled pentagon task with the demo hand's 16 cm fingers, which cross above it."""
+    text = task_paths()["pentagon_task"].read_text()
+    assert "finger_length = 0.11" in text
+    path = tmp_path / "pentagon16.toml"
+    path.write_text(text.replace("finger_length = 0.11", "finger_length = 0.16"))
+    return path
 
 
 def _grasp(task, x):
@@ -99,7 +109,7 @@ def test_invalid_goal_limits_and_regrasps_are_named(kwargs, match):
 def test_cli_refuses_an_invalid_start_with_failure_json(tmp_path, capsys):
     """Before: 20 s of planning, then ``qsplan: error: start: the state is not valid: [...]`` and no report."""
     t0 = time.perf_counter()
-    code = main(["plan", str(task_paths()["pentagon_task"]), "--out", str(tmp_path / "o"), "--quiet", "--no-plots"])
+    code = main(["plan", str(crossing_pentagon_file(tmp_path)), "--out", str(tmp_path / "o"), "--quiet", "--no-plots"])
     _, err = capsys.readouterr()
     assert time.perf_counter() - t0 < 5.0
     assert code == 2 and err.count("\n") == 1 and err.startswith("qsplan: error: no plan: left finger and right finger")
@@ -108,8 +118,8 @@ def test_cli_refuses_an_invalid_start_with_failure_json(tmp_path, capsys):
     assert not (tmp_path / "o" / "plan.csv").exists()
 
 
-def test_bundled_pentagon_is_refused_where_its_fingers_cross():
-    task = load_task(task_paths()["pentagon_task"])
+def test_pentagon_with_long_fingers_is_refused_where_its_fingers_cross(tmp_path):
+    task = load_task(crossing_pentagon_file(tmp_path))
     xs = np.arange(-0.04, 0.0401, 0.005)
     crossed = [x for x in xs if configuration_problem(task, *_grasp(task, x))]
     assert np.allclose([min(crossed), max(crossed)], [-0.015, 0.015])
