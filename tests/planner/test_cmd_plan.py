@@ -71,3 +71,25 @@ def test_bad_input_is_one_line_exit_2(tmp_path, capsys, args, match):
     args = [str(task) if a == "TASK" else a for a in args]
     code, stdout, err = run(args + ["--out", str(tmp_path / "o")], capsys)
     assert code == 2 and match in err and err.count("\n") == 1 and "Traceback" not in err
+
+
+@pytest.mark.ompl
+def test_ctrl_c_during_planning_exits_130_and_leaves_nothing(tmp_path):
+    """SIGINT while OMPL is planning (the validity checker runs Python): one line, exit 130, no output."""
+    import signal
+    import subprocess
+    import sys
+    import time
+
+    out = tmp_path / "demo"
+    proc = subprocess.Popen([sys.executable, "-m", "qsplan.planner.cli", "demo", "--out", str(out)],
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)  # fmt: skip
+    t0, seen = time.perf_counter(), ""
+    while time.perf_counter() - t0 < 60 and "planning with OMPL" not in seen:
+        seen = proc.stderr.readline()
+    time.sleep(0.5)
+    proc.send_signal(signal.SIGINT)
+    _, err = proc.communicate(timeout=60)
+    assert proc.returncode == 130, err[-500:]
+    assert err.splitlines()[-1] == "qsplan: interrupted" and "Traceback" not in err
+    assert not out.exists() or not any(out.iterdir())
