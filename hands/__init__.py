@@ -7,12 +7,13 @@
 * :mod:`qsplan.hands.two_finger_scene` - that hand's scene (geometric and raw) at a configuration.
 * :mod:`qsplan.hands.segments` - manipulation segments of that hand (segment 1: translate left in 4S).
 
-Submodules are imported on first use so that ``import hands`` stays light.
+Submodules are imported on first use so that ``import qsplan.hands`` stays light.
 """
 
 if __name__ != "qsplan.hands":  # the repository root on sys.path must not load a second copy
     raise ImportError(f"this folder installs as qsplan.hands; import qsplan.hands (after `pip install .`), not {__name__}")
 
+from qsplan import lazy_attributes
 
 _LAZY = {
     "eq37_scene": "qsplan.hands.paper",
@@ -54,11 +55,4 @@ _LAZY = {
 __all__ = list(_LAZY)
 
 
-def __getattr__(name):
-    if name in _LAZY:
-        import importlib
-
-        value = getattr(importlib.import_module(_LAZY[name]), name)
-        globals()[name] = value
-        return value
-    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+__getattr__ = lazy_attributes(__name__, _LAZY, globals())

@@ -45,6 +45,7 @@ Parallel infrastructure (:func:`qsplan.mechanics.parallel.map_chunks`) is not pa
 if __name__ != "qsplan.mechanics":  # the repository root on sys.path must not load a second copy
     raise ImportError(f"this folder installs as qsplan.mechanics; import qsplan.mechanics (after `pip install .`), not {__name__}")
 
+from qsplan import lazy_attributes
 
 from qsplan.mechanics.bands.effort import Band, ForceMargin, effort_band, effort_bands
 from qsplan.mechanics.bands.guaranteed import guaranteed_band_box, guaranteed_band_shared, possible_band_box, sampled_band
@@ -174,11 +175,4 @@ __all__ = [
 __all__ += list(_LAZY)
 
 
-def __getattr__(name):
-    if name in _LAZY:
-        import importlib
-
-        value = getattr(importlib.import_module(_LAZY[name]), name)
-        globals()[name] = value
-        return value
-    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+__getattr__ = lazy_attributes(__name__, _LAZY, globals())

@@ -22,6 +22,8 @@ Public API (loaded on first use, so ``import qsplan.planner`` stays light):
 if __name__ != "qsplan.planner":  # the repository root on sys.path must not load a second copy
     raise ImportError(f"this folder installs as qsplan.planner; import qsplan.planner (after `pip install .`), not {__name__}")
 
+from qsplan import lazy_attributes
+
 #: Public name -> the module that defines it (imported on first attribute access).
 _LAZY = {
     # errors
@@ -123,14 +125,7 @@ _LAZY = {
 __all__ = list(_LAZY)
 
 
-def __getattr__(name):
-    if name in _LAZY:
-        import importlib
-
-        value = getattr(importlib.import_module(_LAZY[name]), name)
-        globals()[name] = value
-        return value
-    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+__getattr__ = lazy_attributes(__name__, _LAZY, globals())
 
 
 def __dir__():

@@ -12,3 +12,31 @@ install as subpackages of this one (``pyproject.toml``: ``[tool.setuptools.packa
 """
 
 __version__ = "0.1.0"
+
+
+def lazy_attributes(package: str, table: dict, namespace: dict):
+    """A module-level ``__getattr__`` (PEP 562) that imports ``table[name]`` on first access.
+
+    Used by the subpackages' ``__init__`` so that ``import qsplan.mechanics`` stays light: heavy
+    modules (shapely, scipy, matplotlib, OMPL) load only when one of their public names is used.
+
+    Parameters
+    ----------
+    package : str
+        The package's ``__name__`` (for the error message).
+    table : dict[str, str]
+        Public name -> fully qualified module that defines it.
+    namespace : dict
+        The package's ``globals()``: a loaded name is stored there, so it is imported once.
+    """
+
+    def __getattr__(name):
+        if name in table:
+            import importlib
+
+            value = getattr(importlib.import_module(table[name]), name)
+            namespace[name] = value
+            return value
+        raise AttributeError(f"module {package!r} has no attribute {name!r}")
+
+    return __getattr__
