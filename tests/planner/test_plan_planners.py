@@ -47,9 +47,9 @@ def test_plan_returns_within_its_time_limit(planner, tmp_path):
     if p.returncode == 2:
         assert "no plan: " in p.stderr and (tmp_path / "o" / "failure.json").exists()
     seconds = [float(line.split(" in ")[-1].split(" s")[0]) for line in p.stderr.splitlines() if "  OMPL: " in line]
-    # OMPL itself: the limit, plus what a planner does between two looks at the clock (BIT*'s first batch
-    # of samples: about 1 s here; the others a last motion check)
-    assert all(s < LIMIT + 1.5 for s in seconds)
+    # OMPL itself: the limit, plus what a planner does between two looks at the clock (a batch of
+    # BIT*'s samples, BITSTAR_SAMPLES_PER_BATCH: 0.2 s here; PRM's last roadmap step 0.3 s)
+    assert all(s < LIMIT + 1.0 for s in seconds)
 
 
 @pytest.mark.parametrize("planner", TIMED_PLANNERS)
