@@ -19,11 +19,21 @@ excess up to that range.  Prints a table, writes ``benchmarks/results/bands.csv`
 and the chart ``benchmarks/results/bands_speed_accuracy.png`` (git-ignored) and
 copies the chart to ``docs/bands_speed_accuracy.png`` for the README.
 
+First it prints the speed of the bands per state (the readable reference, as before issue 13)
+against the batched path (:mod:`qsplan.mechanics.bands.batched`, issue 13 point 2) in states per
+second, best of several runs on one core (the machine is shared: the figures are noisy), for the
+desired band alone and for the full guaranteed band with every competitor precluded, and the share
+of competitor searches the batched root cell does not resolve (searched one state at a time).
+
 Usage, with qsplan installed (``pip install .``) or ``PYTHONPATH=.``:
-``python benchmarks/bench_bands.py [N_POINTS]`` (default 200 points along the segment).
+``python benchmarks/bench_bands.py [N_POINTS] [--speed]`` (default 200 points along the segment;
+``--speed``: the speed table only).
 """
 
 import csv
+import os
+
+os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")  # one core, as the issue's target says
 import shutil
 import sys
 import time
@@ -32,6 +42,11 @@ from pathlib import Path
 import numpy as np
 
 from qsplan.hands import default_hand, first_segment, sample_segment
+from qsplan.mechanics.bands.batched import guaranteed_bands_box, guaranteed_bands_shared, state_batch
+from qsplan.mechanics.bands.batched_robust import RootStats, robust_bands
+from qsplan.mechanics.bands.guaranteed import guaranteed_band_box, guaranteed_band_shared
+from qsplan.mechanics.bands.robust import robust_band
+from qsplan.mechanics.modes.contact_mode import ContactMode
 from qsplan.planner import (
     competing_modes,
     guaranteed_sweep,
@@ -74,10 +89,41 @@ def excess(exact, sampled):
     return float(np.max(x)), int(np.sum(x > UNSAFE_RTOL * top))
 
 
-def main(n_points: int = 200) -> int:
+def speed_table(samples, comps, repeat: int = 5) -> list:
+    """States per second, per state against batched, for the desired band and the full guaranteed band."""
+    scenes, mode = samples.scenes, ContactMode(samples.segment.mode)
+    n = len(scenes)
+    lo, hi = MU_RANGE
+    rows = []
+    for shared in (False, True):
+        kind = "shared" if shared else "box"
+        one = guaranteed_band_shared if shared else guaranteed_band_box
+        many = guaranteed_bands_shared if shared else guaranteed_bands_box
+        t_ref, _ = best_of(lambda: [one(s, mode, lo, hi) for s in scenes], max(1, repeat // 2))
+        t_new, _ = best_of(lambda: many(state_batch(scenes), mode, lo, hi), repeat)
+        rows.append(("desired band", kind, n / t_ref, n / t_new, None))
+        t_ref, _ = best_of(lambda: [robust_band(s, mode, MU_RANGE, shared=shared, competitors=comps) for s in scenes], max(1, repeat // 2))
+        stats = RootStats()
+        robust_bands(scenes, mode, MU_RANGE, shared=shared, competitors=comps, stats=stats)
+        t_new, _ = best_of(lambda: robust_bands(scenes, mode, MU_RANGE, shared=shared, competitors=comps), repeat)
+        rows.append(("guaranteed + preclusion", kind, n / t_ref, n / t_new, stats))
+    print(f"bands per state against batched, segment 1 ({n} samples), friction in {list(MU_RANGE)}, competitors {list(comps)}")
+    print(f"states per second, best of {repeat}, one core (shared machine: noisy); scenes built beforehand")
+    print(f"{'band':<24} {'friction':<8} {'per state':>10} {'batched':>10} {'speed-up':>9} {'root-cell fallback':>19}")
+    for band, kind, a, b, st in rows:
+        fb = "-" if st is None else f"{st.fallback}/{st.root + st.fallback} ({100 * st.share_fallback:.1f} %)"
+        print(f"{band:<24} {kind:<8} {a:10.0f} {b:10.0f} {b / a:8.1f}x {fb:>19}")
+    return rows
+
+
+def main(n_points: int = 200, speed_only: bool = False) -> int:
     rng = np.random.default_rng(SEED)
     samples = sample_segment(first_segment(default_hand()), n_points)
     comps = competing_modes(samples)
+    speed_table(samples, comps)
+    if speed_only:
+        return 0
+    print()
     n_c = samples.scenes[0].n_contacts
     rows = []
     for shared in (False, True):
@@ -111,4 +157,5 @@ def main(n_points: int = 200) -> int:
 
 
 if __name__ == "__main__":
-    sys.exit(main(*(int(a) for a in sys.argv[1:2])))
+    args = [a for a in sys.argv[1:] if a != "--speed"]
+    sys.exit(main(*(int(a) for a in args[:1]), speed_only="--speed" in sys.argv[1:]))

@@ -5,6 +5,7 @@
 * :mod:`qsplan.hands.pushing` - a polygon pushed across a surface by a finger (contacts appearing).
 * :mod:`qsplan.hands.two_finger` - the palm and two single-link fingers of Fig. 9 holding a polygon.
 * :mod:`qsplan.hands.two_finger_scene` - that hand's scene (geometric and raw) at a configuration.
+* :mod:`qsplan.hands.two_finger_analytic` - that scene at a grasp from the contacts the hand knows (the fast path).
 * :mod:`qsplan.hands.segments` - manipulation segments of that hand (segment 1: translate left in 4S).
 
 Submodules are imported on first use so that ``import qsplan.hands`` stays light.
@@ -43,6 +44,8 @@ _LAZY = {
     "hand_geometric_scene": "qsplan.hands.two_finger_scene",
     "hand_contacts": "qsplan.hands.two_finger_scene",
     "hand_polygons": "qsplan.hands.two_finger_scene",
+    "analytic_hand_scene": "qsplan.hands.two_finger_analytic",
+    "grasp_contacts": "qsplan.hands.two_finger_analytic",
     "workpiece_world": "qsplan.hands.two_finger",
     "ManipulationSegment": "qsplan.hands.segments",
     "SegmentSamples": "qsplan.hands.segments",

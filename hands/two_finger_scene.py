@@ -2,13 +2,16 @@
 
 :func:`hand_geometric_scene` turns a configuration (workpiece pose, joint angles)
 of a :class:`~qsplan.hands.two_finger.TwoFingerHand` into the geometric scene form,
-and :func:`hand_scene` into a :class:`qsplan.mechanics.Scene` whose contacts are
-found from the polygons by :func:`qsplan.mechanics.find_contacts`.  Contacts are
+and :func:`hand_scene` into a :class:`qsplan.mechanics.Scene`: at a grasp from the
+contacts the hand knows (:mod:`qsplan.hands.two_finger_analytic`), elsewhere, and as
+the reference, from contacts found in the polygons by :func:`qsplan.mechanics.find_contacts`.  Contacts are
 ordered palm (left end, right end of the bottom edge), left finger, right finger
 (:data:`qsplan.hands.two_finger.CONTACT_ROLES`).
 """
 
 from __future__ import annotations
+
+from functools import lru_cache
 
 import numpy as np
 
@@ -19,8 +22,11 @@ from qsplan.mechanics.model.friction import check_friction
 __all__ = ["hand_manipulator", "hand_geometric_scene", "hand_contacts", "hand_scene", "hand_polygons"]
 
 
+@lru_cache(maxsize=16)
 def hand_manipulator(hand: TwoFingerHand):
-    """The two fingers as a :class:`qsplan.mechanics.Manipulator` (joints "left", "right"; palm as the base)."""
+    """The two fingers as a :class:`qsplan.mechanics.Manipulator` (joints "left", "right"; palm as the base).
+
+    Built once per hand (cached: hands and manipulators are immutable)."""
     from qsplan.mechanics.model.manipulator import make_joint, make_manipulator
 
     L, w = hand.finger_length, 0.5 * hand.finger_width
@@ -101,10 +107,18 @@ def hand_contacts(gs) -> list:
     return found
 
 
-def hand_scene(hand: TwoFingerHand, pose, q=None, effort_joint="right", velocity=0.0, effort=0.0, mu=None):
-    """The :class:`qsplan.mechanics.Scene` of the hand at ``pose`` (contacts found from the polygons).
+def hand_scene(hand: TwoFingerHand, pose, q=None, effort_joint="right", velocity=0.0, effort=0.0, mu=None,
+               method="auto"):  # fmt: skip
+    """The :class:`qsplan.mechanics.Scene` of the hand at ``pose``.
 
-    Parameters are those of :func:`hand_geometric_scene`.
+    Parameters are those of :func:`hand_geometric_scene`, and
+
+    method : {"auto", "generic"}
+        ``"auto"`` builds the scene from the grasp's known contacts
+        (:func:`qsplan.hands.two_finger_analytic.analytic_hand_scene`) where the
+        configuration is one, else from the polygons; ``"generic"`` always from the
+        polygons (:func:`qsplan.mechanics.find_contacts`, the reference: both give
+        the same scene to round-off).
 
     Returns
     -------
@@ -113,6 +127,21 @@ def hand_scene(hand: TwoFingerHand, pose, q=None, effort_joint="right", velocity
     """
     from qsplan.mechanics.model.geometric_scene import scene_from_geometric_scene
 
+    if method not in ("auto", "generic"):
+        raise SceneError(f"method: expected 'auto' or 'generic'; got {method!r}")
+    if method == "auto":
+        from qsplan.hands.two_finger_analytic import analytic_hand_scene
+
+        e = _effort_mask(effort_joint)
+        pose = np.asarray(pose, dtype=float)
+        q = finger_angles(hand, pose)[0] if q is None else np.asarray(q, dtype=float)
+        mu_ = None if mu is None else float(check_friction(mu, "mu"))
+        inputs = np.array([float(velocity), float(effort)])
+        if pose.shape == (3,) and q.shape == (2,) and np.all(np.isfinite(pose)) and np.all(np.isfinite(q)) \
+                and np.all(np.isfinite(inputs)):  # else the generic path validates and says what is wrong
+            scene = analytic_hand_scene(hand, pose, q, e, inputs[0], inputs[1], mu_)
+            if scene is not None:
+                return scene
     gs = hand_geometric_scene(hand, pose, q, effort_joint, velocity, effort, mu)
     return scene_from_geometric_scene(gs, hand_contacts(gs))
 

@@ -11,9 +11,8 @@ Subpackages, by the paper's concepts (each ``__init__`` lists its modules and eq
 * :mod:`.motion` - finite motions through mode switches (Section 5.1)
 * :mod:`.crosscheck` - independent checks: exact rational arithmetic, an LP, the LCP and Lemke
 
-Public API (this module's ``__all__``): the names below.  Modules that need shapely or
-scipy (geometry, manipulators, the simulator, the LP check) load on first use, so that
-``import qsplan.mechanics`` stays light.
+Public API (this module's ``__all__``): the names below.  Each loads its module on first use
+(``_LAZY``), so that ``import qsplan.mechanics`` imports neither numpy nor the solver, shapely or scipy.
 
 * contact frames and wrenches (eq. 1): :func:`cross2`, :func:`tangent_from_normal`,
   :func:`wrench_matrix`, :func:`wrench_matrices`, :func:`shift_wrenches`, :func:`point_wrench`
@@ -47,32 +46,79 @@ if __name__ != "qsplan.mechanics":  # the repository root on sys.path must not l
 
 from qsplan import lazy_attributes
 
-from qsplan.mechanics.bands.effort import Band, ForceMargin, effort_band, effort_bands
-from qsplan.mechanics.bands.guaranteed import guaranteed_band_box, guaranteed_band_shared, possible_band_box, sampled_band
-from qsplan.mechanics.bands.robust import RobustBand, robust_band
-from qsplan.mechanics.errors import ModeError, NoAnswerError, QsplanError, SceneError
-from qsplan.mechanics.model.contact import cross2, point_wrench, shift_wrenches, tangent_from_normal, wrench_matrices, wrench_matrix
-from qsplan.mechanics.model.scene import Scene, make_scene
-from qsplan.mechanics.model.scene_io import load_scene, scene_from_dict
-from qsplan.mechanics.model.scene_io_write import scene_to_dict
-from qsplan.mechanics.modes.contact_mode import ContactMode, count_modes, enumerate_modes, iter_mode_batches, mode_from_letters
-from qsplan.mechanics.modes.partition import Partition, effort_partitions, partition_table
-from qsplan.mechanics.modes.planted import planted_scene
-from qsplan.mechanics.modes.reference import ModeCheck, check_mode
-from qsplan.mechanics.modes.solution import ModeSolution, model_residuals, relative_velocity
-from qsplan.mechanics.muspace.appendices import appendix_a, appendix_b, region_3s, region_rs
-from qsplan.mechanics.muspace.graphical import GraphicalTest, graphical_test, graphical_test_mode
-from qsplan.mechanics.muspace.maps import MuMap, feasibility_map, grid_points, polynomial_map
-from qsplan.mechanics.muspace.multilinear import Multilinear
-from qsplan.mechanics.muspace.regions import MuRegion, mode_kinematics, mode_region
-from qsplan.mechanics.muspace.slices import MuSlice, boundary_agreement, mu_slice
-from qsplan.mechanics.numerics import DEFAULT_TOLERANCES, Status, Tolerances
-from qsplan.mechanics.solver.all_modes import solve
-from qsplan.mechanics.solver.result import SolveResult
-
-# Geometry needs shapely and the simulator and the LP check scipy: load those modules on first use so that
-# ``import qsplan.mechanics`` (and the CLI's solver path) stays light.
+# Every public name loads its module on first use (PEP 562), so that ``import qsplan.mechanics`` -- and
+# ``qsplan.mechanics.errors``, which the CLI's light commands need -- imports neither numpy nor the solver.
 _LAZY = {
+    # bands
+    "Band": "qsplan.mechanics.bands.effort",
+    "ForceMargin": "qsplan.mechanics.bands.effort",
+    "effort_band": "qsplan.mechanics.bands.effort",
+    "effort_bands": "qsplan.mechanics.bands.effort",
+    "guaranteed_band_box": "qsplan.mechanics.bands.guaranteed",
+    "guaranteed_band_shared": "qsplan.mechanics.bands.guaranteed",
+    "possible_band_box": "qsplan.mechanics.bands.guaranteed",
+    "sampled_band": "qsplan.mechanics.bands.guaranteed",
+    "RobustBand": "qsplan.mechanics.bands.robust",
+    "robust_band": "qsplan.mechanics.bands.robust",
+    # errors
+    "ModeError": "qsplan.mechanics.errors",
+    "NoAnswerError": "qsplan.mechanics.errors",
+    "QsplanError": "qsplan.mechanics.errors",
+    "SceneError": "qsplan.mechanics.errors",
+    # model
+    "cross2": "qsplan.mechanics.model.contact",
+    "point_wrench": "qsplan.mechanics.model.contact",
+    "shift_wrenches": "qsplan.mechanics.model.contact",
+    "tangent_from_normal": "qsplan.mechanics.model.contact",
+    "wrench_matrices": "qsplan.mechanics.model.contact",
+    "wrench_matrix": "qsplan.mechanics.model.contact",
+    "Scene": "qsplan.mechanics.model.scene",
+    "make_scene": "qsplan.mechanics.model.scene",
+    "load_scene": "qsplan.mechanics.model.scene_io",
+    "scene_from_dict": "qsplan.mechanics.model.scene_io",
+    "scene_to_dict": "qsplan.mechanics.model.scene_io_write",
+    # modes
+    "ContactMode": "qsplan.mechanics.modes.contact_mode",
+    "count_modes": "qsplan.mechanics.modes.counting",
+    "enumerate_modes": "qsplan.mechanics.modes.contact_mode",
+    "iter_mode_batches": "qsplan.mechanics.modes.contact_mode",
+    "mode_from_letters": "qsplan.mechanics.modes.contact_mode",
+    "Partition": "qsplan.mechanics.modes.partition",
+    "effort_partitions": "qsplan.mechanics.modes.partition",
+    "partition_table": "qsplan.mechanics.modes.partition",
+    "planted_scene": "qsplan.mechanics.modes.planted",
+    "ModeCheck": "qsplan.mechanics.modes.reference",
+    "check_mode": "qsplan.mechanics.modes.reference",
+    "ModeSolution": "qsplan.mechanics.modes.solution",
+    "model_residuals": "qsplan.mechanics.modes.solution",
+    "relative_velocity": "qsplan.mechanics.modes.solution",
+    # muspace
+    "appendix_a": "qsplan.mechanics.muspace.appendices",
+    "appendix_b": "qsplan.mechanics.muspace.appendices",
+    "region_3s": "qsplan.mechanics.muspace.appendices",
+    "region_rs": "qsplan.mechanics.muspace.appendices",
+    "GraphicalTest": "qsplan.mechanics.muspace.graphical",
+    "graphical_test": "qsplan.mechanics.muspace.graphical",
+    "graphical_test_mode": "qsplan.mechanics.muspace.graphical",
+    "MuMap": "qsplan.mechanics.muspace.maps",
+    "feasibility_map": "qsplan.mechanics.muspace.maps",
+    "grid_points": "qsplan.mechanics.muspace.maps",
+    "polynomial_map": "qsplan.mechanics.muspace.maps",
+    "Multilinear": "qsplan.mechanics.muspace.multilinear",
+    "MuRegion": "qsplan.mechanics.muspace.regions",
+    "mode_kinematics": "qsplan.mechanics.muspace.regions",
+    "mode_region": "qsplan.mechanics.muspace.regions",
+    "MuSlice": "qsplan.mechanics.muspace.slices",
+    "boundary_agreement": "qsplan.mechanics.muspace.slices",
+    "mu_slice": "qsplan.mechanics.muspace.slices",
+    # numerics
+    "DEFAULT_TOLERANCES": "qsplan.mechanics.numerics",
+    "Status": "qsplan.mechanics.numerics",
+    "Tolerances": "qsplan.mechanics.numerics",
+    # solver
+    "solve": "qsplan.mechanics.solver.all_modes",
+    "SolveResult": "qsplan.mechanics.solver.result",
+    # the modules that need shapely (geometry, manipulators) or scipy (the simulator, the LP check)
     "LPCheck": "qsplan.mechanics.crosscheck.lp_check",
     "lp_mode_feasible": "qsplan.mechanics.crosscheck.lp_check",
     "simulate": "qsplan.mechanics.motion.simulator",
@@ -172,7 +218,11 @@ __all__ = [
     "SolveResult",
     "solve",
 ]
-__all__ += list(_LAZY)
+__all__ += [name for name in _LAZY if name not in __all__]
 
 
 __getattr__ = lazy_attributes(__name__, _LAZY, globals())
+
+
+def __dir__():
+    return sorted(set(globals()) | set(_LAZY))

@@ -4,4 +4,5 @@
 * :mod:`.guaranteed` - over uncertain friction: guaranteed (box vertices, shared-mu roots), possible, sampled
 * :mod:`.preclusion` - competing modes precluded over uncertain friction (Figs. 12-13)
 * :mod:`.robust` - the guaranteed band of one scene with every competitor precluded (Fig. 13)
+* :mod:`.batched`, :mod:`.batched_robust` - the same for a batch of states at once (bit-identical, fast)
 """

@@ -33,6 +33,7 @@ __all__ = [
     "check_one_effort_joint",
     "band_kinematics",
     "band_rows",
+    "coulomb_rows",
     "intersect_rows",
     "effort_band",
     "effort_bands",
@@ -237,34 +238,52 @@ def band_rows(scene: Scene, mk: ModeKinematics, mu_rows, force_margin=None) -> t
     Qs = Q.copy()
     Qs[bad] = np.eye(Q.shape[1])
     sol = np.linalg.solve(Qs, np.broadcast_to(np.column_stack([r0, e]), (N, r0.size, 2)))  # (N, k, 2)
-    idx, contact = kin.idx, kin.contact
-    rows_n = idx < n_c
-    letters = mk.mode.letters
-    out0, out1 = [], []
-    for c in range(n_c):
-        if letters[c] == "B":
-            continue
-        jn = int(np.flatnonzero(rows_n[0] & (contact[0] == c))[0])
-        cn = sol[:, jn, :]  # (N, 2): value at tau = 0, slope
-        if letters[c] == "R":
-            jt = int(np.flatnonzero(~rows_n[0] & (contact[0] == c))[0])
-            ct = sol[:, jt, :]
-            for row in coulomb_slacks(mu_rows[:, c : c + 1], cn, ct):  # linear: value and slope alike
-                out0.append(row[:, 0])
-                out1.append(row[:, 1])
-            out0.append(cn[:, 0])  # c_n >= 0 (eq. 9); implied by the cone rows only when mu > 0
-            out1.append(cn[:, 1])
-        else:
-            out0.append(cn[:, 0])
-            out1.append(cn[:, 1])
-    s0 = np.column_stack(out0)
-    s1 = np.column_stack(out1)
+    s0, s1 = coulomb_rows(mk.mode, kin.idx[0], kin.contact[0], mu_rows, sol)
     scale = np.maximum(np.max(np.abs(sol[:, :, 0]), axis=1), np.max(np.abs(r0)))
     if force_margin is not None:
         s0 = s0 - row_margins(mk.mode, force_margin)[None, :]
     s0[bad] = np.nan
     s1[bad] = np.nan
     return s0, s1, det, scale
+
+
+def coulomb_rows(mode: ContactMode, idx, contact, mu_rows, sol) -> tuple:
+    """The Coulomb rows of eq. (28) from the solution of eq. (26), any leading batch shape.
+
+    Parameters
+    ----------
+    mode : ContactMode
+    idx, contact : ndarray of int, shape (k,)
+        The mode's applicable rows and their contacts (:class:`ModeKinematics`' ``kin``).
+    mu_rows : ndarray, shape (..., n_c)
+    sol : ndarray, shape (..., k, 2)
+        ``c_A`` at ``tau = 0`` and its slope in ``tau`` (eq. 26).
+
+    Returns
+    -------
+    s0, s1 : ndarray, shape (..., r)
+        In :func:`band_rows`' order, without margins.
+    """
+    n_c = mu_rows.shape[-1]
+    rows_n = idx < n_c
+    out0, out1 = [], []
+    for c, letter in enumerate(mode.letters):
+        if letter == "B":
+            continue
+        jn = int(np.flatnonzero(rows_n & (contact == c))[0])
+        cn = sol[..., jn, :]  # (..., 2): value at tau = 0, slope
+        if letter == "R":
+            jt = int(np.flatnonzero(~rows_n & (contact == c))[0])
+            ct = sol[..., jt, :]
+            for row in coulomb_slacks(mu_rows[..., c : c + 1], cn, ct):  # linear: value and slope alike
+                out0.append(row[..., 0])
+                out1.append(row[..., 1])
+            out0.append(cn[..., 0])  # c_n >= 0 (eq. 9); implied by the cone rows only when mu > 0
+            out1.append(cn[..., 1])
+        else:
+            out0.append(cn[..., 0])
+            out1.append(cn[..., 1])
+    return np.stack(out0, axis=-1), np.stack(out1, axis=-1)
 
 
 def intersect_rows(s0, s1, scale, tol: Tolerances):

@@ -46,7 +46,14 @@ from qsplan.mechanics.model.scene import Scene
 from qsplan.mechanics.modes.contact_mode import ContactMode
 from qsplan.mechanics.numerics import DEFAULT_TOLERANCES, Tolerances
 
-__all__ = ["guaranteed_band_box", "guaranteed_band_shared", "possible_band_box", "sampled_band"]
+__all__ = [
+    "guaranteed_band_box",
+    "guaranteed_band_shared",
+    "possible_band_box",
+    "sampled_band",
+    "shared_band_from_rows",
+    "shared_nodes",
+]
 
 
 def _box_vertices(scene: Scene, mode: ContactMode, lo, hi) -> np.ndarray:
@@ -192,9 +199,21 @@ def guaranteed_band_shared(scene: Scene, mode: ContactMode, lo: float, hi: float
     if hi == lo:
         b = effort_band(scene, mode, np.full(scene.n_contacts, lo), tol, force_margin=force_margin)
         return Band(b.mode, joint, b.lower, b.upper, b.feasible, b.reason, "shared-roots")
-    deg = len(mode.sliding) + 1
-    nodes = 0.5 * (lo + hi) + 0.5 * (hi - lo) * np.cos(np.pi * (np.arange(deg + 1) + 0.5) / (deg + 1))
+    nodes = shared_nodes(mode, lo, hi)
     s0, s1, det, scale = band_rows(scene, mk, np.repeat(nodes[:, None], scene.n_contacts, axis=1), force_margin)
+    return shared_band_from_rows(mode, joint, nodes, s0, s1, det, scale, lo, hi, tol)
+
+
+def shared_nodes(mode: ContactMode, lo: float, hi: float) -> np.ndarray:
+    """The ``n_S + 2`` Chebyshev points of ``[lo, hi]`` at which :func:`guaranteed_band_shared` evaluates the rows."""
+    deg = len(mode.sliding) + 1
+    return 0.5 * (lo + hi) + 0.5 * (hi - lo) * np.cos(np.pi * (np.arange(deg + 1) + 0.5) / (deg + 1))
+
+
+def shared_band_from_rows(mode: ContactMode, joint: int, nodes, s0, s1, det, scale, lo: float, hi: float,
+                          tol: Tolerances = DEFAULT_TOLERANCES) -> Band:  # fmt: skip
+    """:func:`guaranteed_band_shared` from the rows at :func:`shared_nodes` (:func:`band_rows`' output, (deg + 1, r))."""
+    deg = len(mode.sliding) + 1
     pdet = _poly_fit_exact(nodes, det, deg)
     P = np.polynomial.Polynomial
     roots_det = [r.real for r in P(pdet).roots() if abs(r.imag) < 1e-12 and lo <= r.real <= hi]

@@ -51,7 +51,7 @@ from qsplan.mechanics.errors import SceneError
 from qsplan.mechanics.modes.contact_mode import ContactMode
 from qsplan.mechanics.numerics import DEFAULT_TOLERANCES, Tolerances
 
-__all__ = ["MAX_CELLS", "PRECLUSION_RTOL", "CompetitorTorques", "competitor_torques"]
+__all__ = ["MAX_CELLS", "PRECLUSION_RTOL", "CompetitorTorques", "bernstein_matrix", "cell_lower_bounds", "competitor_torques", "point_bands"]
 
 #: Relative tolerance of the branch and bound (of the effort interval's largest finite
 #: edge, or 1 N m): the search stops when no cell can lower the bound by more.  The
@@ -143,29 +143,20 @@ class _Cells:
         R = s0.shape[1]
         N0 = (s0 * det[:, None]).reshape(m, 2**d, R)
         N1 = (s1 * det[:, None]).reshape(m, 2**d, R)
-        pl, pu, pok = _point_bands(s0, s1, scale, self.tol)
+        pl, pu, pok = point_bands(s0, s1, scale, self.tol)
         K = 2**d
         det = det.reshape(m, K)
         return det, N0, N1, pl.reshape(m, K), pu.reshape(m, K), pok.reshape(m, K), _spread(det, N0, N1, d)
 
     def _bernstein(self, a, b):
-        n = self.deg
-        h = b - a
-        # T[m, j, i]: coefficient of t^i in (a + h t)^j
-        j = np.arange(n + 1)
-        C = np.array([[comb(jj, ii) for ii in range(n + 1)] for jj in range(n + 1)], dtype=float)
-        expo = j[:, None] - j[None, :]
-        T = C[None] * np.where(expo[None] >= 0, a[:, None, None] ** np.maximum(expo, 0)[None], 0.0) * h[:, None, None] ** j[None, None, :]
-        # Bernstein: beta_k = sum_{i<=k} C(k,i)/C(n,i) d_i
-        Bm = np.array([[comb(k, i) / comb(n, i) if i <= k else 0.0 for i in range(n + 1)] for k in range(n + 1)])
-        M = np.einsum("ki,mji->mkj", Bm, T)  # (m, K, j): control value k from power coefficient j
+        M = bernstein_matrix(self.deg, a, b)
         det = M @ self.cdet
         N0 = M @ self.cN0
         N1 = M @ self.cN1
         # point bands from the model itself (the fitted polynomials lose their accuracy near a root of det)
         pts = np.stack([a, 0.5 * (a + b), b], axis=1)  # (m, 3)
         s0, s1, _, scale = band_rows(self.scene, self.mk, np.repeat(pts.reshape(-1, 1), self.n_c, axis=1))
-        pl, pu, pok = _point_bands(s0, s1, scale, self.tol)
+        pl, pu, pok = point_bands(s0, s1, scale, self.tol)
         m = a.size
         return det, N0, N1, pl.reshape(m, 3), pu.reshape(m, 3), pok.reshape(m, 3), np.ones((m, 1))
 
@@ -188,6 +179,19 @@ class _Cells:
         return np.vstack([clo, lo2]), np.vstack([hi1, chi])
 
 
+def bernstein_matrix(n: int, a, b) -> np.ndarray:
+    """(m, n + 1, n + 1): the Bernstein coefficients on ``[a, b]`` (m,) of a degree-``n`` polynomial from its power coefficients."""
+    h = b - a
+    # T[m, j, i]: coefficient of t^i in (a + h t)^j
+    j = np.arange(n + 1)
+    C = np.array([[comb(jj, ii) for ii in range(n + 1)] for jj in range(n + 1)], dtype=float)
+    expo = j[:, None] - j[None, :]
+    T = C[None] * np.where(expo[None] >= 0, a[:, None, None] ** np.maximum(expo, 0)[None], 0.0) * h[:, None, None] ** j[None, None, :]
+    # Bernstein: beta_k = sum_{i<=k} C(k,i)/C(n,i) d_i
+    Bm = np.array([[comb(k, i) / comb(n, i) if i <= k else 0.0 for i in range(n + 1)] for k in range(n + 1)])
+    return np.einsum("ki,mji->mkj", Bm, T)  # (m, K, j): control value k from power coefficient j
+
+
 def _spread(det, N0, N1, d):
     """How much the control values change along each side of each cell, relative to their size, (m, d).
 
@@ -207,7 +211,7 @@ def _spread(det, N0, N1, d):
     return np.stack([np.max(np.abs(X[:, idx ^ (1 << i)] - X), axis=(1, 2)) for i in range(d)], axis=1)
 
 
-def _point_bands(s0, s1, scale, tol: Tolerances):
+def point_bands(s0, s1, scale, tol: Tolerances):
     """Band of each friction point from its rows ``s0 + tau s1 >= 0``: lower, upper, ok (n,)."""
     big = np.max(np.abs(s1), axis=1, keepdims=True)
     flat = np.abs(s1) <= tol.force * big
@@ -220,9 +224,13 @@ def _point_bands(s0, s1, scale, tol: Tolerances):
     return lower, upper, ok
 
 
-def _lower_bounds(det, N0, N1, g_lo, g_hi, tol: Tolerances):
-    """Smallest effort in ``[g_lo, g_hi]`` each cell may admit (inf: none), shape (m,)."""
+def cell_lower_bounds(det, N0, N1, g_lo, g_hi, tol: Tolerances):
+    """Smallest effort in ``[g_lo, g_hi]`` each cell may admit (inf: none), shape (m,).
+
+    ``g_lo, g_hi``: floats, or arrays of shape (m,) (one interval per cell: the batched path).
+    """
     m, _, R = N0.shape
+    g_lo, g_hi = (np.broadcast_to(np.asarray(g, dtype=float), (m,))[:, None] for g in (g_lo, g_hi))
     finite = np.all(np.isfinite(det), axis=1) & np.all(np.isfinite(N0), axis=(1, 2)) & np.all(np.isfinite(N1), axis=(1, 2))
     pos, neg = np.all(det > 0, axis=1), np.all(det < 0, axis=1)
     steady = finite & (pos | neg)
@@ -240,7 +248,7 @@ def _lower_bounds(det, N0, N1, g_lo, g_hi, tol: Tolerances):
         lo_r = start.min(axis=1)  # (m, R)
         up_r = end.max(axis=1)
         whole = np.any(flat & (a >= -e), axis=1) | (up_r >= lo_r)
-        cand = np.concatenate([np.full((m, 1), g_lo), lo_r], axis=1)  # (m, R+1)
+        cand = np.concatenate([g_lo, lo_r], axis=1)  # (m, R+1)
         # a row's half-lines (-inf, up_r] and [lo_r, inf) exist only where finite: with g_lo = -inf
         # the candidate -inf lies in the first only when some control point has a falling row
         below = (cand[:, :, None] <= up_r[:, None, :]) & (up_r[:, None, :] > -np.inf)
@@ -248,31 +256,35 @@ def _lower_bounds(det, N0, N1, g_lo, g_hi, tol: Tolerances):
         inside = whole[:, None, :] | below | above
         valid = np.all(inside, axis=2) & (cand >= g_lo) & (cand <= g_hi)
         steady_lb = np.min(np.where(valid, cand, np.inf), axis=1)
-        # --- det changes sign: rows r, q with N_r > 0 and N_q < 0 on the whole cell exclude the effort
-        a, b = N0, N1
-        flat = np.abs(b) <= tol.force * bscale
-        up_pos = ~flat & (b > 0)
-        dn_pos = ~flat & (b < 0)
-        hi_k = (e - a) / b  # a + tau b > e: tau above it where b > 0, below where b < 0
-        p_lo = np.max(np.where(up_pos, hi_k, -np.inf), axis=1)  # (m, R)
-        p_up = np.min(np.where(dn_pos, hi_k, np.inf), axis=1)
-        p_up = np.where(np.any(flat & (a <= e), axis=1), -np.inf, p_up)
-        lo_k = (-e - a) / b  # a + tau b < -e: tau below it where b > 0, above where b < 0
-        n_lo = np.max(np.where(dn_pos, lo_k, -np.inf), axis=1)
-        n_up = np.min(np.where(up_pos, lo_k, np.inf), axis=1)
-        n_up = np.where(np.any(flat & (a >= -e), axis=1), -np.inf, n_up)
-        E_lo = np.maximum(p_lo[:, :, None], n_lo[:, None, :])  # (m, R, R): Pos_r & Neg_q
-        E_up = np.minimum(p_up[:, :, None], n_up[:, None, :])
-        offdiag = ~np.eye(R, dtype=bool)[None]
-        live = offdiag & (E_lo < E_up)
-        E_lo = np.where(live, E_lo, np.nan).reshape(m, -1)
-        E_up = np.where(live, E_up, np.nan).reshape(m, -1)
-        cand = np.concatenate([np.full((m, 1), g_lo), np.nan_to_num(E_up, nan=np.inf)], axis=1)
-        # an exclusion interval unbounded below excludes the candidate -inf too
-        strictly = ((cand[:, :, None] > E_lo[:, None, :]) | (E_lo[:, None, :] == -np.inf)) & (cand[:, :, None] < E_up[:, None, :])
-        valid = ~np.any(strictly, axis=2) & (cand >= g_lo) & (cand <= g_hi)
-        straddle_lb = np.min(np.where(valid, cand, np.inf), axis=1)
-    out = np.where(steady, steady_lb, np.where(finite, straddle_lb, g_lo))
+        # --- det changes sign: rows r, q with N_r > 0 and N_q < 0 on the whole cell exclude the effort;
+        # only where it does (the other cells take steady_lb): the same values, much less work
+        sub = np.flatnonzero(finite & ~steady)
+        straddle_lb = np.full(m, np.inf)
+        if sub.size:
+            a, b, e, bscale, gl, gh = N0[sub], N1[sub], e[sub], bscale[sub], g_lo[sub], g_hi[sub]
+            flat = np.abs(b) <= tol.force * bscale
+            up_pos = ~flat & (b > 0)
+            dn_pos = ~flat & (b < 0)
+            hi_k = (e - a) / b  # a + tau b > e: tau above it where b > 0, below where b < 0
+            p_lo = np.max(np.where(up_pos, hi_k, -np.inf), axis=1)  # (m, R)
+            p_up = np.min(np.where(dn_pos, hi_k, np.inf), axis=1)
+            p_up = np.where(np.any(flat & (a <= e), axis=1), -np.inf, p_up)
+            lo_k = (-e - a) / b  # a + tau b < -e: tau below it where b > 0, above where b < 0
+            n_lo = np.max(np.where(dn_pos, lo_k, -np.inf), axis=1)
+            n_up = np.min(np.where(up_pos, lo_k, np.inf), axis=1)
+            n_up = np.where(np.any(flat & (a >= -e), axis=1), -np.inf, n_up)
+            E_lo = np.maximum(p_lo[:, :, None], n_lo[:, None, :])  # (m, R, R): Pos_r & Neg_q
+            E_up = np.minimum(p_up[:, :, None], n_up[:, None, :])
+            offdiag = ~np.eye(R, dtype=bool)[None]
+            live = offdiag & (E_lo < E_up)
+            E_lo = np.where(live, E_lo, np.nan).reshape(sub.size, -1)
+            E_up = np.where(live, E_up, np.nan).reshape(sub.size, -1)
+            cand = np.concatenate([gl, np.nan_to_num(E_up, nan=np.inf)], axis=1)
+            # an exclusion interval unbounded below excludes the candidate -inf too
+            strictly = ((cand[:, :, None] > E_lo[:, None, :]) | (E_lo[:, None, :] == -np.inf)) & (cand[:, :, None] < E_up[:, None, :])
+            valid = ~np.any(strictly, axis=2) & (cand >= gl) & (cand <= gh)
+            straddle_lb[sub] = np.min(np.where(valid, cand, np.inf), axis=1)
+    out = np.where(steady, steady_lb, np.where(finite, straddle_lb, g_lo[:, 0]))
     return out, steady
 
 
@@ -300,7 +312,7 @@ def _search(cells: _Cells, lo_, hi_, flip, atol, budget, tol):
         feas = pok & (pl <= pu) & (np.maximum(pl, lo_) <= np.minimum(pu, hi_) + atol)
         if feas.any():
             incumbent = min(incumbent, float(np.min(np.where(feas, np.clip(pl, lo_, hi_), np.inf))))
-        lb, steady = _lower_bounds(det, N0, sign * N1, lo_, hi_, tol)
+        lb, steady = cell_lower_bounds(det, N0, sign * N1, lo_, hi_, tol)
         possible = lb < np.inf  # lb is +inf for a cell where nothing is possible, and may be -inf
         straddling |= bool(np.any(~steady & possible))
         # a cell that cannot beat the incumbent, or the interval's far end, by more than atol is resolved

@@ -31,7 +31,7 @@ from qsplan.mechanics.model.friction import check_mu_range
 from qsplan.mechanics.modes.contact_mode import ContactMode, enumerate_modes
 from qsplan.mechanics.numerics import Status
 
-__all__ = ["TOUCH_RTOL", "RobustBand", "admissible_competitors", "robust_band", "subtract_hull"]
+__all__ = ["TOUCH_RTOL", "RobustBand", "admissible_competitors", "assemble_robust_band", "robust_band", "subtract_hull"]
 
 #: Relative distance (of the band's largest finite edge, or 1 N m) within which a
 #: competitor's possible efforts only touch the desired mode's band: the two modes
@@ -170,7 +170,21 @@ def robust_band(scene, mode, mu_range, *, shared: bool = False, competitors=None
     comps = admissible_competitors([scene], mode) if competitors is None else tuple(competitors)
     guaranteed = guaranteed_band_shared if shared else guaranteed_band_box
     desired = guaranteed(scene, mode, lo, hi, force_margin=force_margin)
-    common = dict(mode=mode.letters, desired=desired, competitors=comps, mu_range=(lo, hi), shared=bool(shared))
+    torques = {}
+    if desired.feasible:
+        g_lo, g_hi = desired.lower + 0.0, desired.upper + 0.0  # + 0.0: no negative zero
+        torques = {c: competitor_torques(scene, c, lo, hi, g_lo, g_hi, shared=shared) for c in comps}
+    return assemble_robust_band(mode, desired, comps, torques, (lo, hi), shared)
+
+
+def assemble_robust_band(mode, desired: Band, comps, torques: dict, mu_range, shared) -> RobustBand:
+    """The :class:`RobustBand` from the desired mode's guaranteed band and each competitor's
+    :class:`CompetitorTorques` inside it (``torques``: competitor letters to their hulls; empty
+    when ``desired`` is infeasible).  The one place :func:`robust_band` and its batched twin
+    (:func:`qsplan.mechanics.bands.batched_robust.robust_bands`) cut the competitors out.
+    """
+    mode = _as_mode(mode)
+    common = dict(mode=mode.letters, desired=desired, competitors=tuple(comps), mu_range=tuple(mu_range), shared=bool(shared))
     if not desired.feasible:
         return RobustBand(lower=np.nan, upper=np.nan, feasible=False, exact=bool(desired.exact), split=False,
                           precluded={}, reason=desired.reason, **common)  # fmt: skip
@@ -179,7 +193,7 @@ def robust_band(scene, mode, mu_range, *, shared: bool = False, competitors=None
     atol = TOUCH_RTOL * max(finite + [1.0])
     exact, notes, hulls = bool(desired.exact), [], {}
     for c in comps:
-        ct: CompetitorTorques = competitor_torques(scene, c, lo, hi, g_lo, g_hi, shared=shared)
+        ct: CompetitorTorques = torques[c]
         if ct.empty:
             status = (ct.reason or "").removeprefix("kinematics: ")
             if status in Status.ILL_CONDITIONED:  # the solver cannot decide this mode either: not precluded

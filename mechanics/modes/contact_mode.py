@@ -22,6 +22,7 @@ from math import comb
 import numpy as np
 
 from qsplan.mechanics.errors import ModeError
+from qsplan.mechanics.modes.counting import count_modes  # eq. (49), numpy-free for `qsplan count`
 
 __all__ = [
     "Letter",
@@ -136,30 +137,6 @@ def mode_from_letters(letters, n_contacts: int | None = None, dof: int | None = 
             f"needs {dof} (eq. 29 with |tau_I| = {dof - 3})"
         )
     return mode
-
-
-def count_modes(n_contacts: int, dof: int) -> int:
-    """Number of contact modes with ``2 n_R + n_S = dof`` (eq. 49).
-
-    Parameters
-    ----------
-    n_contacts : int
-        ``n_c``.
-    dof : int
-        ``3 + |tau_I|``, the number of applicable constraints.
-
-    Returns
-    -------
-    int
-        0 when ``n_c < dof / 2`` (no mode satisfies the utility conditions).
-    """
-    if n_contacts < 0 or dof < 0:
-        raise ModeError(f"count: contacts and dof must be nonnegative; got {n_contacts}, {dof}")
-    return sum(
-        comb(n_contacts, nr) * comb(n_contacts - nr, dof - 2 * nr)
-        for nr in range(dof // 2 + 1)
-        if dof - 2 * nr <= n_contacts - nr
-    )
 
 
 def _iter_sets(n_contacts: int, dof: int):

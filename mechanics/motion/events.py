@@ -12,7 +12,6 @@ from __future__ import annotations
 from dataclasses import dataclass, replace
 
 import numpy as np
-from scipy.optimize import brentq
 
 from qsplan.mechanics.modes.contact_mode import ContactMode
 from qsplan.mechanics.motion.conditions import mode_motion, mode_values
@@ -208,6 +207,8 @@ def integrate_mode(system, x, t, t_final, mode: ContactMode, contacts, mu, xi, l
                 hi, g1, crossed = mid, g_mid, c_mid
             else:
                 lo = mid
+        from scipy.optimize import brentq  # here: importing scipy.optimize costs ~0.5 s, most runs never need it
+
         roots = {}
         for i in crossed:
             if np.isfinite(g1[i]):

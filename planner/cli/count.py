@@ -20,7 +20,7 @@ def add_parser(subparsers):
 
 def run(args, out) -> int:
     from qsplan.mechanics.errors import ModeError
-    from qsplan.mechanics.modes.contact_mode import count_modes
+    from qsplan.mechanics.modes.counting import count_modes
 
     if args.contacts < 0:
         raise ModeError(f"--contacts: expected a nonnegative integer; got {args.contacts}")

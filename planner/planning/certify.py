@@ -17,7 +17,8 @@ the row's joint angles and workpiece pose) and checked
    (the velocity-controlled finger's ``qd``, the torque-controlled finger's ``tau``)
    the all-modes solver (:func:`qsplan.mechanics.solve`, eqs. 13-28) finds the planned
    mode and no other feasible at every vertex of the friction set and at seeded random
-   points in it; no mode's feasibility is left undecided (a mode degenerate only to
+   points in it (the kinematics once per row, the friction vectors in one batch:
+   :mod:`qsplan.planner.planning.certify_modes`); no mode's feasibility is left undecided (a mode degenerate only to
    machine precision is outside the model and is counted, not failed); the torque
    lies inside its exported band; the planned mode's normal forces are at least
    ``force_margin``; it moves the workpiece as the rows do.
@@ -45,11 +46,13 @@ from qsplan.planner.planning.certify_rows import (
     SPEED_RTOL,
     contact_checks,
     friction_points,
+    joint_housings,
     limit_checks,
-    mode_checks,
     overlap_checks,
+    row_bodies,
     step_checks,
 )
+from qsplan.planner.planning.certify_modes import mode_checks
 
 __all__ = ["Violation", "RowVerdict", "Certificate", "certify_plan", "read_plan", "task_from_metadata", "KINDS"]
 
@@ -293,7 +296,7 @@ def _xdot_rows(cols, k) -> float:
 
 
 def certify_plan(plan, task, *, n_random: int = 8, seed: int = 0, force_margin: float = 0.0,
-                 progress=None) -> Certificate:  # fmt: skip
+                 progress=None, batched: bool = True) -> Certificate:  # fmt: skip
     """Check an exported plan row by row against ``task`` (see the module docstring for the checks).
 
     Parameters
@@ -310,6 +313,9 @@ def certify_plan(plan, task, *, n_random: int = 8, seed: int = 0, force_margin: 
         N, nonnegative: the planned mode's normal forces must be at least this.
     progress : callable, optional
         Called with a line of text now and then.
+    batched : bool
+        Solve all friction vectors of a row in one batch (the kinematic stage once); False:
+        the reference, :func:`qsplan.mechanics.solve` once per friction vector.  Same certificate.
 
     Returns
     -------
@@ -329,21 +335,24 @@ def certify_plan(plan, task, *, n_random: int = 8, seed: int = 0, force_margin: 
     cols, _ = read_plan(source)
     rng = np.random.default_rng(seed)
     n = cols["t"].size
+    roots = joint_housings(task.hand)
     verdicts, every = [], []
     for k in range(n):
         t, mode = float(cols["t"][k]), str(cols["mode"][k])
         found = limit_checks(task, cols, k)
+        bodies = None
         if not any(kind == "input" for kind, _ in found):
-            found += overlap_checks(task, cols, k)
+            bodies = row_bodies(task, cols, k, roots)
+            found += overlap_checks(task, cols, k, bodies)
         if k + 1 < n:
             found += step_checks(task, cols, k)
         pts, excluded = 0, ()
         if mode != "free" and not any(kind == "input" for kind, _ in found):
-            contact = contact_checks(task, cols, k)
+            contact = contact_checks(task, cols, k, bodies)
             found += contact
             if not contact:
                 mus = friction_points(task, int(n_random), rng)
-                more, excluded = mode_checks(task, cols, k, mus, force_margin, _xdot_rows(cols, k))
+                more, excluded = mode_checks(task, cols, k, mus, force_margin, _xdot_rows(cols, k), batched)
                 found += more
                 pts = len(mus)
         vs = tuple(Violation(k, t, kind, msg) for kind, msg in found)

@@ -4,16 +4,13 @@ Every function here takes the task, the plan's columns (``{name: ndarray}`` as
 :func:`qsplan.planner.export.plan_files.read_plan_csv` returns them) and a row
 index, and returns ``(kind, message)`` pairs: nothing of the planner's own
 validity checker or band computation is used.  The geometry comes from the
-hand's polygons (:func:`qsplan.hands.hand_polygons`), the mechanics from the
-all-modes solver (:func:`qsplan.mechanics.solve`, eqs. 13-28) on the scene of the
-row (:func:`qsplan.hands.hand_scene`).  Units SI (m, rad, s, N, N m).
+hand's polygons (:func:`qsplan.hands.hand_polygons`); the mechanics of a row (the
+mode check) is in :mod:`qsplan.planner.planning.certify_modes`.  Units SI (m, rad, s, N, N m).
 """
 
 from __future__ import annotations
 
 import numpy as np
-
-from qsplan.mechanics import DEFAULT_TOLERANCES, Tolerances
 
 __all__ = [
     "OVERLAP_DEPTH_TOL",
@@ -22,16 +19,15 @@ __all__ = [
     "LIMIT_TOL",
     "SPEED_RTOL",
     "JUMP_TOL",
-    "MOTION_RTOL",
-    "EXACT_TOLERANCES",
     "row_pose",
     "row_q",
+    "joint_housings",
+    "row_bodies",
     "overlap_checks",
     "contact_checks",
     "limit_checks",
     "step_checks",
     "friction_points",
-    "mode_checks",
 ]
 
 #: Penetration (m) tolerated between two bodies: the depth (the narrowest width) of
@@ -62,22 +58,6 @@ SPEED_RTOL = 1e-6
 #: Jump (rad or m) tolerated between two rows at the same time (a phase switch): rounding.
 JUMP_TOL = 1e-9
 
-#: Relative difference tolerated between the workpiece speed the solver computes from
-#: the exported velocity command and the one the rows' poses show (finite differences of
-#: a straight slide are exact; the command is the closed-form derivative): 1 %.
-MOTION_RTOL = 1e-2
-
-
-#: Tolerances at which a mode that was degenerate at the default ones is tested again.  A
-#: mode still degenerate at these is degenerate to machine precision (e.g. a finger breaking
-#: from a workpiece held by rolling contacts leaves its joint's velocity undetermined):
-#: outside the model (eq. 32, the strict inequalities 11, 15, 16), no competitor.  One that
-#: turns decided at these was only nearly degenerate: its feasibility is not decided at the
-#: default tolerances, and the row is not certified.  1e-15 is the lowest singularity
-#: threshold at which the stability study (``benchmarks/bench_stability.py``) saw no LU failure.
-EXACT_TOLERANCES = Tolerances(singular=1e-15, velocity=1e-13)
-
-
 def row_pose(cols, k) -> np.ndarray:
     """Workpiece ``(x, y, theta)`` of row ``k`` (m, m, rad), shape (3,)."""
     return np.array([cols["x_workpiece"][k], cols["y_workpiece"][k], cols["theta_workpiece"][k]], dtype=float)
@@ -88,15 +68,26 @@ def row_q(cols, k) -> np.ndarray:
     return np.array([cols["q_left"][k], cols["q_right"][k]], dtype=float)
 
 
-def _bodies(task, cols, k) -> dict:
-    from shapely.geometry import Point, Polygon
+def joint_housings(hand) -> dict:
+    """``{"left", "right"}`` -> the disk (shapely) about each finger's joint inside which it may overlap the palm."""
+    from shapely.geometry import Point
+
+    housing = JOINT_HOUSING * hand.finger_width
+    return {side: Point(p).buffer(housing, 64) for side, p in zip(("left", "right"), hand.pivots)}
+
+
+def row_bodies(task, cols, k, roots=None) -> dict:
+    """The bodies of row ``k`` as shapely geometry: ``{"polys": {name: Polygon}, "roots": {side: disk}}``.
+
+    Built once per row and passed to :func:`overlap_checks` and :func:`contact_checks`;
+    ``roots``: :func:`joint_housings` of the task's hand, when already built (they do not move).
+    """
+    from shapely.geometry import Polygon
 
     from qsplan.hands import hand_polygons
 
     polys = {name: Polygon(v) for name, v in hand_polygons(task.hand, row_pose(cols, k), row_q(cols, k)).items()}
-    housing = JOINT_HOUSING * task.hand.finger_width
-    roots = {side: Point(p).buffer(housing, 64) for side, p in zip(("left", "right"), task.hand.pivots)}
-    return {"polys": polys, "roots": roots}
+    return {"polys": polys, "roots": joint_housings(task.hand) if roots is None else roots}
 
 
 def _depth(inter) -> float:
@@ -116,9 +107,12 @@ _PAIRS = (("left", "right"), ("left", "workpiece"), ("right", "workpiece"), ("wo
           ("left", "palm"), ("right", "palm"))  # fmt: skip
 
 
-def overlap_checks(task, cols, k) -> list:
-    """Check 1: no two of left finger, right finger, palm and workpiece overlap deeper than :data:`OVERLAP_DEPTH_TOL`."""
-    b = _bodies(task, cols, k)
+def overlap_checks(task, cols, k, bodies=None) -> list:
+    """Check 1: no two of left finger, right finger, palm and workpiece overlap deeper than :data:`OVERLAP_DEPTH_TOL`.
+
+    ``bodies``: :func:`row_bodies` of the row, when already built.
+    """
+    b = row_bodies(task, cols, k) if bodies is None else bodies
     polys, out = b["polys"], []
     for a, c in _PAIRS:
         A = polys[a].difference(b["roots"][a]) if c == "palm" and a in b["roots"] else polys[a]
@@ -130,11 +124,14 @@ def overlap_checks(task, cols, k) -> list:
     return out
 
 
-def contact_checks(task, cols, k) -> list:
-    """Check 3: every contact of the row's mode is present (palm:0, palm:1, left finger, right finger)."""
+def contact_checks(task, cols, k, bodies=None) -> list:
+    """Check 3: every contact of the row's mode is present (palm:0, palm:1, left finger, right finger).
+
+    ``bodies``: :func:`row_bodies` of the row, when already built.
+    """
     from shapely.geometry import Point
 
-    polys = _bodies(task, cols, k)["polys"]
+    polys = (row_bodies(task, cols, k) if bodies is None else bodies)["polys"]
     mode = str(cols["mode"][k])
     if len(mode) != 4 or set(mode) - set("RSB"):
         return [("contact", f"mode {mode!r}: expected four letters of R, S, B (palm:0, palm:1, left, right)")]
@@ -217,81 +214,3 @@ def friction_points(task, n_random, rng) -> np.ndarray:
         vertices = np.array(np.meshgrid(*[[lo, hi]] * 4, indexing="ij")).reshape(4, -1).T.astype(float)
         draws = rng.uniform(lo, hi, (n_random, 4))
     return np.unique(np.vstack([vertices, draws]), axis=0) if lo == hi else np.vstack([vertices, draws])
-
-
-def _statuses(scene, tol) -> dict:
-    from qsplan.mechanics import enumerate_modes, solve
-
-    res = solve(scene, tol, residuals=False, keep_statuses=True, workers=1, search="all")
-    modes = enumerate_modes(scene.n_contacts, scene.dof)
-    return res, {m.letters: s for m, s in zip(modes, res.statuses)}
-
-
-def _fmt_mu(mu) -> str:
-    return "[" + ", ".join(f"{m:.4g}" for m in mu) + "]"
-
-
-def mode_checks(task, cols, k, mus, force_margin=0.0, xdot_rows=np.nan) -> tuple:
-    """Check 4: with the row's commands the planned mode is the only feasible one at every friction vector.
-
-    Parameters
-    ----------
-    mus : ndarray, shape (m, 4)
-        Friction vectors (palm:0, palm:1, left, right).
-    force_margin : float
-        N: the planned mode's normal forces must be at least this at every contact.
-    xdot_rows : float
-        The workpiece's ``x`` velocity (m/s) the rows show (finite difference); nan: not checked.
-
-    Returns
-    -------
-    (list of (kind, message), tuple of str)
-        The failures (at most one per kind: the first friction vector that shows it) and
-        the modes set aside as degenerate to machine precision (outside the model).
-    """
-    from qsplan.hands import hand_scene
-    from qsplan.mechanics import QsplanError, Status
-
-    mode, e = str(cols["mode"][k]), str(cols["effort_joint"][k])
-    v = "right" if e == "left" else "left"
-    try:
-        scene = hand_scene(task.hand, row_pose(cols, k), row_q(cols, k), e, velocity=float(cols[f"qd_{v}"][k]),
-                           effort=float(cols[f"tau_{e}"][k]))  # fmt: skip
-    except QsplanError as exc:
-        return [("contact", f"the row's scene cannot be built: {exc}")], ()
-    found, excluded = {}, set()
-    exact_cache = {}
-    for mu in mus:
-        res, status = _statuses(scene.with_mu(mu), DEFAULT_TOLERANCES)
-        others = [m for m in res.feasible_modes if m != mode]
-        if others and "mode" not in found:
-            found["mode"] = f"competitor {'/'.join(others)} feasible at mu = {_fmt_mu(mu)} (planned {mode})"
-        if mode not in res.feasible_modes and "planned" not in found:
-            found["planned"] = f"planned mode {mode} not feasible at mu = {_fmt_mu(mu)} ({status.get(mode, 'not tested')})"
-        degenerate = [m for m, s in status.items() if s in Status.DEGENERATE]
-        if degenerate:
-            key = tuple(mu) if Status.EQUILIBRIUM_SINGULAR in {status[m] for m in degenerate} else "kinematic"
-            if key not in exact_cache:
-                exact_cache[key] = _statuses(scene.with_mu(mu), EXACT_TOLERANCES)[1]
-            tight = exact_cache[key]
-            for m in degenerate:
-                if tight[m] in Status.DEGENERATE:
-                    excluded.add(m)
-                elif "undecided" not in found:
-                    found["undecided"] = (f"mode {m} is nearly degenerate ({status[m].replace('_', ' ')}) at "
-                                          f"mu = {_fmt_mu(mu)}: its feasibility is not decided "
-                                          f"({tight[m].replace('_', ' ')} at machine precision)")  # fmt: skip
-        sol = res.solution(mode)
-        if sol is None:
-            continue
-        if force_margin > 0 and sol.c_n.min() < force_margin and "force margin" not in found:
-            i = int(np.argmin(sol.c_n))
-            found["force margin"] = (f"normal force {sol.c_n[i]:.4g} N at contact {i} below the margin "
-                                     f"{force_margin:g} N at mu = {_fmt_mu(mu)}")  # fmt: skip
-        xdot = sol.qdot[0] - sol.qdot[2] * float(cols["y_workpiece"][k])  # qdot is the world origin's velocity
-        if np.isfinite(xdot_rows) and "motion" not in found:
-            if np.sign(xdot) != np.sign(xdot_rows) or abs(xdot - xdot_rows) > MOTION_RTOL * abs(xdot_rows):
-                found["motion"] = (f"the commands move the workpiece at {xdot * 1e3:.4g} mm/s at mu = {_fmt_mu(mu)}; "
-                                   f"the rows show {xdot_rows * 1e3:.4g} mm/s")  # fmt: skip
-    kinds = {"planned": "mode", "mode": "mode"}
-    return [(kinds.get(kind, kind), msg) for kind, msg in found.items()], tuple(sorted(excluded))

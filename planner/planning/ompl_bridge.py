@@ -29,11 +29,12 @@ from __future__ import annotations
 
 import time
 from dataclasses import dataclass, field
-from typing import Callable
+from typing import TYPE_CHECKING, Callable
 
-import numpy as np
+from qsplan.mechanics.errors import QsplanError
 
-from qsplan.mechanics import QsplanError
+if TYPE_CHECKING:  # numpy loads in plan_path, so that the CLI's parser (PLANNERS) stays light
+    import numpy as np
 
 __all__ = ["PlannerOptions", "PlanResult", "plan_path", "PLANNERS", "TIMED_PLANNERS", "ompl_available"]
 
@@ -119,11 +120,12 @@ class PlanResult:
     exact : bool
         The path reaches the goal (OMPL's EXACT_SOLUTION).
     status : str
-        OMPL's status text.
+        OMPL's status text (``"dense sweep: ..."`` for an in-contact segment, naming the first invalid state).
     validity_checks : int
-        Calls of the validity predicate.
+        Calls of the validity predicate (for an in-contact segment's dense sweep, which makes this record
+        without OMPL: the samples judged).
     seconds : float
-        Wall-clock planning time.
+        Wall-clock planning time (the dense sweep's time).
     """
 
     path: np.ndarray
@@ -187,6 +189,8 @@ def plan_path(
         On malformed bounds or a start/goal outside them or invalid, or a ``state_cost`` with a planner
         of :data:`TIMED_PLANNERS`.
     """
+    import numpy as np
+
     try:
         from ompl import base as ob
         from ompl import geometric as og

@@ -192,8 +192,8 @@ def _verify(plan, csv_path, n, seed, progress) -> list:
 
     mus = friction_samples(plan.task.mu_range, n, seed, shared=plan.task.shared_mu)
     columns = read_plan_csv(csv_path)
-    out = []
+    out, scenes = [], {}  # the scenes along the plan do not depend on friction: built once for all replays
     for mu in mus:
         progress(f"re-simulating the exported plan at mu = {[round(float(m), 4) for m in mu]}")
-        out.append(replay_plan(columns, plan.task.hand, mu))
+        out.append(replay_plan(columns, plan.task.hand, mu, scenes=scenes))
     return out

@@ -1,31 +1,31 @@
-"""Two-finger manipulation plans through OMPL with guaranteed torque bands (Section 5.2, Figs. 9-13).
+"""Two-finger manipulation plans with guaranteed torque bands, regrasps through OMPL (Section 5.2, Figs. 9-13).
 
 :func:`plan_task` turns a :class:`qsplan.planner.planning.task.Task` into a :class:`Plan`:
 
 1. **In-contact segments.**  Segment ``i`` slides the workpiece along the palm from
    the previous waypoint to the next in mode 4S (``"SSSS"``); its configuration
-   variable is the workpiece's ``x`` (the fingers follow by tangency,
-   :func:`qsplan.hands.two_finger.finger_angles`).  OMPL (:func:`qsplan.planner.planning.ompl_bridge.plan_path`)
-   plans over ``x`` with the validity checker of :func:`check_contact_state`: no
-   two bodies overlapping (every pair of fingers, palm and workpiece:
-   :mod:`qsplan.planner.planning.collision`), the same four contacts as at the segment's start and the
-   4S kinematics possible (eqs. 24-25), joints inside their limits, and a
-   guaranteed band (desired mode feasible for the whole friction set, every
-   competing mode precluded: :func:`qsplan.planner.torque.pointwise.guaranteed_sweep`) at least
-   ``torque_resolution`` wide.  Edges are checked every ``validity_resolution`` of
-   the range.  With an optimizing planner, ``state_cost = 1 / margin`` prefers wide
-   bands.  The effort-controlled finger is derived: among the joint sets the
-   control-mode partitioner admits for 4S (eq. 32), the one whose narrowest band
-   along the straight line is widest.
+   variable is the workpiece's ``x`` alone (the fingers follow by tangency,
+   :func:`qsplan.hands.two_finger.finger_angles`), so the only path is the straight line
+   and there is nothing to search: no OMPL here.  The line is swept every
+   :data:`SWEEP_STEP` and every sample judged once with the validity conditions of
+   :func:`check_contact_state`: no two bodies overlapping (every pair of fingers, palm
+   and workpiece: :mod:`qsplan.planner.planning.collision`), the same four contacts as at
+   the segment's start and the 4S kinematics possible (eqs. 24-25), joints inside their
+   limits, and a guaranteed band (desired mode feasible for the whole friction set, every
+   competing mode precluded: :func:`qsplan.planner.torque.pointwise.guaranteed_sweep`) at
+   least ``torque_resolution`` wide; the first invalid sample ends the segment with a
+   :class:`qsplan.planner.planning.failure.FailureReport`.  The effort-controlled finger is
+   derived: among the joint sets the control-mode partitioner admits for 4S (eq. 32), the
+   one whose narrowest band along the straight line is widest.
 2. **Regrasps.**  Between segments both fingers open by :data:`REGRASP_OPENING` and
-   close again on the workpiece, planned by OMPL in joint space, collision-free
+   close again on the workpiece, planned by OMPL in joint space (two variables: the search that
+   ``--planner`` and ``--time-limit`` choose), collision-free
    (:func:`check_free_state`: the fingers clear the workpiece, the palm and each
    other; the straight lines between OMPL's states checked again every :data:`SWEEP_STEP`
    at the fingertips).  Assumed: the workpiece rests on the palm meanwhile (its centre of
    mass lies over its bottom edge, checked by :func:`qsplan.planner.planning.task.make_task`) and
    a quasistatic release leaves it where it is.
-3. **From path to plan.**  Each segment's path is swept every :data:`SWEEP_STEP` (every
-   sample checked again for overlaps, limits and contact changes),
+3. **From path to plan.**  Each segment's dense sweep is
    time-parameterized at the largest constant speed within the workpiece and joint
    speed limits, and each command is chosen in the guaranteed band with the largest
    margin that can be kept along the whole segment: half its narrowest band, from
@@ -83,6 +83,7 @@ __all__ = [
     "check_free_state",
     "contact_samples",
     "plan_task",
+    "sweep_contact_segment",
 ]
 
 
@@ -93,8 +94,8 @@ REGRASP_OPENING = 0.1
 #: Distance (m) between the samples of the dense band sweep of a segment (0.5 mm: 80 per 4 cm).
 SWEEP_STEP = 5e-4
 
-#: RRTConnect, deterministic, seed 1; edges checked every 2 % of the range (0.8 mm over a 4 cm
-#: segment, below the 0.5 mm dense sweep that follows only by a factor 1.6: the sweep is the guarantee).
+#: The regrasps' OMPL queries (in-contact segments need no search): RRTConnect, deterministic, seed 1;
+#: edges checked every 2 % of the joint box, then the exported lines every SWEEP_STEP at the fingertips.
 #: The iteration budget decides (same inputs, same plan); the time limit per OMPL query (s) is a
 #: safety net well above the few seconds a query takes, so a loaded machine does not change the answer.
 DEFAULT_OPTIONS = PlannerOptions(validity_resolution=0.02, iterations=2_000, time_limit=120.0)
@@ -180,16 +181,80 @@ def _densify_rows(path, step):
     return np.vstack(out)
 
 
+def _straight_path(x0, x1):
+    """The segment's path: the straight line ``[x0, x1]`` (shape (2, 1)), computed as OMPL's straight line was."""
+    start, goal = np.array([x0], float), np.array([x1], float)
+    return start + np.linspace(0.0, 1.0, 2)[:, None] * (goal - start)
+
+
+def sweep_contact_segment(task, name, x, effort, direction, touching, comps):
+    """Judge every sample of an in-contact segment once, with the validity conditions of
+    :func:`check_contact_state` (the same contacts, no overlap, joint limits, 4S kinematics, a guaranteed band
+    at least ``task.torque_resolution`` wide), the band batched over the samples as the plan needs it anyway.
+
+    Parameters
+    ----------
+    task : Task
+    name : str
+        The segment's name (for messages).
+    x : ndarray, shape (n,)
+        Workpiece x of the samples (m), in the order of motion.
+    effort : str
+        The effort-controlled finger, ``"left"`` or ``"right"``.
+    direction : float
+        Sign of the workpiece's velocity.
+    touching : ndarray, shape (2,)
+        The workpiece vertices the fingertips touch at the segment's start (a change is invalid).
+    comps : tuple of str
+        The competing modes to preclude (:func:`qsplan.planner.torque.sweep.competing_modes`).
+
+    Returns
+    -------
+    k : int or None
+        Index of the first invalid sample (the first ``k`` where :func:`check_contact_state` is not ok), or None.
+    samples : qsplan.hands.segments.SegmentSamples or None
+        When every sample is valid: the samples moving at ``speed``.
+    band : qsplan.mechanics.bands.effort.Band or None
+        Their guaranteed band (N m), competitors precluded.
+    speed : float or None
+        Workpiece speed (m/s): the fastest within the workpiece and joint speed limits.
+    """
+    from qsplan.mechanics.bands.effort import band_kinematics
+    from qsplan.mechanics.modes.contact_mode import ContactMode
+
+    from qsplan.planner.torque.pointwise import guaranteed_sweep
+
+    try:
+        S = contact_samples(task, x, effort, direction)
+    except QsplanError:  # no grasp somewhere: the first sample without one
+        k = next((k for k, xk in enumerate(x) if not check_contact_state(task, xk, effort, direction, touching, comps).ok), 0)
+        return k, None, None, None
+    rate = np.max(np.abs(S.qd))
+    speed = min(task.workpiece_speed, task.joint_speed / rate) if rate > 0 else task.workpiece_speed
+    S = contact_samples(task, x, effort, direction * speed, name)
+    mode = ContactMode(MODE)
+    for k in range(len(x)):
+        if (np.any(S.touching[k] != touching) or configuration_problem(task, S.pose[k], S.q[k])
+                or not band_kinematics(S.scenes[k], mode).ok):  # fmt: skip
+            return k, None, None, None
+    band = guaranteed_sweep(S, task.mu_range, task.shared_mu, MODE, comps, force_margin=task.force_margin).band
+    bad = ~np.asarray(band.feasible) | (band.upper - band.lower < task.torque_resolution)
+    if bad.any():
+        return int(np.argmax(bad)), None, None, None
+    return None, S, band, float(speed)
+
+
 def _segment(task, i, x0, x1, t0, options, progress, counters):
     from qsplan.hands.two_finger import finger_angles
-    from qsplan.planner.torque.pointwise import guaranteed_sweep
+    from qsplan.planner.planning.ompl_bridge import PlanResult
     from qsplan.planner.torque.sweep import competing_modes
     from qsplan.planner.torque.command import choose_command, default_safety_margin
 
     name = _segment_name(i, x0, x1)
     direction = float(np.sign(x1 - x0))
     effort = _effort_joint(task, x0, x1, progress)
-    progress(f"{name}: effort-controlled finger {effort}; planning with OMPL {options.planner}")
+    progress(f"{name}: effort-controlled finger {effort}; one configuration variable: checking the straight line "
+             f"every {SWEEP_STEP * 1e3:g} mm (no search)")  # fmt: skip
     try:
         line = contact_samples(task, np.linspace(x0, x1, 9), effort, direction * task.workpiece_speed)
     except QsplanError as exc:
@@ -197,61 +262,34 @@ def _segment(task, i, x0, x1, t0, options, progress, counters):
                                                f"no four-contact grasp: {exc}")) from None  # fmt: skip
     comps = competing_modes(line)
     touching = line.touching[0]
-
-    memo = {}  # OMPL's simplifier re-checks the same interpolated states along an edge many times
-
-    def judge(x):
-        c = memo.get(x)
-        if c is None:
-            c = memo[x] = check_contact_state(task, x, effort, direction, touching, comps)
-        return c
-
-    def valid(s):
-        return judge(float(s[0])).ok
-
-    def cost(s):
-        c = judge(float(s[0]))
-        m = 0.5 * c.width if np.isfinite(c.width) else 1.0
-        return 1.0 / max(m, 1e-9)
-
     for x_end, where in ((x0, "the start of the segment"), (x1, "its goal")):
-        c = judge(x_end)  # a start or goal refused for its geometry is named here; for its band, by failure_report
-        if not c.ok and not c.reason.startswith(("band", "no guaranteed band")):
+        c = check_contact_state(task, x_end, effort, direction, touching, comps)
+        if c.ok:
+            continue
+        if not c.reason.startswith(("band", "no guaranteed band")):  # refused for its geometry: named here
             try:
                 q_end = finger_angles(task.hand, task.pose(x_end))[0]
             except QsplanError:
                 q_end = None
             raise PlanFailure(configuration_report(task, name, where, x_end, q_end, c.reason))
-    pad = max(0.05 * abs(x1 - x0), 1e-3)
-    low, high = [min(x0, x1) - pad], [max(x0, x1) + pad]
-    optimizing = options.planner in ("RRTstar", "BITstar")
-    try:
-        res = plan_path(low, high, [x0], [x1], valid, options, state_cost=cost if optimizing else None)
-    except QsplanError:
-        res = None
-    if res is not None:
-        counters[0] += res.validity_checks
-        counters[1] += res.seconds
-    if res is None or not res.exact:
+        raise PlanFailure(failure_report(task, name, x0, x1, effort, direction, comps, None))  # for its band
+    # the configuration is the workpiece's x alone (the fingers follow by tangency): the only path is the
+    # straight line, and its dense sweep is the whole check (where OMPL used to return this line after ~100
+    # checks at 0.8 mm, followed by this sweep)
+    path = _straight_path(x0, x1)
+    x = _densify(path[:, 0], SWEEP_STEP)
+    t_check = time.perf_counter()
+    k, S, band, speed = sweep_contact_segment(task, name, x, effort, direction, touching, comps)
+    seconds = time.perf_counter() - t_check
+    counters[0] += len(x) if k is None else k + 1
+    counters[1] += seconds
+    if k is not None:
+        why = check_contact_state(task, x[k], effort, direction, touching, comps).reason or "band narrower than the resolution"
+        status = f"dense sweep: state {k + 1} of {len(x)} invalid, at x = {x[k]:.4g} m: {why}"
+        res = PlanResult(path[:k + 1], False, status, k + 1, seconds, options)
         raise PlanFailure(failure_report(task, name, x0, x1, effort, direction, comps, res))
-    progress(f"  OMPL: {res.status}, {len(res.path)} states, {res.validity_checks} validity checks in {res.seconds:.2f} s")
-    x = _densify(res.path[:, 0], SWEEP_STEP)
-    # the fastest constant speed within the workpiece and joint speed limits
-    S = contact_samples(task, x, effort, direction)
-    rate = np.max(np.abs(S.qd))
-    speed = min(task.workpiece_speed, task.joint_speed / rate) if rate > 0 else task.workpiece_speed
-    S = contact_samples(task, x, effort, direction * speed, name)
-    progress(f"  checking {len(x)} configurations every {SWEEP_STEP * 1e3:g} mm for overlaps and limits")
-    for k in range(len(x)):  # OMPL checked its states and edges at validity_resolution; the plan's rows are these
-        moved = np.any(S.touching[k] != touching)
-        if moved or configuration_problem(task, S.pose[k], S.q[k]):
-            reason = "a finger moves to another workpiece vertex (a contact change)" if moved else None
-            raise PlanFailure(configuration_report(task, name, f"x = {x[k]:.4g} m on the path between OMPL's states",
-                                                   x[k], S.q[k], reason, res.status))  # fmt: skip
-    progress(f"  sweeping {len(x)} configurations for the guaranteed band")
-    band = guaranteed_sweep(S, task.mu_range, task.shared_mu, MODE, comps, force_margin=task.force_margin).band
-    if not band.feasible.all() or np.nanmin(band.width) < task.torque_resolution:
-        raise PlanFailure(failure_report(task, name, x0, x1, effort, direction, comps, res, xs=x))
+    res = PlanResult(path, True, f"dense sweep: all {len(x)} states valid", len(x), seconds, options)
+    progress(f"  {res.status} (overlaps, limits, contacts, 4S kinematics, guaranteed band) in {seconds:.2f} s")
     try:
         safety = default_safety_margin(band)
     except NoAnswerError:  # unbounded everywhere: keep the controller's resolution from the finite edge
@@ -261,8 +299,8 @@ def _segment(task, i, x0, x1, t0, options, progress, counters):
     v = 1 - (0 if effort == "left" else 1)
     qd = S.qd.copy()
     qd[:, 1 - v] = np.nan  # the effort-controlled joint gets no velocity command
-    return ContactSegmentPlan(name, effort, MODE, res.path[:, 0].copy(), t0 + s / speed, x, S.q.copy(), qd,
-                              band.lower.copy(), band.upper.copy(), command, margin, comps, float(speed), res)  # fmt: skip
+    return ContactSegmentPlan(name, effort, MODE, path[:, 0].copy(), t0 + s / speed, x, S.q.copy(), qd,
+                              band.lower.copy(), band.upper.copy(), command, margin, comps, speed, res)  # fmt: skip
 
 
 def _regrasp(task, i, x, q, t0, options, progress, counters):
@@ -276,6 +314,8 @@ def _regrasp(task, i, x, q, t0, options, progress, counters):
         res = plan_path(lim[:, 0], lim[:, 1], a, b, lambda s: check_free_state(task, x, s), options)
         counters[0] += res.validity_checks
         counters[1] += res.seconds
+        progress(f"  OMPL: {what} of the fingers: {res.status}, {len(res.path)} states, "
+                 f"{res.validity_checks} validity checks in {res.seconds:.2f} s")  # fmt: skip
         if not res.exact:
             raise PlanFailure(configuration_report(task, name, f"{what} of the fingers", x, b,
                                                    f"OMPL found no collision-free finger motion ({res.status})",

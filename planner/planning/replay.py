@@ -23,7 +23,7 @@ segment starts from the simulated end of the previous one: errors carry over.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -35,6 +35,10 @@ __all__ = ["ReplaySystem", "SegmentReplay", "Replay", "replay_plan", "replay_seg
 #: 0.5 mm of workpiece travel at the default 1 cm/s, the spacing of the plan's rows (its band sweep),
 #: so each step spans about one row of the linearly interpolated commands.
 REPLAY_STEP = 0.05
+
+
+#: Scenes a replay keeps (:attr:`ReplaySystem.scenes`), a few kB each: ~40 MB at most.
+MAX_CACHED_SCENES = 10_000
 
 
 def _default_options():
@@ -67,6 +71,12 @@ class ReplaySystem:
         Command rows: time (s), the velocity-controlled joint's speed (rad/s), the effort (N m).
     friction : qsplan.mechanics.motion.system.Friction
         Of the four potential contacts (palm, palm, left finger, right finger).
+    scenes : dict
+        Scenes already built, by the state's bytes (a scene depends on the state alone): the
+        integrator asks again for the scene at the end of every step (its event functions, then
+        the next step's first stage), and replays of one segment at other friction vectors pass
+        through the same states when the mode's motion does not depend on friction (eqs. 23-25).
+        Cleared past :data:`MAX_CACHED_SCENES`.
     """
 
     hand: object
@@ -75,6 +85,7 @@ class ReplaySystem:
     velocity: np.ndarray
     effort: np.ndarray
     friction: object
+    scenes: dict = field(default_factory=dict, repr=False)
 
     state_names = ("x (m)", "y (m)", "theta (rad)", "q_left (rad)", "q_right (rad)", "t (s)")
     contact_names = ("palm:0", "palm:1", "left", "right")
@@ -88,8 +99,15 @@ class ReplaySystem:
 
         if tuple(contacts) != (0, 1, 2, 3):
             raise QsplanError(f"contacts: the replay keeps all four contacts; got {tuple(contacts)}")
-        velocity, effort = self.commands(x[5])
-        return hand_scene(self.hand, x[:3], x[3:5], self.effort_joint, velocity=velocity, effort=effort)
+        key = np.asarray(x, dtype=float).tobytes()
+        scene = self.scenes.get(key)
+        if scene is None:
+            velocity, effort = self.commands(x[5])
+            scene = hand_scene(self.hand, x[:3], x[3:5], self.effort_joint, velocity=velocity, effort=effort)
+            if len(self.scenes) >= MAX_CACHED_SCENES:
+                self.scenes.clear()
+            self.scenes[key] = scene
+        return scene
 
     def rates(self, x, qdot, thetadot) -> np.ndarray:
         from qsplan.mechanics.motion.system import pose_rate
@@ -216,7 +234,7 @@ def replay_segments(columns) -> list:
     return out
 
 
-def replay_plan(columns, hand, mu, options=None) -> Replay:
+def replay_plan(columns, hand, mu, options=None, scenes=None) -> Replay:
     """Re-simulate every in-contact segment of an exported plan at the friction vector ``mu``.
 
     Parameters
@@ -229,6 +247,9 @@ def replay_plan(columns, hand, mu, options=None) -> Replay:
         Friction of the contacts palm:0, palm:1, left, right (static = kinetic).
     options : qsplan.mechanics.motion.simulator.MotionOptions, optional
         Default ``max_step`` :data:`REPLAY_STEP` and ``max_switches = 0`` (stop at the first mode change).
+    scenes : dict, optional
+        A cache of the scenes built, to pass again to the replays of the same ``columns`` and
+        ``hand`` at other friction vectors (the scenes do not depend on friction); same results.
 
     Returns
     -------
@@ -243,13 +264,15 @@ def replay_plan(columns, hand, mu, options=None) -> Replay:
     if np.any(~np.isfinite(mu)) or np.any(mu < 0):
         raise QsplanError(f"mu: expected four nonnegative friction coefficients; got {mu.tolist()}")
     friction = make_friction(mu, mu)
+    scenes = {} if scenes is None else scenes
     out, x_prev = [], None
     for seg in replay_segments(columns):
         rows, e = seg["rows"], seg["effort_joint"]
         v = "left" if e == "right" else "right"
         t = np.asarray(columns["t"], float)[rows]
         system = ReplaySystem(hand, e, t, np.asarray(columns[f"qd_{v}"], float)[rows],
-                              np.asarray(columns[f"tau_{e}"], float)[rows], friction)  # fmt: skip
+                              np.asarray(columns[f"tau_{e}"], float)[rows], friction,
+                              scenes.setdefault(seg["phase"], {}))  # fmt: skip
         k = rows[0]
         pose = np.array([columns["x_workpiece"][k], columns["y_workpiece"][k], columns["theta_workpiece"][k]], float)
         if x_prev is not None:

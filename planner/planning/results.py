@@ -75,7 +75,7 @@ class ContactSegmentPlan:
         The torque-controlled finger; the other is velocity-controlled.
     mode : str
     x_path : ndarray, shape (m,)
-        OMPL's path of the workpiece's x (m).
+        The path of the workpiece's x (m): the straight line, start and goal.
     t, x : ndarray, shape (n,)
         Dense samples: time from the plan's start (s) and workpiece x (m).
     q, qd : ndarray, shape (n, 2)
@@ -87,6 +87,7 @@ class ContactSegmentPlan:
     speed : float
         Workpiece speed (m/s).
     planning : qsplan.planner.planning.ompl_bridge.PlanResult
+        The dense sweep's outcome (no OMPL query: the path is the straight line).
     """
 
     name: str
@@ -146,9 +147,11 @@ class Plan:
     seconds : float
         Wall-clock planning time (s), OMPL and sweeps.
     validity_checks : int
-        Validity-checker calls by OMPL.
+        States judged: the in-contact segments' dense-sweep samples (each once) plus OMPL's
+        validity-checker calls on the regrasps.
     ompl_seconds : float
-        Time inside OMPL (s).
+        Time judging them (s): the in-contact dense sweeps (scenes, overlaps, guaranteed bands)
+        plus the regrasps' OMPL queries; ``checks_per_second`` is their ratio.
     """
 
     task: Task

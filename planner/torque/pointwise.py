@@ -6,7 +6,8 @@ its single effort-controlled joint:
 * :func:`point_band_sweep` - the band of one mode at one friction (Figs. 10-12);
 * :func:`guaranteed_sweep` - the band that keeps the desired mode feasible for
   every friction in an uncertainty set and precludes every competing mode there
-  (Fig. 13), exact: :func:`qsplan.mechanics.robust_band` at every sample;
+  (Fig. 13), exact: :func:`qsplan.mechanics.robust_band` at every sample (computed for all samples
+  at once by :func:`qsplan.mechanics.bands.batched_robust.robust_bands`, bit-identical);
 * :func:`sampled_guaranteed_sweep` - the paper's method: at each listed friction
   value the desired mode's band minus the competitors' bands, intersected over
   the list.
@@ -22,11 +23,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from qsplan.mechanics.bands.effort import effort_band, effort_bands
-from qsplan.mechanics.bands.robust import TOUCH_RTOL, admissible_competitors, robust_band, subtract_hull
+from qsplan.mechanics.bands.batched import effort_bands_batch, map_batches, point_bands_batch
+from qsplan.mechanics.bands.batched_robust import admissible_competitors_batch, robust_bands
+from qsplan.mechanics.bands.robust import TOUCH_RTOL, subtract_hull
 from qsplan.mechanics.errors import QsplanError
 from qsplan.mechanics.model.friction import check_mu_range
-from qsplan.mechanics.modes.contact_mode import ContactMode
+from qsplan.mechanics.modes.contact_mode import ContactMode, enumerate_modes
 
 __all__ = [
     "DEFAULT_MU_RANGE",
@@ -159,6 +161,13 @@ def _mode(samples, mode) -> ContactMode:
     return ContactMode(letters)
 
 
+def admissible_competitors(scenes, mode) -> tuple:
+    """:func:`qsplan.mechanics.bands.robust.admissible_competitors`, batched over the scenes."""
+    found = set().union(*map_batches(scenes, lambda batch: [admissible_competitors_batch(batch, mode)[1]] * batch.size))
+    scene0 = scenes[0]
+    return tuple(m.letters for m in enumerate_modes(scene0.n_contacts, scene0.dof) if m.letters in found and m.letters != mode.letters)
+
+
 def _sweep(label, mode, samples, bands, method) -> BandSweep:
     feas = np.array([b.feasible for b in bands])
     lower = np.array([b.lower + 0.0 if b.feasible else np.nan for b in bands])  # + 0.0: no negative zero
@@ -184,7 +193,7 @@ def point_band_sweep(samples, mu, mode=None, label=None) -> BandSweep:
     mu_arr = np.broadcast_to(np.asarray(mu, dtype=float), (samples.scenes[0].n_contacts,))
     if not np.all(np.isfinite(mu_arr)) or np.any(mu_arr < 0):
         raise QsplanError(f"mu: expected nonnegative finite coefficients; got {mu!r}")
-    bands = [effort_band(s, mode, mu_arr) for s in samples.scenes]
+    bands = map_batches(samples.scenes, lambda batch: point_bands_batch(batch, mode, mu_arr))  # effort_band at every sample
     if label is None:
         where = f"{mu_arr[0]:g}" if np.ptp(mu_arr) == 0 else str(mu_arr.tolist())
         label = f"{mode.name}, mu = {where}"
@@ -219,8 +228,8 @@ def guaranteed_sweep(samples, mu_range=DEFAULT_MU_RANGE, shared=False, mode=None
     lo, hi = check_mu_range(*mu_range)
     mode = _mode(samples, mode)
     comps = admissible_competitors(samples.scenes, mode) if competitors is None else tuple(competitors)
-    robust = [robust_band(s, mode, (lo, hi), shared=shared, competitors=comps, force_margin=force_margin)
-              for s in samples.scenes]  # fmt: skip
+    # robust_band at every sample, batched over the samples (bit-identical: tests/mechanics/test_bands_batched.py)
+    robust = robust_bands(samples.scenes, mode, (lo, hi), shared=shared, competitors=comps, force_margin=force_margin)
     desired = [r.desired for r in robust]
     method = desired[0].method
     where = f"mu in [{lo:g}, {hi:g}]" + (" (shared)" if shared else " (each contact)")
@@ -262,10 +271,13 @@ def sampled_guaranteed_sweep(samples, mu_values, mode=None, competitors=None, *,
         raise QsplanError(f"mu samples: expected nonnegative finite values, shape (m,) or (m, {n_c}); got shape {mus.shape}")
     n = len(samples)
     lower, upper, feas = np.full(n, -np.inf), np.full(n, np.inf), np.ones(n, dtype=bool)
-    for k, scene in enumerate(samples.scenes):
-        l, u, ok = effort_bands(scene, mode, mus, force_margin=force_margin)
+    # effort_bands of the mode and of every competitor at every sample, batched over the samples
+    des = map_batches(samples.scenes, lambda b: list(zip(*effort_bands_batch(b, mode, mus, force_margin=force_margin))))
+    com = {c: map_batches(samples.scenes, lambda b, c=c: list(zip(*effort_bands_batch(b, c, mus)))) for c in comps}
+    for k in range(n):
+        l, u, ok = (a.copy() for a in des[k])
         for c in comps:
-            cl, cu, cok = effort_bands(scene, c, mus)
+            cl, cu, cok = com[c][k]
             for j in np.flatnonzero(ok & cok):  # at each friction sample: the mode's band minus the competitor's
                 l[j], u[j], _ = subtract_hull(l[j], u[j], cl[j], cu[j], 0.0)
         ok &= ~np.isnan(l)

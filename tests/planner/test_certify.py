@@ -195,3 +195,89 @@ def test_pentagon_task_is_certified_or_refused(tmp_path):
     export_plan(plan, tmp_path)
     cert = certify_plan(tmp_path, task, n_random=0)
     assert cert.ok, cert.summary() + "\n" + "\n".join(map(str, cert.violations[:5]))
+
+
+def _same_certificates(a, b):
+    """Two certificates of one plan agree row by row (verdicts, violations, excluded modes); times aside."""
+    assert a.rows == b.rows and a.violations == b.violations and a.counts == b.counts and a.ok == b.ok
+    assert a.to_dict()["excluded_degenerate_modes"] == b.to_dict()["excluded_degenerate_modes"]
+
+
+def _flip_velocity(rows):  # the velocity-controlled finger driven backwards: the workpiece moves the other way
+    for k in range(_contact_row(rows, 0), _contact_row(rows, 6)):
+        v = "right" if rows[k]["effort_joint"] == "left" else "left"
+        rows[k][f"qd_{v}"] = repr(-float(rows[k][f"qd_{v}"]))
+
+
+def _torque_far_outside(rows):  # a torque far beyond its band: another mode wins, or the planned one fails
+    for k in range(_contact_row(rows, 0), _contact_row(rows, 4)):
+        e = rows[k]["effort_joint"]
+        rows[k][f"tau_{e}"] = repr(float(rows[k][f"tau_{e}"]) * 4.0 + 1.0)
+
+
+def _stop_velocity(rows):  # no driving speed: every mode degenerate (zero speeds), all set aside
+    for k in range(_contact_row(rows, 0), _contact_row(rows, 3)):
+        rows[k][f"qd_{'right' if rows[k]['effort_joint'] == 'left' else 'left'}"] = "0.0"
+
+
+def _torque_zero(rows):
+    for k in range(_contact_row(rows, 2), _contact_row(rows, 5)):
+        rows[k][f"tau_{rows[k]['effort_joint']}"] = "0.0"
+
+
+@pytest.mark.ompl
+@pytest.mark.parametrize("edit, kw, kinds", [
+    (None, {"n_random": 3, "seed": 5}, set()),
+    (None, {"n_random": 0, "force_margin": 50.0}, {"force margin"}),
+    (_flip_velocity, {"n_random": 2}, {"motion"}),
+    (_torque_far_outside, {"n_random": 2}, {"torque", "mode"}),
+    (_torque_zero, {"n_random": 1}, {"torque"}),
+    (_stop_velocity, {"n_random": 1}, {"mode"}),
+])  # fmt: skip
+def test_batched_certificate_is_the_per_vector_one(short_plan, tmp_path, edit, kw, kinds):
+    """All friction vectors of a row in one batch give the certificate of one solve per vector."""
+    task, out = short_plan
+    src = out if edit is None else _corrupt(out, tmp_path / "bad", edit)
+    fast = certify_plan(src, task, **kw)
+    reference = certify_plan(src, task, batched=False, **kw)
+    _same_certificates(fast, reference)
+    assert kinds <= {v.kind for v in fast.violations}
+
+
+def test_all_vectors_match_the_solver_per_vector():
+    """Statuses, feasible modes, c_n and qdot of the batched path are the solver's, bit for bit,
+    on seeded hand scenes, with and without degenerate modes, at default and machine-precision tolerances."""
+    from qsplan.hands import hand_scene
+    from qsplan.mechanics import Status
+    from qsplan.planner.planning.certify_modes import EXACT_TOLERANCES, solve_all_vectors, solve_per_vector
+
+    task = make_task(default_hand(), 0.0, [0.01])
+    hand = task.hand
+    rng = np.random.default_rng(11)
+    seen_degenerate = False
+    for _ in range(12):
+        pose = task.pose(rng.uniform(-0.02, 0.02))
+        e = str(rng.choice(["left", "right"]))
+        scene = hand_scene(hand, pose, None, e, velocity=rng.uniform(-0.3, 0.3), effort=rng.uniform(-1.0, 1.0))
+        mus = np.vstack([np.zeros(4), np.full(4, 0.2), rng.uniform(0.0, 0.6, (6, 4))])
+        for tol in (None, EXACT_TOLERANCES):
+            args = () if tol is None else (tol,)
+            fast, ref = solve_all_vectors(scene, mus, *args), solve_per_vector(scene, mus, *args)
+            assert fast.letters == ref.letters
+            for name in ("codes", "c_n", "qdot"):
+                assert np.array_equal(getattr(fast, name), getattr(ref, name)), name
+            seen_degenerate |= bool(np.isin(fast.codes, [Status.ORDER.index(s) for s in Status.DEGENERATE]).any())
+    assert seen_degenerate
+
+
+@pytest.mark.slow
+@pytest.mark.ompl
+def test_demo_plan_batched_certificate_is_the_per_vector_one(tmp_path):
+    from qsplan.planner.planning.task import demo_task_path
+
+    task = load_task(demo_task_path())
+    export_plan(plan_task(task), tmp_path)
+    kw = {"force_margin": task.force_margin.normal}
+    fast = certify_plan(tmp_path, task, **kw)
+    _same_certificates(fast, certify_plan(tmp_path, task, batched=False, **kw))
+    assert fast.ok

@@ -75,7 +75,7 @@ def test_bad_input_is_one_line_exit_2(tmp_path, capsys, args, match):
 
 @pytest.mark.ompl
 def test_ctrl_c_during_planning_exits_130_and_leaves_nothing(tmp_path):
-    """SIGINT while OMPL is planning (the validity checker runs Python): one line, exit 130, no output."""
+    """SIGINT while a segment is being planned (its dense sweep runs Python): one line, exit 130, no output."""
     import signal
     import subprocess
     import sys
@@ -85,7 +85,7 @@ def test_ctrl_c_during_planning_exits_130_and_leaves_nothing(tmp_path):
     proc = subprocess.Popen([sys.executable, "-m", "qsplan.planner.cli", "demo", "--out", str(out)],
                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)  # fmt: skip
     t0, seen = time.perf_counter(), ""
-    while time.perf_counter() - t0 < 60 and "planning with OMPL" not in seen:
+    while time.perf_counter() - t0 < 60 and "effort-controlled finger" not in seen:  # a segment is being planned
         seen = proc.stderr.readline()
     time.sleep(0.5)
     proc.send_signal(signal.SIGINT)

@@ -1,0 +1,262 @@
+"""Analytic scenes of the two-finger hand: the contacts it knows, not a polygon search (Section 3, eqs. 1-5).
+
+At a grasp the hand's contacts are known: the workpiece's bottom edge lies on the
+palm (contacts at its two ends, normal the edge's inward normal, +y when level) and
+each finger's inner edge touches one workpiece vertex (the tangency of
+:func:`qsplan.hands.two_finger.finger_angles`; normal the edge's outward normal,
+into the workpiece).  :func:`grasp_contacts` finds them in closed form and checks,
+with margins, that the polygon search (:func:`qsplan.mechanics.model.geometry.find_contacts`)
+would find exactly these four and nothing else; :func:`analytic_hand_scene` turns
+them into the :class:`qsplan.mechanics.Scene` that
+:func:`qsplan.hands.two_finger_scene.hand_scene` builds by the generic path, to
+round-off (the tests compare the two on hundreds of configurations).  Where the
+check fails (a finger flush with an edge, a tip or corner near the workpiece, the
+workpiece off the palm) both return None and the caller takes the generic path.
+Units SI (m, rad, N, N m).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from functools import lru_cache
+
+import numpy as np
+
+from qsplan.hands.two_finger import JOINT_NAMES, TwoFingerHand, workpiece_world
+from qsplan.mechanics.model.contact import wrench_matrices
+from qsplan.mechanics.model.geometry import CONTACT_TOL
+from qsplan.mechanics.model.scene import Scene
+
+__all__ = ["GraspContacts", "analytic_hand_scene", "grasp_contacts"]
+
+#: Margins (in contact tolerances) of the closed-form check: a feature the polygon search must
+#: find lies within NEAR tolerances, one it must not find beyond FAR; values between fall back
+#: to the generic path, so rounding in either path never decides which contacts a scene has.
+NEAR, FAR = 0.5, 2.0
+
+#: A workpiece vertex whose turn is below this relative size is (nearly) straight: the polygon
+#: search may drop it (:mod:`qsplan.mechanics.model.geometry` drops turns below 1e-12), so a hand
+#: with one always takes the generic path.
+_STRAIGHT_TOL = 1e-9
+
+_CONTACT_NAMES = ("palm:0", "palm:1", "left:2", "right:3")
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class GraspContacts:
+    """The four contacts of a grasp, in the hand's order (palm left end, palm right end, left, right).
+
+    Attributes
+    ----------
+    points : ndarray, shape (4, 2)
+        Contact points ``r_i``, world frame (m): workpiece vertices.
+    normals : ndarray, shape (4, 2)
+        Unit normals ``n_i`` into the workpiece.
+    vertices : ndarray of int, shape (4,)
+        The workpiece vertex of each contact.
+    """
+
+    points: np.ndarray
+    normals: np.ndarray
+    vertices: np.ndarray
+
+
+@lru_cache(maxsize=16)
+def _constants(hand: TwoFingerHand):
+    """Per-hand constants (cached: hands are immutable): whether the analytic path applies, each finger's inner
+    edge in its link frame (its two ends in the link ring's order, m) and the joint axes (m), as plain floats."""
+    V = hand.workpiece
+    d_prev, d_next = V - np.roll(V, 1, axis=0), np.roll(V, -1, axis=0) - V
+    turn = np.abs(d_prev[:, 0] * d_next[:, 1] - d_prev[:, 1] * d_next[:, 0])
+    corners_only = bool(np.all(turn > _STRAIGHT_TOL * np.linalg.norm(d_prev, axis=1) * np.linalg.norm(d_next, axis=1)))
+    L, w = float(hand.finger_length), 0.5 * hand.finger_width
+    # hand_manipulator's link shape is (0, -w), (L, -w), (L, w), (0, w): the left finger touches with its
+    # first edge (outward normal -y), the right one with its third (outward normal +y)
+    inner = (((0.0, -w), (L, -w)), ((L, w), (0.0, w)))
+    return corners_only, inner, tuple(map(tuple, hand.pivots.tolist()))
+
+
+def _segment_distance(p, a, b) -> float:
+    """Distance (m) from the point ``p`` to the segment ``a -> b`` (pairs of floats)."""
+    dx, dy = b[0] - a[0], b[1] - a[1]
+    rx, ry = p[0] - a[0], p[1] - a[1]
+    t = min(max((rx * dx + ry * dy) / (dx * dx + dy * dy), 0.0), 1.0)
+    return math.hypot(rx - t * dx, ry - t * dy)
+
+
+def _unit(v) -> np.ndarray:
+    """``v / |v|`` exactly as :func:`qsplan.mechanics.model.geometry.find_contacts` normalises a normal."""
+    v = np.array(v)
+    return v / math.sqrt(v.dot(v))
+
+
+def grasp_contacts(hand: TwoFingerHand, pose, q, tol: float = CONTACT_TOL) -> GraspContacts | None:
+    """The four contacts of the hand at workpiece ``pose`` and joints ``q``; None where the polygons could give others.
+
+    Parameters
+    ----------
+    hand : TwoFingerHand
+    pose : array-like, shape (3,)
+        Workpiece ``(x, y, theta)`` (m, m, rad).
+    q : array-like, shape (2,)
+        Joint angles (rad), left and right.
+    tol : float
+        The polygon search's contact tolerance (m).
+
+    Returns
+    -------
+    GraspContacts or None
+        None unless: the bottom edge's two ends are within ``NEAR * tol`` of the palm's top and every other
+        vertex above ``FAR * tol``; each finger's inner edge is within ``NEAR * tol`` of one workpiece vertex,
+        ``FAR * tol`` inside its ends, every other vertex beyond ``FAR * tol``; and no end of the palm's top
+        edge or of a finger's inner edge within ``FAR * tol`` of a workpiece edge, nor a workpiece edge lying
+        along one of them (an edge-edge contact) but the bottom edge on the palm.
+    """
+    # plain floats: a handful of numbers per state, where numpy's per-call overhead would dominate
+    corners_only, inner, pivots = _constants(hand)
+    if not corners_only:
+        return None
+    near, far = NEAR * tol, FAR * tol
+    V = workpiece_world(hand, pose)
+    P = V.tolist()
+    k = len(P)
+    if not (abs(P[0][1]) <= near and abs(P[1][1]) <= near and min(p[1] for p in P[2:]) > far):
+        return None
+    q = np.asarray(q, dtype=float).tolist()
+    halfwidth = float(hand.palm_halfwidth)
+    # (edge ends, unit normal into the workpiece, workpiece edges to check (index, test facing)): the palm's top
+    # edge right to left (the palm ring's order), with the edges at the bottom edge's ends; then each finger's inner edge
+    bodies = [((halfwidth, 0.0), (-halfwidth, 0.0), (0.0, 1.0), ((k - 1, True), (0, False), (1, True)))]
+    touch = []
+    for (ax, ay), ends, qf in zip(pivots, inner, q):
+        # the link's corners as qsplan.mechanics.model.manipulator.link_polygons computes them
+        c, s = math.cos(qf), math.sin(qf)
+        (e0x, e0y), (e1x, e1y) = ((ax + (c * lx - s * ly), ay + (s * lx + c * ly)) for lx, ly in ends)
+        dx, dy = e1x - e0x, e1y - e0y
+        length = math.sqrt(dx * dx + dy * dy)
+        nx, ny = dy / length, -dx / length  # the finger's outward normal: into the workpiece
+        dist = [(x - e0x) * nx + (y - e0y) * ny for x, y in P]  # signed, positive outside the finger
+        i = min(range(k), key=dist.__getitem__)
+        along = ((P[i][0] - e0x) * dx + (P[i][1] - e0y) * dy) / length
+        others = min(d for j, d in enumerate(dist) if j != i)
+        if not (abs(dist[i]) <= near and others > far and far < along < length - far):
+            return None
+        touch.append(i)
+        bodies.append(((e0x, e0y), (e1x, e1y), (nx, ny), (((i - 1) % k, True), (i, True))))
+    if not _clear(P, bodies, near, far):
+        return None
+    ex, ey = P[1][0] - P[0][0], P[1][1] - P[0][1]
+    size = math.sqrt(ex * ex + ey * ey)
+    bottom = _unit((-(ey / size), -(-ex / size)))  # the bottom edge's inward normal
+    normals = np.stack([bottom, bottom, _unit(bodies[1][2]), _unit(bodies[2][2])])
+    vertices = np.array([0, 1, *touch])
+    return GraspContacts(V[vertices], normals, vertices)
+
+
+def _clear(P, bodies, near, far) -> bool:
+    """Whether no other contact can appear next to the expected ones: no end of the palm's top edge or of a
+    finger's inner edge within ``far`` of a workpiece edge at its touching vertices (a vertex on an edge), and
+    none of those workpiece edges facing the body's edge with both ends of their overlap within ``far`` of its
+    line (an edge on an edge, as :func:`qsplan.mechanics.model.geometry.find_contacts` tests it).  Other edges
+    have both ends beyond ``far`` from the body's line, so cannot touch it; the bottom edge (edge 0, checked for
+    corners only) lies on the palm by design.
+
+    ``P``: the workpiece's world vertices, k pairs of floats; ``bodies``: (edge start, edge end, unit normal into
+    the workpiece, the workpiece edges to check as (index, whether to test it for facing too)) of the palm and
+    each finger.
+    """
+    k = len(P)
+    for e0, e1, (nx, ny), edges in bodies:
+        for edge, facing in edges:
+            f0, f1 = P[edge], P[(edge + 1) % k]
+            if min(_segment_distance(e0, f0, f1), _segment_distance(e1, f0, f1)) <= far:
+                return False
+            if not facing:
+                continue
+            ux, uy = f1[0] - f0[0], f1[1] - f0[1]
+            size = math.sqrt(ux * ux + uy * uy)
+            ux, uy = ux / size, uy / size
+            se0 = (e0[0] - f0[0]) * ux + (e0[1] - f0[1]) * uy
+            se1 = (e1[0] - f0[0]) * ux + (e1[1] - f0[1]) * uy
+            lo, hi = max(0.0, min(se0, se1)), min(size, max(se0, se1))
+            if hi - lo >= near:
+                off = (f0[0] - e0[0]) * nx + (f0[1] - e0[1]) * ny
+                slope = ux * nx + uy * ny
+                if max(off + lo * slope, off + hi * slope) <= far:
+                    return False
+    return True
+
+
+def _finger_jacobian(hand, points, normals):
+    """Contact Jacobian rows ``j_in, j_it`` (eq. 5), shape (2, 2, 2) [finger, row, joint], of each finger's contact
+    point ``points[k]`` (m) with normal ``normals[k]``: a point on a link turning about the fixed axis ``a_k``
+    moves at ``ez x (p - a_k) qdot_k``, the only nonzero column of its point Jacobian (the general tree is
+    :func:`qsplan.mechanics.model.manipulator.contact_jacobian`, which the tests compare against)."""
+    out = np.empty((2, 2, 2))
+    for k, ((ax, ay), (px, py), normal) in enumerate(zip(_constants(hand)[2], points.tolist(), normals)):
+        Jp = np.zeros((2, 2))
+        Jp[0, k], Jp[1, k] = -(py - ay), px - ax
+        n = normal / np.hypot(*normal)
+        out[k] = np.array([n, [-n[1], n[0]]]) @ Jp  # [n^T; t^T] Jp, t = n turned +90 degrees
+    return out
+
+
+def _gravity_efforts(hand, q):
+    """``g_man`` (eq. 3), shape (2,): each finger's weight at half its length, ``m g (L/2) cos q_k`` (N m)."""
+    if hand.finger_mass == 0.0:
+        return np.zeros(2)
+    pivots = hand.pivots
+    com_x = pivots[:, 0] + (np.cos(q) * (0.5 * hand.finger_length) - np.sin(q) * 0.0)
+    return hand.finger_mass * hand.gravity * (com_x - pivots[:, 0])
+
+
+def _frozen(a):
+    a = np.asarray(a)
+    a.setflags(write=False)
+    return a
+
+
+def analytic_hand_scene(hand: TwoFingerHand, pose, q, effort_controlled, velocity=0.0, effort=0.0, mu=None):
+    """The hand's :class:`qsplan.mechanics.Scene` at a grasp from :func:`grasp_contacts`, or None off a grasp.
+
+    Parameters
+    ----------
+    hand : TwoFingerHand
+    pose : array-like, shape (3,)
+        Workpiece ``(x, y, theta)`` (m, m, rad).
+    q : array-like, shape (2,)
+        Joint angles (rad).
+    effort_controlled : ndarray of bool, shape (2,)
+        The control mode of each joint (validated by the caller).
+    velocity, effort : float
+        Input of the velocity-controlled joint (rad/s) and the effort-controlled one (N m).
+    mu : float, optional
+        Friction of every contact (validated by the caller); default ``hand.mu``.
+
+    Returns
+    -------
+    Scene or None
+        Equal to the generic path's scene to round-off: ``W_n, W_t`` (eq. 1), ``J_n, J_t`` (eq. 5; zero rows
+        on the palm), ``g_obj`` the workpiece weight at its centre of mass (eq. 2), ``g_man`` (eq. 3).
+    """
+    pose = np.asarray(pose, dtype=float)
+    q = np.asarray(q, dtype=float)
+    found = grasp_contacts(hand, pose, q)
+    if found is None:
+        return None
+    Wn, Wt = wrench_matrices(found.points, found.normals)
+    J = _finger_jacobian(hand, found.points[2:], found.normals[2:])
+    Jn, Jt = np.zeros((4, 2)), np.zeros((4, 2))  # the palm's rows are zero
+    Jn[2:], Jt[2:] = J[:, 0], J[:, 1]
+    weight = -hand.workpiece_mass * hand.gravity
+    g_obj = np.array([0.0, weight, pose[0] * weight - pose[1] * 0.0])  # qsplan.mechanics.model.contact.point_wrench
+    e = np.array(effort_controlled, dtype=bool)
+    return Scene(
+        Wn=_frozen(Wn), Wt=_frozen(Wt), Jn=_frozen(Jn), Jt=_frozen(Jt),
+        mu=_frozen(np.full(4, hand.mu if mu is None else float(mu))), g_obj=_frozen(g_obj),
+        g_man=_frozen(_gravity_efforts(hand, q)), effort_controlled=_frozen(e),
+        joint_velocity=_frozen(np.where(e, np.nan, float(velocity))),
+        joint_effort=_frozen(np.where(e, float(effort), np.nan)),
+        joint_names=JOINT_NAMES, contact_names=_CONTACT_NAMES,
+    )  # fmt: skip

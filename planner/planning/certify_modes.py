@@ -1,0 +1,240 @@
+"""The mode check of the plan certifier (:mod:`qsplan.planner.planning.certify`): the planned mode, alone.
+
+:func:`mode_checks` rebuilds a row's scene from the task (:func:`qsplan.hands.hand_scene`)
+and asks which modes its commands make feasible at every friction vector to test.  Two
+paths give the same statuses, bit for bit:
+
+* the reference, :func:`solve_per_vector`: the all-modes solver
+  (:func:`qsplan.mechanics.solve`, eqs. 13-28) once per friction vector;
+* the fast path, :func:`solve_all_vectors`: the kinematic stage of every mode (eqs. 23-25,
+  16), which does not depend on friction, once, then the equilibrium and Coulomb stage
+  (eqs. 26-28) for every admissible mode at every friction vector in one batch.  It calls
+  the very stages :func:`qsplan.mechanics.solve` calls, on the same batches of modes, so
+  each mode gets the solver's own decision (the tests compare the certificates).
+
+Both share the mechanics library (the model), nothing of the planner's bookkeeping.
+Units SI (m, rad, s, N, N m).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from functools import lru_cache
+
+import numpy as np
+
+from qsplan.mechanics import DEFAULT_TOLERANCES, Tolerances
+
+__all__ = ["MOTION_RTOL", "EXACT_TOLERANCES", "VectorStatuses", "solve_per_vector", "solve_all_vectors", "mode_checks"]
+
+#: Relative difference tolerated between the workpiece speed the solver computes from
+#: the exported velocity command and the one the rows' poses show (finite differences of
+#: a straight slide are exact; the command is the closed-form derivative): 1 %.
+MOTION_RTOL = 1e-2
+
+#: Tolerances at which a mode that was degenerate at the default ones is tested again.  A
+#: mode still degenerate at these is degenerate to machine precision (e.g. a finger breaking
+#: from a workpiece held by rolling contacts leaves its joint's velocity undetermined):
+#: outside the model (eq. 32, the strict inequalities 11, 15, 16), no competitor.  One that
+#: turns decided at these was only nearly degenerate: its feasibility is not decided at the
+#: default tolerances, and the row is not certified.  1e-15 is the lowest singularity
+#: threshold at which the stability study (``benchmarks/bench_stability.py``) saw no LU failure.
+EXACT_TOLERANCES = Tolerances(singular=1e-15, velocity=1e-13)
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class VectorStatuses:
+    """Every mode's status at each of ``m`` friction vectors, and the feasible modes' forces and motion.
+
+    Attributes
+    ----------
+    letters : tuple of str
+        The modes, in enumeration order (eq. 49).
+    codes : ndarray of int8, shape (m, n_modes)
+        Status codes into ``Status.ORDER`` (0: feasible).
+    c_n : ndarray, shape (m, n_modes, n_c)
+        Normal forces (N) of the feasible modes; 0 elsewhere.
+    qdot : ndarray, shape (m, n_modes, 3)
+        Workpiece velocity (m/s, m/s, rad/s, of the world origin) of the feasible modes; 0 elsewhere.
+    """
+
+    letters: tuple
+    codes: np.ndarray
+    c_n: np.ndarray
+    qdot: np.ndarray
+
+
+def solve_per_vector(scene, mus, tol: Tolerances = DEFAULT_TOLERANCES) -> VectorStatuses:
+    """The reference: :func:`qsplan.mechanics.solve` at each friction vector.
+
+    Parameters
+    ----------
+    scene : Scene
+        Its own ``mu`` is ignored.
+    mus : ndarray, shape (m, n_c)
+    tol : Tolerances
+
+    Returns
+    -------
+    VectorStatuses
+    """
+    from qsplan.mechanics import Status, enumerate_modes, solve
+
+    letters = tuple(m.letters for m in enumerate_modes(scene.n_contacts, scene.dof))
+    index = {m: j for j, m in enumerate(letters)}
+    m = len(mus)
+    codes = np.zeros((m, len(letters)), dtype=np.int8)
+    c_n = np.zeros((m, len(letters), scene.n_contacts))
+    qdot = np.zeros((m, len(letters), 3))
+    for i, mu in enumerate(mus):
+        res = solve(scene.with_mu(mu), tol, residuals=False, keep_statuses=True, workers=1, search="all")
+        codes[i] = [Status.ORDER.index(st) for st in res.statuses]
+        for sol in res.solutions:
+            c_n[i, index[sol.mode.letters]] = sol.c_n
+            qdot[i, index[sol.mode.letters]] = sol.qdot
+    return VectorStatuses(letters, codes, c_n, qdot)
+
+
+@lru_cache(maxsize=8)
+def _mode_batches(n_contacts: int, dof: int) -> tuple:
+    """The solver's batches of mode codes (read-only) and every mode's letters, in enumeration order."""
+    from qsplan.mechanics.modes.contact_mode import codes_to_letters, iter_mode_batches
+    from qsplan.mechanics.solver.batch import DEFAULT_BATCH
+
+    batches = tuple(iter_mode_batches(n_contacts, dof, DEFAULT_BATCH))
+    for codes in batches:
+        codes.setflags(write=False)
+    return batches, tuple(codes_to_letters(c) for codes in batches for c in codes)
+
+
+def solve_all_vectors(scene, mus, tol: Tolerances = DEFAULT_TOLERANCES) -> VectorStatuses:
+    """:func:`solve_per_vector`'s answer with the kinematic stage once and one equilibrium batch.
+
+    The modes go through :func:`qsplan.mechanics.modes.kinematics.kinematics_stage` in the
+    solver's batches (:func:`qsplan.mechanics.modes.contact_mode.iter_mode_batches`), the
+    admissible ones, repeated for every friction vector, through
+    :func:`qsplan.mechanics.modes.equilibrium.equilibrium_stage`: every matrix is factorised
+    alone, so every number is the one :func:`qsplan.mechanics.solve` computes.
+
+    Same parameters and result as :func:`solve_per_vector`.
+    """
+    from qsplan.mechanics.modes.equilibrium import equilibrium_stage
+    from qsplan.mechanics.modes.kinematics import ScenePool, kinematics_stage, velocity_scale
+
+    mus = np.asarray(mus, dtype=float).reshape(-1, scene.n_contacts)
+    n = mus.shape[0]
+    pool = ScenePool(scene)
+    vtol = tol.velocity * velocity_scale(scene)
+    tau_e = np.nan_to_num(scene.joint_effort)[pool.E]
+    batches, letters = _mode_batches(scene.n_contacts, scene.dof)
+    codes = np.zeros((n, len(letters)), dtype=np.int8)
+    c_n = np.zeros((n, len(letters), scene.n_contacts))
+    qdot = np.zeros((n, len(letters), 3))
+    lo = 0
+    for batch in batches:
+        status, live, kin = kinematics_stage(scene, pool, batch, tol, vtol)
+        codes[:, lo : lo + status.size] = status
+        if live.size:
+            rows_mode = np.tile(np.arange(live.size), n)
+            rows_pt = np.repeat(np.arange(n), live.size)
+            est, cn, _, _, _ = equilibrium_stage(scene, pool, kin.take(rows_mode), mus[rows_pt],
+                                                 np.broadcast_to(tau_e, (rows_pt.size, tau_e.size)), tol)  # fmt: skip
+            cols = lo + live[rows_mode]
+            codes[rows_pt, cols] = est
+            ok = est == 0
+            c_n[rows_pt[ok], cols[ok]] = cn[ok]
+            qdot[rows_pt[ok], cols[ok]] = kin.qdot[rows_mode[ok]]
+        lo += status.size
+    return VectorStatuses(letters, codes, c_n, qdot)
+
+
+def _fmt_mu(mu) -> str:
+    return "[" + ", ".join(f"{m:.4g}" for m in mu) + "]"
+
+
+def mode_checks(task, cols, k, mus, force_margin=0.0, xdot_rows=np.nan, batched=True) -> tuple:
+    """Check 4: with the row's commands the planned mode is the only feasible one at every friction vector.
+
+    Parameters
+    ----------
+    mus : ndarray, shape (m, 4)
+        Friction vectors (palm:0, palm:1, left, right).
+    force_margin : float
+        N: the planned mode's normal forces must be at least this at every contact.
+    xdot_rows : float
+        The workpiece's ``x`` velocity (m/s) the rows show (finite difference); nan: not checked.
+    batched : bool
+        Every friction vector in one batch (:func:`solve_all_vectors`); False: the
+        reference, one solve per vector (:func:`solve_per_vector`).  Same verdicts.
+
+    Returns
+    -------
+    (list of (kind, message), tuple of str)
+        The failures (at most one per kind: the first friction vector that shows it) and
+        the modes set aside as degenerate to machine precision (outside the model).
+    """
+    from qsplan.hands import hand_scene
+    from qsplan.mechanics import QsplanError, Status
+
+    from qsplan.planner.planning.certify_rows import row_pose, row_q
+
+    mode, e = str(cols["mode"][k]), str(cols["effort_joint"][k])
+    v = "right" if e == "left" else "left"
+    try:
+        # method="generic": contacts found by polygon contact finding, the reference path, not the
+        # closed-form grasp the planner uses (qsplan.hands.two_finger_analytic): a certifier shares no
+        # shortcut with what it certifies (~2 ms per row)
+        scene = hand_scene(task.hand, row_pose(cols, k), row_q(cols, k), e, velocity=float(cols[f"qd_{v}"][k]),
+                           effort=float(cols[f"tau_{e}"][k]), method="generic")  # fmt: skip
+    except QsplanError as exc:
+        return [("contact", f"the row's scene cannot be built: {exc}")], ()
+    solve_at = solve_all_vectors if batched else solve_per_vector
+    names = Status.ORDER
+    degenerate_codes = [names.index(s) for s in sorted(Status.DEGENERATE)]
+    singular = names.index(Status.EQUILIBRIUM_SINGULAR)
+    found = {}
+    exact_cache = {}  # statuses at machine precision: per friction vector, or once for kinematic degeneracy
+    sv = solve_at(scene, mus, DEFAULT_TOLERANCES)
+    letters = sv.letters
+    j_mode = letters.index(mode) if mode in letters else None
+    feasible = sv.codes == 0
+    n_feasible = feasible.sum(axis=1)
+    planned = feasible[:, j_mode] if j_mode is not None else np.zeros(len(mus), dtype=bool)
+    degenerate = np.isin(sv.codes, degenerate_codes)
+    excluded = np.zeros(len(letters), dtype=bool)
+    for i, mu in enumerate(mus):
+        row = sv.codes[i]
+        if n_feasible[i] > planned[i] and "mode" not in found:
+            others = [letters[j] for j in np.flatnonzero(feasible[i]) if letters[j] != mode]
+            found["mode"] = f"competitor {'/'.join(others)} feasible at mu = {_fmt_mu(mu)} (planned {mode})"
+        if not planned[i] and "planned" not in found:
+            why = "not tested" if j_mode is None else names[row[j_mode]]
+            found["planned"] = f"planned mode {mode} not feasible at mu = {_fmt_mu(mu)} ({why})"
+        if degenerate[i].any():
+            key = tuple(mu) if np.any(degenerate[i] & (row == singular)) else "kinematic"
+            if key not in exact_cache:
+                tight = solve_at(scene, mu[None, :], EXACT_TOLERANCES).codes[0]
+                exact_cache[key] = tight, np.isin(tight, degenerate_codes)
+            tight, still = exact_cache[key]
+            excluded |= degenerate[i] & still
+            undecided = np.flatnonzero(degenerate[i] & ~still)
+            if undecided.size and "undecided" not in found:
+                j = undecided[0]
+                found["undecided"] = (f"mode {letters[j]} is nearly degenerate ({names[row[j]].replace('_', ' ')}) "
+                                      f"at mu = {_fmt_mu(mu)}: its feasibility is not decided "
+                                      f"({names[tight[j]].replace('_', ' ')} at machine precision)")  # fmt: skip
+        if not planned[i]:
+            continue
+        c_n, qdot = sv.c_n[i, j_mode], sv.qdot[i, j_mode]
+        if force_margin > 0 and c_n.min() < force_margin and "force margin" not in found:
+            i_c = int(np.argmin(c_n))
+            found["force margin"] = (f"normal force {c_n[i_c]:.4g} N at contact {i_c} below the margin "
+                                     f"{force_margin:g} N at mu = {_fmt_mu(mu)}")  # fmt: skip
+        xdot = qdot[0] - qdot[2] * float(cols["y_workpiece"][k])  # qdot is the world origin's velocity
+        if np.isfinite(xdot_rows) and "motion" not in found:
+            if np.sign(xdot) != np.sign(xdot_rows) or abs(xdot - xdot_rows) > MOTION_RTOL * abs(xdot_rows):
+                found["motion"] = (f"the commands move the workpiece at {xdot * 1e3:.4g} mm/s at mu = {_fmt_mu(mu)}; "
+                                   f"the rows show {xdot_rows * 1e3:.4g} mm/s")  # fmt: skip
+    kinds = {"planned": "mode", "mode": "mode"}
+    set_aside = tuple(sorted(letters[j] for j in np.flatnonzero(excluded)))
+    return [(kinds.get(kind, kind), msg) for kind, msg in found.items()], set_aside
