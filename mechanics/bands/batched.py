@@ -11,10 +11,11 @@ and one ``solve``), and the rows assembled by the same function
 (:func:`qsplan.mechanics.bands.effort.coulomb_rows`); ``tests/mechanics/test_bands_batched.py``
 compares them on hundreds of states.
 
-The kinematic stage and ``Q_AI`` are restated here over states (the per-scene functions
-:func:`qsplan.mechanics.modes.kinematics.kinematics_stage` and
-:func:`qsplan.mechanics.modes.equilibrium.equilibrium_matrix` gather from one scene's rows);
-the tests check both against them.
+Nothing of eqs. (23)-(26) is restated here: a :class:`StateBatch` holds the rows of
+:class:`qsplan.mechanics.modes.kinematics.ScenePool` with a leading state axis, and the
+kinematic stage (:func:`qsplan.mechanics.modes.kinematics.kinematic_tests`) and ``Q_AI``
+(:func:`qsplan.mechanics.modes.equilibrium.equilibrium_columns`) are the solver's own
+functions, which serve modes of one scene and states of a batch alike.
 """
 
 from __future__ import annotations
@@ -27,9 +28,10 @@ from qsplan.mechanics.bands.effort import Band, check_force_margin, check_one_ef
 from qsplan.mechanics.bands.guaranteed import shared_band_from_rows, shared_nodes
 from qsplan.mechanics.errors import SceneError
 from qsplan.mechanics.model.friction import check_mu_range
-from qsplan.mechanics.modes.contact_mode import ContactMode, Letter, letters_to_codes
-from qsplan.mechanics.modes.kinematics import applicable_rows, check_mode_fits
-from qsplan.mechanics.numerics import DEFAULT_TOLERANCES, Status, StatusCode, Tolerances, hadamard_ratio
+from qsplan.mechanics.modes.contact_mode import ContactMode, letters_to_codes
+from qsplan.mechanics.modes.equilibrium import equilibrium_columns
+from qsplan.mechanics.modes.kinematics import applicable_rows, check_mode_fits, kinematic_tests, kinematics_rows
+from qsplan.mechanics.numerics import DEFAULT_TOLERANCES, Status, StatusCode, Tolerances
 
 __all__ = [
     "StateBatch",
@@ -45,8 +47,6 @@ __all__ = [
     "guaranteed_bands_box",
     "guaranteed_bands_shared",
 ]
-
-_B, _S = int(Letter.B), int(Letter.S)
 
 
 def batch_signature(scene) -> tuple:
@@ -82,6 +82,8 @@ class StateBatch:
     Wrows : ndarray, shape (S, 2 n_c, 3)
         ``[W_n^T; W_t^T]`` of each state (the per-scene ``ScenePool.Wrows``).
     Jrows : ndarray, shape (S, 2 n_c, n_j)
+    M : ndarray, shape (S, 2 n_c, 4)
+        The rows ``P_AI`` gathers from (eq. 23, :func:`~qsplan.mechanics.modes.kinematics.kinematics_rows`).
     log_row_norm : ndarray, shape (S, 2 n_c)
         Log norms of the rows of ``P_AI`` (eq. 23).
     drive : ndarray, shape (S, 2 n_c)
@@ -100,6 +102,7 @@ class StateBatch:
     V: np.ndarray
     Wrows: np.ndarray
     Jrows: np.ndarray
+    M: np.ndarray
     log_row_norm: np.ndarray
     drive: np.ndarray
     vtol: np.ndarray
@@ -130,15 +133,12 @@ def state_batch(scenes, tol: Tolerances = DEFAULT_TOLERANCES) -> StateBatch:
     stack = lambda name: np.stack([getattr(s, name) for s in scenes])  # noqa: E731
     Wrows = np.concatenate([stack("Wn"), stack("Wt")], axis=2).transpose(0, 2, 1)
     Jrows = np.concatenate([stack("Jn"), stack("Jt")], axis=1)
-    M = np.concatenate([Wrows, -Jrows[:, :, E]], axis=2)  # rows of P_AI (eq. 23)
-    with np.errstate(divide="ignore"):
-        log_row_norm = np.log(np.linalg.norm(M, axis=2))
     velocity = stack("joint_velocity")
-    drive = np.einsum("srj,sj->sr", Jrows[:, :, V], velocity[:, V])
+    M, log_row_norm, drive = kinematics_rows(Wrows, Jrows, velocity, E, V)
     speed = np.max(np.abs(drive), axis=1) if drive.shape[1] else np.zeros(len(scenes))
     vtol = tol.velocity * np.where(speed > 0, speed, 1.0)
     r0 = np.concatenate([-stack("g_obj"), -stack("g_man")[:, E]], axis=1)
-    return StateBatch(scenes, joint, E, V, Wrows, Jrows, log_row_norm, drive, vtol, r0, velocity)
+    return StateBatch(scenes, joint, E, V, Wrows, Jrows, M, log_row_norm, drive, vtol, r0, velocity)
 
 
 def take_states(batch: StateBatch, rows) -> StateBatch:
@@ -147,7 +147,8 @@ def take_states(batch: StateBatch, rows) -> StateBatch:
     if rows.size == batch.size and np.array_equal(rows, np.arange(batch.size)):
         return batch
     return StateBatch(tuple(batch.scenes[s] for s in rows), batch.joint, batch.E, batch.V, batch.Wrows[rows], batch.Jrows[rows],
-                      batch.log_row_norm[rows], batch.drive[rows], batch.vtol[rows], batch.r0[rows], batch.velocity[rows])  # fmt: skip
+                      batch.M[rows], batch.log_row_norm[rows], batch.drive[rows], batch.vtol[rows], batch.r0[rows],
+                      batch.velocity[rows])  # fmt: skip
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -187,29 +188,7 @@ def batch_kinematics(batch: StateBatch, mode, tol: Tolerances = DEFAULT_TOLERANC
     mode = check_mode_fits(batch.scenes[0], mode)
     codes = letters_to_codes(mode.letters)
     idx, contact, slide = (a[0] for a in applicable_rows(batch.scenes[0], codes[None, :]))
-    n_c, S = batch.n_c, batch.size
-    M = np.concatenate([batch.Wrows[:, idx], -batch.Jrows[:, idx][:, :, batch.E]], axis=2)  # P_AI (eq. 23)
-    status = np.zeros(S, dtype=np.int8)
-    sing = ~(hadamard_ratio(M, log_row_norms=batch.log_row_norm[:, idx].sum(axis=1)) >= tol.singular)
-    status[sing] = StatusCode.KINEMATICS_SINGULAR
-    M[sing] = np.eye(M.shape[1])
-    z = np.linalg.solve(M, batch.drive[:, idx][..., None])[..., 0]  # eq. (24)
-    thetadot = np.empty((S, batch.Jrows.shape[2]))
-    thetadot[:, batch.V] = batch.velocity[:, batch.V]
-    thetadot[:, batch.E] = z[:, 3:]
-    v = np.einsum("sj,srj->sr", z[:, :3], batch.Wrows) - np.einsum("sj,srj->sr", thetadot, batch.Jrows)  # eq. (5)
-    v_n, v_t = v[:, :n_c], v[:, n_c:]
-    vtol = batch.vtol[:, None]
-    alive = ~sing
-    brk = codes[None, :] == _B
-    for code, bad in ((StatusCode.BREAKING_VIOLATED, np.any(brk & (v_n < -vtol), axis=1)),  # eq. (15)
-                      (StatusCode.BREAKING_ZERO_SPEED, np.any(brk & (v_n <= vtol), axis=1)),
-                      (StatusCode.ZERO_SLIDING_SPEED, np.any((codes[None, :] == _S) & (np.abs(v_t) <= vtol), axis=1))):  # eq. (16)
-        hit = alive & bad
-        status[hit] = code
-        alive &= ~hit
-    xi = np.where(codes[None, :] == _S, np.sign(v_t), 0.0)
-    xi[~alive] = 0.0
+    status, _, _, xi = kinematic_tests(batch, idx, codes, tol, batch.vtol[:, None])
     return BatchKinematics(mode, idx, contact, slide, status, xi)
 
 
@@ -228,15 +207,13 @@ def batch_rows(batch: StateBatch, bk: BatchKinematics, mu_rows, force_margin=Non
         NaN where ``Q_AI`` is singular; meaningless at states where ``bk.ok`` is False.
     det, scale : ndarray, shape (S, N)
     """
-    S, n_c, idx, E = batch.size, batch.n_c, bk.idx, batch.E
+    S = batch.size
     mu = np.asarray(mu_rows, dtype=float)
     mu = np.broadcast_to(mu, (S,) + mu.shape[-2:]) if mu.ndim == 2 else mu
     N = mu.shape[1]
-    partner = bk.contact + n_c
-    f = np.where(bk.slide, -(mu * bk.xi[:, None, :])[:, :, bk.contact], 0.0)[..., None]  # (S, N, k, 1): eqs. (18-20)
-    WAmu = batch.Wrows[:, None, idx] + f * batch.Wrows[:, None, partner]
-    JAmu = batch.Jrows[:, idx][:, :, E][:, None] + f * batch.Jrows[:, partner][:, :, E][:, None]
-    Q = np.concatenate([WAmu, JAmu], axis=3).swapaxes(2, 3)  # (S, N, k, k): Q_AI of eq. (26)
+    # Q_AI of eq. (26), (S, N, k, k): the solver's function with the rows of each state
+    Q = equilibrium_columns(batch.Wrows[:, None], batch.Jrows[:, None], batch.E, bk.idx, bk.contact, bk.slide,
+                            mu, bk.xi[:, None, :])  # fmt: skip
     det = np.linalg.det(Q)
     k = Q.shape[-1]
     e = np.zeros(k)

@@ -18,7 +18,15 @@ from qsplan.mechanics.modes.contact_mode import Letter
 from qsplan.mechanics.modes.kinematics import Kinematics, ScenePool
 from qsplan.mechanics.numerics import StatusCode, Tolerances, hadamard_ratio
 
-__all__ = ["sliding_friction", "coulomb_slacks", "worst_slack", "equilibrium_matrix", "contact_forces", "equilibrium_stage"]
+__all__ = [
+    "sliding_friction",
+    "coulomb_slacks",
+    "worst_slack",
+    "equilibrium_columns",
+    "equilibrium_matrix",
+    "contact_forces",
+    "equilibrium_stage",
+]
 
 
 def sliding_friction(mu, xi, c_n):
@@ -67,23 +75,51 @@ def worst_slack(codes, mu, c_n, c_t):
     return slack.min(axis=1)
 
 
-def equilibrium_matrix(pool: "ScenePool", kin: Kinematics, mu: np.ndarray) -> np.ndarray:
-    """``Q_AI`` of eq. (26) for every row: ``[W_Amu; J_AmuI^T]``, shape (m, k, k).
+def equilibrium_columns(Wrows, Jrows, E, idx, contact, slide, mu, xi) -> np.ndarray:
+    """``Q_AI = [W_Amu; J_AmuI^T]`` of eq. (26) from the constraint rows, over leading axes.
 
-    Column ``j`` belongs to the applicable constraint ``kin.idx[:, j]``; sliding
-    normal columns pick up ``-mu xi`` times the tangential column (eqs. 18-20).
+    Column ``j`` belongs to the applicable constraint ``idx[..., j]``; sliding normal columns
+    pick up ``-mu xi`` times the tangential column (eqs. 18-20).  Two layouts, as in
+    :func:`qsplan.mechanics.modes.kinematics.kinematics_matrix`: modes of one scene (rows
+    shared, ``idx`` one per mode) or states of a batch (rows per state, ``idx`` shared).
+
+    Parameters
+    ----------
+    Wrows : ndarray, shape (2 n_c, 3) or (..., 2 n_c, 3)
+        ``[W_n^T; W_t^T]``; with a leading state axis, add the axes of ``mu`` (e.g. ``(S, 1, 2 n_c, 3)``).
+    Jrows : ndarray, shape (2 n_c, n_j) or (..., 2 n_c, n_j)
+    E : ndarray of int
+        Effort-controlled joints.
+    idx, contact : ndarray of int, shape (m, k) or (k,)
+        Applicable rows and their contacts (:func:`qsplan.mechanics.modes.kinematics.applicable_rows`).
+    slide : ndarray of bool, shape (m, k) or (k,)
+        The row is the normal row of a sliding contact.
+    mu, xi : ndarray, broadcasting to shape (..., n_c)
+        Friction coefficients and sliding directions (eq. 16).
+
+    Returns
+    -------
+    ndarray, shape (..., k, k)
+    """
+    n_c = Wrows.shape[-2] // 2
+    mu_xi = mu * xi
+    at = np.broadcast_to(contact, mu_xi.shape[:-1] + contact.shape[-1:])
+    f = np.where(slide, -np.take_along_axis(mu_xi, at, axis=-1), 0.0)[..., None]
+    partner = contact + n_c
+    JE = Jrows[..., E]
+    WAmu = np.take(Wrows, idx, axis=-2) + f * np.take(Wrows, partner, axis=-2)  # (..., k, 3): columns of W_Amu
+    JAmu = np.take(JE, idx, axis=-2) + f * np.take(JE, partner, axis=-2)  # columns of J_AmuI^T
+    return np.concatenate([WAmu, JAmu], axis=-1).swapaxes(-1, -2)
+
+
+def equilibrium_matrix(pool: "ScenePool", kin: Kinematics, mu: np.ndarray) -> np.ndarray:
+    """``Q_AI`` of eq. (26) for every row of ``kin`` (:func:`equilibrium_columns`), shape (m, k, k).
 
     Parameters
     ----------
     mu : ndarray, shape (m, n_c)
     """
-    n_c = pool.Wrows.shape[0] // 2
-    idx, contact, E = kin.idx, kin.contact, pool.E
-    f = np.where(kin.slide, -np.take_along_axis(mu * kin.xi, contact, axis=1), 0.0)
-    partner = contact + n_c
-    WAmu = pool.Wrows[idx] + f[..., None] * pool.Wrows[partner]  # (m, k, 3): columns of W_Amu
-    JAmu = pool.Jrows[idx][:, :, E] + f[..., None] * pool.Jrows[partner][:, :, E]  # columns of J_AmuI^T
-    return np.concatenate([WAmu, JAmu], axis=2).transpose(0, 2, 1)
+    return equilibrium_columns(pool.Wrows, pool.Jrows, pool.E, kin.idx, kin.contact, kin.slide, mu, kin.xi)
 
 
 def contact_forces(kin: Kinematics, cA: np.ndarray, mu: np.ndarray, n_c: int):

@@ -1,11 +1,17 @@
-"""Kinematics of a contact mode, vectorized over modes (eqs. 13-16, 23-25).
+"""Kinematics of a contact mode, vectorized over modes or over states (eqs. 13-16, 23-25).
 
 For every mode of a batch: the applicable constraint rows (eq. 14), the partition
-``P_AI`` (eq. 23) solved for ``qdot, thetadot_I`` (eq. 24), the separation speeds of
-breaking contacts (eq. 25) and the sliding directions ``xi`` (eq. 16).  This is the
-one implementation of eqs. (23)-(25) that the batched solver, mu-space maps, effort
-bands and finite motion call; the one-mode reference
-(:func:`qsplan.mechanics.modes.reference.check_mode`) re-derives them on purpose.
+``P_AI`` (eq. 23) solved for ``qdot, thetadot_I`` (eq. 24), the contact velocities
+(eq. 5), the tests of breaking contacts (eq. 15, with eq. 25) and the sliding
+directions ``xi`` (eq. 16).  This is the one implementation of eqs. (23)-(25) that the
+batched solver, mu-space maps, effort bands, bands over a batch of states
+(:mod:`qsplan.mechanics.bands.batched`) and finite motion call.  Each function takes
+its rows from a *row pool*: a :class:`ScenePool` (the rows of one scene, shared by many
+modes) or a :class:`qsplan.mechanics.bands.batched.StateBatch` (the same attributes with
+a leading state axis, one mode); where a product depends on that layout the function
+keeps one numpy call per layout, so both stay bit-identical to their former selves.
+The one-mode reference (:func:`qsplan.mechanics.modes.reference.check_mode`) re-derives
+them on purpose.
 """
 
 from __future__ import annotations
@@ -23,8 +29,13 @@ __all__ = [
     "applicable_rows",
     "ScenePool",
     "Kinematics",
+    "kinematics_rows",
     "kinematics_matrix",
+    "contact_motion",
     "solve_kinematics",
+    "kinematic_status",
+    "sliding_directions",
+    "kinematic_tests",
     "kinematics_stage",
     "check_mode_fits",
     "single_mode_kinematics",
@@ -67,18 +78,54 @@ def applicable_rows(scene: Scene, codes: np.ndarray):
     return idx, contact, slide
 
 
+def kinematics_rows(Wrows, Jrows, velocity, E, V):
+    """The rows of ``P_AI`` of every constraint (eq. 23), their log norms and the drive of eq. (24).
+
+    One scene (rows shared by all its modes) or a stack of scenes (a leading state axis).
+
+    Parameters
+    ----------
+    Wrows : ndarray, shape (2 n_c, 3) or (S, 2 n_c, 3)
+        ``[W_n^T; W_t^T]``: the wrench of each constraint as a row.
+    Jrows : ndarray, shape (2 n_c, n_j) or (S, 2 n_c, n_j)
+        ``[J_n; J_t]``.
+    velocity : ndarray, shape (n_j,) or (S, n_j)
+        Joint velocities (those of effort-controlled joints unused).
+    E, V : ndarray of int
+        Effort- and velocity-controlled joints.
+
+    Returns
+    -------
+    M : ndarray, shape (..., 2 n_c, 3 + n_e)
+        ``[w^T, -J_I]`` per constraint: ``P_AI`` gathers its rows from it.
+    log_row_norm : ndarray, shape (..., 2 n_c)
+        ``log ||row||`` (``-inf`` for a zero row), the Hadamard ratio's denominator.
+    drive : ndarray, shape (..., 2 n_c)
+        ``J_II thetadot_II`` (m/s), the right-hand side of eq. (24).
+    """
+    M = np.concatenate([Wrows, -Jrows[..., E]], axis=-1)
+    with np.errstate(divide="ignore"):
+        log_row_norm = np.log(np.linalg.norm(M, axis=-1))
+    if Jrows.ndim == 2:  # one scene: a matrix-vector product
+        drive = Jrows[:, V] @ velocity[V]
+    else:  # one per state
+        drive = np.einsum("srj,sj->sr", Jrows[:, :, V], velocity[:, V])
+    return M, log_row_norm, drive
+
 
 class ScenePool:
-    """Per-scene arrays every batch gathers rows from (computed once per solve)."""
+    """Per-scene arrays every batch of modes gathers rows from (computed once per solve).
+
+    The same attributes as :class:`qsplan.mechanics.bands.batched.StateBatch` (which stacks
+    them over states), so the functions of eqs. (23)-(25) serve both.
+    """
 
     def __init__(self, scene: Scene):
         self.E, self.V = scene.effort_joints, scene.velocity_joints
         self.Wrows = np.vstack([scene.Wn.T, scene.Wt.T])  # (2 n_c, 3): w_n, w_t as rows
         self.Jrows = np.vstack([scene.Jn, scene.Jt])  # (2 n_c, n_j)
-        self.M = np.hstack([self.Wrows, -self.Jrows[:, self.E]])  # rows of P_AI (eq. 23)
-        with np.errstate(divide="ignore"):
-            self.log_row_norm = np.log(np.linalg.norm(self.M, axis=1))
-        self.drive = self.Jrows[:, self.V] @ scene.joint_velocity[self.V]  # right-hand side of eq. (24)
+        self.velocity = scene.joint_velocity
+        self.M, self.log_row_norm, self.drive = kinematics_rows(self.Wrows, self.Jrows, self.velocity, self.E, self.V)
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -113,39 +160,127 @@ class Kinematics:
         return Kinematics(*(getattr(self, f)[rows] for f in self.__slots__))
 
 
-def kinematics_matrix(pool: ScenePool, idx: np.ndarray) -> np.ndarray:
-    """``P_AI = [W_A^T, -J_AI]`` of every mode (eq. 23), shape (m, k, k) for ``idx`` (m, k) from :func:`applicable_rows`."""
-    return pool.M[idx]
-
-
-def solve_kinematics(scene: Scene, pool: ScenePool, idx: np.ndarray, P: np.ndarray):
-    """Eq. (24) for every mode, ``P_AI z_I = J_AII thetadot_II``, then the contact velocities (eq. 5).
+def kinematics_matrix(pool, idx: np.ndarray) -> np.ndarray:
+    """``P_AI = [W_A^T, -J_AI]`` (eq. 23) gathered from the rows ``pool.M`` (:func:`kinematics_rows`).
 
     Parameters
     ----------
-    idx : ndarray of int, shape (m, k)
-        Applicable rows (:func:`applicable_rows`).
-    P : ndarray, shape (m, k, k)
-        ``P_AI`` (:func:`kinematics_matrix`), nonsingular (raises ``numpy.linalg.LinAlgError`` otherwise).
+    pool : ScenePool or StateBatch
+        Rows of one scene, shape (2 n_c, k), or of a stack of states, shape (S, 2 n_c, k).
+    idx : ndarray of int, shape (m, k) or (k,)
+        Applicable rows (:func:`applicable_rows`): one set per mode (one scene), or one set
+        shared by the states.
 
     Returns
     -------
-    qdot : ndarray, shape (m, 3)
-    thetadot : ndarray, shape (m, n_j)
+    ndarray, shape (m, k, k) or (S, k, k)
+    """
+    return np.take(pool.M, idx, axis=-2)
+
+
+def contact_motion(pool, idx: np.ndarray, P: np.ndarray):
+    """Eq. (24), ``P_AI z_I = J_AII thetadot_II``, then the contact velocities (eq. 5).
+
+    Parameters
+    ----------
+    pool : ScenePool or StateBatch
+        Modes of one scene or states of a batch, as in :func:`kinematics_matrix`.
+    idx : ndarray of int, shape (m, k) or (k,)
+    P : ndarray, shape (R, k, k)
+        ``P_AI`` (:func:`kinematics_matrix`), nonsingular (raises ``numpy.linalg.LinAlgError``
+        otherwise); ``R`` rows are modes (one scene) or states.
+
+    Returns
+    -------
+    qdot : ndarray, shape (R, 3)
+    thetadot : ndarray, shape (R, n_j)
         Inputs at velocity-controlled joints, eq. (24)'s solution at effort-controlled ones.
-    v_n, v_t : ndarray, shape (m, n_c)
+    v_n, v_t : ndarray, shape (R, n_c)
         Relative contact velocities (eq. 5), m/s.
     """
-    n_c = scene.n_contacts
-    E, V = pool.E, pool.V
-    m = idx.shape[0]
-    z = np.linalg.solve(P, pool.drive[idx][..., None])[..., 0]  # eq. (24)
-    thetadot = np.empty((m, scene.n_joints))
-    thetadot[:, V] = scene.joint_velocity[V]
-    thetadot[:, E] = z[:, 3:]
-    qdot = z[:, :3]
-    v = qdot @ pool.Wrows.T - thetadot @ pool.Jrows.T  # eq. (5), (m, 2 n_c)
-    return qdot, thetadot, v[:, :n_c], v[:, n_c:]
+    n_c = pool.Wrows.shape[-2] // 2
+    z = np.linalg.solve(P, np.take(pool.drive, idx, axis=-1)[..., None])[..., 0]  # eq. (24)
+    thetadot = np.empty(z.shape[:-1] + pool.velocity.shape[-1:])
+    thetadot[..., pool.V] = pool.velocity[..., pool.V]
+    thetadot[..., pool.E] = z[..., 3:]
+    qdot = z[..., :3]
+    if pool.Wrows.ndim == 2:  # rows shared by the modes: two matrix products
+        v = qdot @ pool.Wrows.T - thetadot @ pool.Jrows.T  # eq. (5), (R, 2 n_c)
+    else:  # rows per state
+        v = np.einsum("sj,srj->sr", qdot, pool.Wrows) - np.einsum("sj,srj->sr", thetadot, pool.Jrows)
+    return qdot, thetadot, v[..., :n_c], v[..., n_c:]
+
+
+def solve_kinematics(scene: Scene, pool: ScenePool, idx: np.ndarray, P: np.ndarray):
+    """:func:`contact_motion` for modes of ``scene`` (``pool`` is its :class:`ScenePool`)."""
+    return contact_motion(pool, idx, P)
+
+
+def kinematic_status(codes: np.ndarray, v_n, v_t, vtol, singular: np.ndarray) -> np.ndarray:
+    """The kinematic verdict of eqs. (15)-(16) from the contact velocities, over any leading axes.
+
+    Parameters
+    ----------
+    codes : ndarray of uint8, shape (..., n_c)
+        Letter codes, broadcasting against ``v_n``.
+    v_n, v_t : ndarray, shape (..., n_c)
+        Relative contact velocities (eq. 5), m/s.
+    vtol : float or ndarray broadcasting against ``v_n``
+        Velocity tolerance (m/s).
+    singular : ndarray of bool, shape (...)
+        ``P_AI`` failed the Hadamard test; these keep ``KINEMATICS_SINGULAR``.
+
+    Returns
+    -------
+    ndarray of int8, shape (...)
+        The first failure in ``Status.ORDER`` (singular; a breaking contact approaching (15) or
+        not separating; a sliding contact at zero speed, where eq. (16) is undefined), 0 if none.
+    """
+    status = np.zeros(singular.shape, dtype=np.int8)
+    status[singular] = StatusCode.KINEMATICS_SINGULAR
+    alive = ~singular
+    brk = codes == _B
+    for code, bad in ((StatusCode.BREAKING_VIOLATED, np.any(brk & (v_n < -vtol), axis=-1)),  # eq. (15)
+                      (StatusCode.BREAKING_ZERO_SPEED, np.any(brk & (v_n <= vtol), axis=-1)),
+                      (StatusCode.ZERO_SLIDING_SPEED, np.any((codes == _S) & (np.abs(v_t) <= vtol), axis=-1))):  # eq. (16)
+        hit = alive & bad
+        status[hit] = code
+        alive &= ~hit
+    return status
+
+
+def sliding_directions(codes: np.ndarray, v_t, passed: np.ndarray) -> np.ndarray:
+    """``xi = sgn(v_t)`` at sliding contacts (eq. 16), 0 elsewhere and where ``passed`` (shape (...)) is False."""
+    return np.where((codes == _S) & passed[..., None], np.sign(v_t), 0.0)
+
+
+def kinematic_tests(pool, idx: np.ndarray, codes: np.ndarray, tol: Tolerances, vtol):
+    """The kinematic stage (eqs. 23-25, 15-16) on modes of one scene or on states of a batch.
+
+    Parameters
+    ----------
+    pool : ScenePool or StateBatch
+        As in :func:`kinematics_matrix`.
+    idx : ndarray of int, shape (m, k) or (k,)
+    codes : ndarray of uint8, shape (m, n_c) or (n_c,)
+    vtol : float or ndarray, shape (S, 1)
+        Velocity tolerance (m/s).
+
+    Returns
+    -------
+    status : ndarray of int8, shape (R,)
+        Codes into ``Status.ORDER``; 0 where the mode passed.
+    qdot : ndarray, shape (R, 3)
+    thetadot : ndarray, shape (R, n_j)
+    xi : ndarray, shape (R, n_c)
+        Sliding directions (:func:`sliding_directions`), 0 at rows that failed.
+    """
+    P = kinematics_matrix(pool, idx)
+    sing = ~(hadamard_ratio(P, log_row_norms=np.take(pool.log_row_norm, idx, axis=-1).sum(axis=-1)) >= tol.singular)
+    P[sing] = np.eye(P.shape[-1])
+    qdot, thetadot, v_n, v_t = contact_motion(pool, idx, P)
+    status = kinematic_status(codes, v_n, v_t, vtol, sing)
+    return status, qdot, thetadot, sliding_directions(codes, v_t, status == StatusCode.FEASIBLE)
 
 
 def kinematics_stage(scene: Scene, pool: "ScenePool", codes: np.ndarray, tol: Tolerances, vtol: float):
@@ -160,32 +295,10 @@ def kinematics_stage(scene: Scene, pool: "ScenePool", codes: np.ndarray, tol: To
     kin : Kinematics
         Their kinematic solution (independent of mu and of the effort inputs).
     """
-    m = codes.shape[0]
-    status = np.zeros(m, dtype=np.int8)
-
     idx, contact, slide = applicable_rows(scene, codes)
-    P = kinematics_matrix(pool, idx)
-    sing = ~(hadamard_ratio(P, log_row_norms=pool.log_row_norm[idx].sum(axis=1)) >= tol.singular)
-    status[sing] = StatusCode.KINEMATICS_SINGULAR
-    P[sing] = np.eye(P.shape[1])
-    qdot, thetadot, v_n, v_t = solve_kinematics(scene, pool, idx, P)
-
-    alive = ~sing
-    brk = codes == _B
-    b_viol = alive & np.any(brk & (v_n < -vtol), axis=1)  # eq. (15)
-    status[b_viol] = StatusCode.BREAKING_VIOLATED
-    alive &= ~b_viol
-    b_zero = alive & np.any(brk & (v_n <= vtol), axis=1)
-    status[b_zero] = StatusCode.BREAKING_ZERO_SPEED
-    alive &= ~b_zero
-    sld = codes == _S
-    s_zero = alive & np.any(sld & (np.abs(v_t) <= vtol), axis=1)  # eq. (16) undefined
-    status[s_zero] = StatusCode.ZERO_SLIDING_SPEED
-    alive &= ~s_zero
-
-    live = np.flatnonzero(alive)
-    xi = np.where(sld[live], np.sign(v_t[live]), 0.0)
-    kin = Kinematics(codes[live], idx[live], contact[live], slide[live], qdot[live], thetadot[live], xi)
+    status, qdot, thetadot, xi = kinematic_tests(pool, idx, codes, tol, vtol)
+    live = np.flatnonzero(status == StatusCode.FEASIBLE)
+    kin = Kinematics(codes[live], idx[live], contact[live], slide[live], qdot[live], thetadot[live], xi[live])
     return status, live, kin
 
 
