@@ -30,7 +30,7 @@ from qsplan.mechanics.errors import SceneError
 from qsplan.mechanics.model.friction import check_mu_range
 from qsplan.mechanics.modes.contact_mode import ContactMode, letters_to_codes
 from qsplan.mechanics.modes.equilibrium import equilibrium_columns
-from qsplan.mechanics.modes.kinematics import applicable_rows, check_mode_fits, kinematic_tests, kinematics_rows
+from qsplan.mechanics.modes.kinematics import applicable_rows, check_mode_fits, kinematic_tests, kinematics_rows, sliding_directions
 from qsplan.mechanics.numerics import DEFAULT_TOLERANCES, Status, StatusCode, Tolerances
 
 __all__ = [
@@ -188,7 +188,8 @@ def batch_kinematics(batch: StateBatch, mode, tol: Tolerances = DEFAULT_TOLERANC
     mode = check_mode_fits(batch.scenes[0], mode)
     codes = letters_to_codes(mode.letters)
     idx, contact, slide = (a[0] for a in applicable_rows(batch.scenes[0], codes[None, :]))
-    status, _, _, xi = kinematic_tests(batch, idx, codes, tol, batch.vtol[:, None])
+    status, _, _, v_t = kinematic_tests(batch, idx, codes, tol, batch.vtol[:, None])
+    xi = sliding_directions(codes, v_t, status == StatusCode.FEASIBLE)
     return BatchKinematics(mode, idx, contact, slide, status, xi)
 
 

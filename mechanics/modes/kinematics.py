@@ -272,15 +272,15 @@ def kinematic_tests(pool, idx: np.ndarray, codes: np.ndarray, tol: Tolerances, v
         Codes into ``Status.ORDER``; 0 where the mode passed.
     qdot : ndarray, shape (R, 3)
     thetadot : ndarray, shape (R, n_j)
-    xi : ndarray, shape (R, n_c)
-        Sliding directions (:func:`sliding_directions`), 0 at rows that failed.
+    v_t : ndarray, shape (R, n_c)
+        Tangential contact velocities (eq. 5), m/s: :func:`sliding_directions` gives ``xi``
+        (left to the caller, so the solver forms it for the surviving modes only: memory).
     """
     P = kinematics_matrix(pool, idx)
     sing = ~(hadamard_ratio(P, log_row_norms=np.take(pool.log_row_norm, idx, axis=-1).sum(axis=-1)) >= tol.singular)
     P[sing] = np.eye(P.shape[-1])
     qdot, thetadot, v_n, v_t = contact_motion(pool, idx, P)
-    status = kinematic_status(codes, v_n, v_t, vtol, sing)
-    return status, qdot, thetadot, sliding_directions(codes, v_t, status == StatusCode.FEASIBLE)
+    return kinematic_status(codes, v_n, v_t, vtol, sing), qdot, thetadot, v_t
 
 
 def kinematics_stage(scene: Scene, pool: "ScenePool", codes: np.ndarray, tol: Tolerances, vtol: float):
@@ -296,9 +296,10 @@ def kinematics_stage(scene: Scene, pool: "ScenePool", codes: np.ndarray, tol: To
         Their kinematic solution (independent of mu and of the effort inputs).
     """
     idx, contact, slide = applicable_rows(scene, codes)
-    status, qdot, thetadot, xi = kinematic_tests(pool, idx, codes, tol, vtol)
+    status, qdot, thetadot, v_t = kinematic_tests(pool, idx, codes, tol, vtol)
     live = np.flatnonzero(status == StatusCode.FEASIBLE)
-    kin = Kinematics(codes[live], idx[live], contact[live], slide[live], qdot[live], thetadot[live], xi[live])
+    xi = sliding_directions(codes[live], v_t[live], np.ones(live.size, dtype=bool))
+    kin = Kinematics(codes[live], idx[live], contact[live], slide[live], qdot[live], thetadot[live], xi)
     return status, live, kin
 
 
