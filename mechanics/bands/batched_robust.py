@@ -36,6 +36,7 @@ from qsplan.mechanics.bands.preclusion import (
     bernstein_matrix,
     cell_lower_bounds,
     competitor_torques,
+    friction_set,
     point_bands,
 )
 from qsplan.mechanics.bands.robust import assemble_robust_band
@@ -129,15 +130,7 @@ def competitor_torques_batch(batch: StateBatch, mode, lo, hi, g_lo, g_hi, shared
     n_c, S = batch.n_c, batch.size
     g_lo = np.broadcast_to(np.asarray(g_lo, dtype=float), (S,))
     g_hi = np.broadcast_to(np.asarray(g_hi, dtype=float), (S,))
-    if shared:
-        lo_a, hi_a = float(lo), float(hi)
-        if not (np.isfinite(lo_a) and np.isfinite(hi_a)) or lo_a < 0 or lo_a > hi_a:
-            raise SceneError(f"mu range: expected 0 <= lo <= hi, finite; got {lo}, {hi}")
-    else:
-        lo_a = np.broadcast_to(np.asarray(lo, float), (n_c,)).copy()
-        hi_a = np.broadcast_to(np.asarray(hi, float), (n_c,)).copy()
-        if np.any(lo_a > hi_a) or np.any(lo_a < 0) or not (np.all(np.isfinite(lo_a)) and np.all(np.isfinite(hi_a))):
-            raise SceneError(f"mu range: expected 0 <= lo <= hi, finite; got lo={lo_a.tolist()}, hi={hi_a.tolist()}")
+    lo_a, hi_a = friction_set(lo, hi, n_c, shared)
     if not np.all(g_lo <= g_hi):
         k = int(np.flatnonzero(~(g_lo <= g_hi))[0])
         raise SceneError(f"effort interval: expected g_lo <= g_hi; got {g_lo[k]}, {g_hi[k]}")

@@ -51,7 +51,8 @@ from qsplan.mechanics.errors import SceneError
 from qsplan.mechanics.modes.contact_mode import ContactMode
 from qsplan.mechanics.numerics import DEFAULT_TOLERANCES, Tolerances
 
-__all__ = ["MAX_CELLS", "PRECLUSION_RTOL", "CompetitorTorques", "bernstein_matrix", "cell_lower_bounds", "competitor_torques", "point_bands"]
+__all__ = ["MAX_CELLS", "PRECLUSION_RTOL", "CompetitorTorques", "bernstein_matrix", "cell_lower_bounds", "competitor_torques",
+           "friction_set", "point_bands"]
 
 #: Relative tolerance of the branch and bound (of the effort interval's largest finite
 #: edge, or 1 N m): the search stops when no cell can lower the bound by more.  The
@@ -331,6 +332,20 @@ def _search(cells: _Cells, lo_, hi_, flip, atol, budget, tol):
     return sign * value, exact, used, straddling
 
 
+def friction_set(lo, hi, n_c: int, shared: bool):
+    """The friction set, checked (``SceneError`` unless ``0 <= lo <= hi``, finite): floats, or shape (n_c,) (a box)."""
+    if shared:
+        lo_a, hi_a = float(lo), float(hi)
+        if not (np.isfinite(lo_a) and np.isfinite(hi_a)) or lo_a < 0 or lo_a > hi_a:
+            raise SceneError(f"mu range: expected 0 <= lo <= hi, finite; got {lo}, {hi}")
+        return lo_a, hi_a
+    lo_a = np.broadcast_to(np.asarray(lo, float), (n_c,)).copy()
+    hi_a = np.broadcast_to(np.asarray(hi, float), (n_c,)).copy()
+    if np.any(lo_a > hi_a) or np.any(lo_a < 0) or not (np.all(np.isfinite(lo_a)) and np.all(np.isfinite(hi_a))):
+        raise SceneError(f"mu range: expected 0 <= lo <= hi, finite; got lo={lo_a.tolist()}, hi={hi_a.tolist()}")
+    return lo_a, hi_a
+
+
 def competitor_torques(scene, mode, lo, hi, g_lo, g_hi, shared=False, tol: Tolerances = DEFAULT_TOLERANCES,
                        rtol: float = PRECLUSION_RTOL, max_cells: int = MAX_CELLS) -> CompetitorTorques:  # fmt: skip
     """Efforts in ``[g_lo, g_hi]`` for which ``mode`` is feasible for some friction in the set.
@@ -359,15 +374,7 @@ def competitor_torques(scene, mode, lo, hi, g_lo, g_hi, shared=False, tol: Toler
     """
     mode = mode if isinstance(mode, ContactMode) else ContactMode(str(mode).upper())
     n_c = scene.n_contacts
-    if shared:
-        lo_a, hi_a = float(lo), float(hi)
-        if not (np.isfinite(lo_a) and np.isfinite(hi_a)) or lo_a < 0 or lo_a > hi_a:
-            raise SceneError(f"mu range: expected 0 <= lo <= hi, finite; got {lo}, {hi}")
-    else:
-        lo_a = np.broadcast_to(np.asarray(lo, float), (n_c,)).copy()
-        hi_a = np.broadcast_to(np.asarray(hi, float), (n_c,)).copy()
-        if np.any(lo_a > hi_a) or np.any(lo_a < 0) or not (np.all(np.isfinite(lo_a)) and np.all(np.isfinite(hi_a))):
-            raise SceneError(f"mu range: expected 0 <= lo <= hi, finite; got lo={lo_a.tolist()}, hi={hi_a.tolist()}")
+    lo_a, hi_a = friction_set(lo, hi, n_c, shared)
     if not g_lo <= g_hi:
         raise SceneError(f"effort interval: expected g_lo <= g_hi; got {g_lo}, {g_hi}")
     mk = band_kinematics(scene, mode, tol)
