@@ -130,16 +130,14 @@ def _pool_context():
     return multiprocessing.get_context("forkserver" if "forkserver" in methods else "spawn")
 
 
-def _client(scheduler):
-    """A connected Dask client for ``scheduler`` and whether we own (must close) it."""
-    if not isinstance(scheduler, str):
-        if not (hasattr(scheduler, "map") and hasattr(scheduler, "gather")):
-            raise QsplanError(
-                f"scheduler: expected an address such as 'tcp://host:8786' or a dask.distributed Client; "
-                f"got {type(scheduler).__name__}"
-            )
-        return scheduler, False
-    return connect(scheduler, CONNECT_TIMEOUT), True
+def _check_client(scheduler):
+    """``scheduler`` when it is a Dask client (a caller's, not ours to close); else a named error."""
+    if not (hasattr(scheduler, "map") and hasattr(scheduler, "gather")):
+        raise QsplanError(
+            f"scheduler: expected an address such as 'tcp://host:8786' or a dask.distributed Client; "
+            f"got {type(scheduler).__name__}"
+        )
+    return scheduler
 
 
 def no_progress_timeout() -> float:
@@ -243,7 +241,7 @@ def map_chunks(fn, items, *, workers=None, scheduler=None, progress=None) -> lis
     if scheduler is not None:
         timeout = no_progress_timeout()
         if not isinstance(scheduler, str):
-            client = _client(scheduler)[0]
+            client = _check_client(scheduler)
             address = getattr(getattr(client, "scheduler", None), "address", "the client's")
             return _on_cluster(client, fn, items, address, timeout, progress)
         try:
@@ -253,7 +251,7 @@ def map_chunks(fn, items, *, workers=None, scheduler=None, progress=None) -> lis
                 f"scheduler: {scheduler} needs Dask distributed; install it with: pip install 'qsplan[cluster]'"
             ) from None
         with quiet_dask_logs():
-            client = _client(scheduler)[0]
+            client = connect(scheduler, CONNECT_TIMEOUT)
             try:
                 return _on_cluster(client, fn, items, scheduler, timeout, progress)
             finally:

@@ -39,10 +39,9 @@ from qsplan.mechanics.bands.preclusion import (
     friction_set,
     point_bands,
 )
-from qsplan.mechanics.bands.robust import assemble_robust_band
-from qsplan.mechanics.errors import QsplanError, SceneError
-from qsplan.mechanics.model.friction import check_mu_range
-from qsplan.mechanics.modes.contact_mode import ContactMode, enumerate_modes
+from qsplan.mechanics.bands.robust import assemble_robust_band, check_mu_pair
+from qsplan.mechanics.errors import SceneError
+from qsplan.mechanics.modes.contact_mode import enumerate_modes, mode_from_letters
 from qsplan.mechanics.numerics import DEFAULT_TOLERANCES, Tolerances
 
 __all__ = ["RootStats", "admissible_competitors_batch", "competitor_torques_batch", "robust_bands"]
@@ -126,7 +125,7 @@ def competitor_torques_batch(batch: StateBatch, mode, lo, hi, g_lo, g_hi, shared
     -------
     list of CompetitorTorques, length S
     """
-    mode = mode if isinstance(mode, ContactMode) else ContactMode(str(mode).upper())
+    mode = mode_from_letters(mode)
     n_c, S = batch.n_c, batch.size
     g_lo = np.broadcast_to(np.asarray(g_lo, dtype=float), (S,))
     g_hi = np.broadcast_to(np.asarray(g_hi, dtype=float), (S,))
@@ -181,7 +180,7 @@ def admissible_competitors_batch(batch: StateBatch, mode, tol: Tolerances = DEFA
     per_state : list of tuple of str, length S
     union : tuple of str
     """
-    mode = mode if isinstance(mode, ContactMode) else ContactMode(str(mode).upper())
+    mode = mode_from_letters(mode)
     s0 = batch.scenes[0]
     oks = [(m.letters, batch_kinematics(batch, m, tol).ok) for m in enumerate_modes(s0.n_contacts, s0.dof) if m.letters != mode.letters]
     per_state = [tuple(c for c, ok in oks if ok[s]) for s in range(batch.size)]
@@ -199,12 +198,8 @@ def robust_bands(scenes, mode, mu_range, *, shared: bool = False, competitors=No
     -------
     list of RobustBand, one per scene
     """
-    try:
-        lo, hi = (float(v) for v in mu_range)
-    except (TypeError, ValueError):
-        raise QsplanError(f"mu range: expected (LO, HI); got {mu_range!r}") from None
-    lo, hi = check_mu_range(lo, hi)
-    mode = mode if isinstance(mode, ContactMode) else ContactMode(str(mode).upper())
+    lo, hi = check_mu_pair(mu_range)
+    mode = mode_from_letters(mode)
 
     def per_batch(batch):
         if competitors is None:

@@ -128,9 +128,8 @@ class ForceMargin:
     def __post_init__(self):
         for name in ("normal", "slack"):
             v = getattr(self, name)
-            if isinstance(v, bool) or not isinstance(v, (int, float, np.integer, np.floating)):
-                raise QsplanError(f"force_margin.{name}: expected a nonnegative finite force (N); got {v!r}")
-            if not (np.isfinite(v) and v >= 0):
+            if (isinstance(v, bool) or not isinstance(v, (int, float, np.integer, np.floating))
+                    or not (np.isfinite(v) and v >= 0)):
                 raise QsplanError(f"force_margin.{name}: expected a nonnegative finite force (N); got {v!r}")
             object.__setattr__(self, name, float(v))
 
@@ -226,7 +225,7 @@ def band_rows(scene: Scene, mk: ModeKinematics, mu_rows, force_margin=None) -> t
         Force scale of each row set (N), for tolerances.
     """
     mu_rows = np.atleast_2d(np.asarray(mu_rows, dtype=float))
-    N, n_c = mu_rows.shape[0], scene.n_contacts
+    N = mu_rows.shape[0]
     kin = mk.kin.take(np.zeros(N, dtype=int))
     Q = equilibrium_matrix(mk.pool, kin, mu_rows)
     det = np.linalg.det(Q)
@@ -319,7 +318,7 @@ def effort_bands(scene: Scene, mode: ContactMode, mu_rows, tol: Tolerances = DEF
     N = mu_rows.shape[0]
     if not mk.ok:
         return np.full(N, np.nan), np.full(N, np.nan), np.zeros(N, dtype=bool)
-    s0, s1, det, scale = band_rows(scene, mk, mu_rows, force_margin)
+    s0, s1, _, scale = band_rows(scene, mk, mu_rows, force_margin)
     lower, upper, ok = intersect_rows(s0, s1, scale, tol)
     return lower, upper, ok
 

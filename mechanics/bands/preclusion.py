@@ -46,9 +46,10 @@ from math import comb
 
 import numpy as np
 
-from qsplan.mechanics.bands.effort import band_kinematics, band_rows
+from qsplan.mechanics.bands.effort import band_kinematics, band_rows, intersect_rows
+from qsplan.mechanics.bands.guaranteed import shared_nodes
 from qsplan.mechanics.errors import SceneError
-from qsplan.mechanics.modes.contact_mode import ContactMode
+from qsplan.mechanics.modes.contact_mode import mode_from_letters
 from qsplan.mechanics.numerics import DEFAULT_TOLERANCES, Tolerances
 
 __all__ = ["MAX_CELLS", "PRECLUSION_RTOL", "CompetitorTorques", "bernstein_matrix", "cell_lower_bounds", "competitor_torques",
@@ -113,8 +114,8 @@ class _Cells:
         n_c = scene.n_contacts
         self.n_c = n_c
         if shared:
-            self.deg = len(mk.mode.sliding) + 1
-            nodes = 0.5 * (lo + hi) + 0.5 * (hi - lo) * np.cos(np.pi * (np.arange(self.deg + 1) + 0.5) / (self.deg + 1))
+            nodes = shared_nodes(mk.mode, lo, hi)
+            self.deg = nodes.size - 1
             s0, s1, det, _ = band_rows(scene, mk, np.repeat(nodes[:, None], n_c, axis=1))
             V = np.vander(nodes, self.deg + 1, increasing=True)
             self.cdet = np.linalg.solve(V, det)  # (deg+1,) power-basis coefficients in mu
@@ -212,17 +213,8 @@ def _spread(det, N0, N1, d):
     return np.stack([np.max(np.abs(X[:, idx ^ (1 << i)] - X), axis=(1, 2)) for i in range(d)], axis=1)
 
 
-def point_bands(s0, s1, scale, tol: Tolerances):
-    """Band of each friction point from its rows ``s0 + tau s1 >= 0``: lower, upper, ok (n,)."""
-    big = np.max(np.abs(s1), axis=1, keepdims=True)
-    flat = np.abs(s1) <= tol.force * big
-    ftol = tol.force * scale[:, None]
-    with np.errstate(divide="ignore", invalid="ignore"):
-        edge = -s0 / s1
-    lower = np.max(np.where(~flat & (s1 > 0), edge, -np.inf), axis=1)
-    upper = np.min(np.where(~flat & (s1 < 0), edge, np.inf), axis=1)
-    ok = np.all(~flat | (s0 >= -ftol), axis=1) & (lower <= upper) & np.all(np.isfinite(s0), axis=1)
-    return lower, upper, ok
+#: The band of each friction point from its rows ``s0 + tau s1 >= 0``: the effort-band intersection itself.
+point_bands = intersect_rows
 
 
 def cell_lower_bounds(det, N0, N1, g_lo, g_hi, tol: Tolerances):
@@ -372,7 +364,7 @@ def competitor_torques(scene, mode, lo, hi, g_lo, g_hi, shared=False, tol: Toler
     -------
     CompetitorTorques
     """
-    mode = mode if isinstance(mode, ContactMode) else ContactMode(str(mode).upper())
+    mode = mode_from_letters(mode)
     n_c = scene.n_contacts
     lo_a, hi_a = friction_set(lo, hi, n_c, shared)
     if not g_lo <= g_hi:

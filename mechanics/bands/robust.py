@@ -28,7 +28,7 @@ from qsplan.mechanics.bands.guaranteed import guaranteed_band_box, guaranteed_ba
 from qsplan.mechanics.bands.preclusion import CompetitorTorques, competitor_torques
 from qsplan.mechanics.errors import QsplanError
 from qsplan.mechanics.model.friction import check_mu_range
-from qsplan.mechanics.modes.contact_mode import ContactMode, enumerate_modes
+from qsplan.mechanics.modes.contact_mode import enumerate_modes, mode_from_letters
 from qsplan.mechanics.numerics import Status
 
 __all__ = ["TOUCH_RTOL", "RobustBand", "admissible_competitors", "assemble_robust_band", "robust_band", "subtract_hull"]
@@ -115,17 +115,14 @@ def admissible_competitors(scenes, mode) -> tuple:
 
     A mode whose kinematics fail is infeasible for every effort and friction, so only these can compete.
     """
-    mode = _as_mode(mode)
+    mode = mode_from_letters(mode)
     scene0 = scenes[0]
     return tuple(m.letters for m in enumerate_modes(scene0.n_contacts, scene0.dof)
                  if m.letters != mode.letters and any(band_kinematics(s, m).ok for s in scenes))  # fmt: skip
 
 
-def _as_mode(mode) -> ContactMode:
-    return mode if isinstance(mode, ContactMode) else ContactMode(str(mode).upper())
-
-
-def _check_mu_range(mu_range):
+def check_mu_pair(mu_range):
+    """``(lo, hi)`` of a friction range given as a pair, checked (:func:`qsplan.mechanics.model.friction.check_mu_range`)."""
     try:
         lo, hi = (float(v) for v in mu_range)
     except (TypeError, ValueError):
@@ -165,8 +162,8 @@ def robust_band(scene, mode, mu_range, *, shared: bool = False, competitors=None
     ----------
     Trinkle & Zeng (1995), Section 5.2 (Figs. 12-13), eq. 28.
     """
-    lo, hi = _check_mu_range(mu_range)
-    mode = _as_mode(mode)
+    lo, hi = check_mu_pair(mu_range)
+    mode = mode_from_letters(mode)
     comps = admissible_competitors([scene], mode) if competitors is None else tuple(competitors)
     guaranteed = guaranteed_band_shared if shared else guaranteed_band_box
     desired = guaranteed(scene, mode, lo, hi, force_margin=force_margin)
@@ -183,7 +180,7 @@ def assemble_robust_band(mode, desired: Band, comps, torques: dict, mu_range, sh
     when ``desired`` is infeasible).  The one place :func:`robust_band` and its batched twin
     (:func:`qsplan.mechanics.bands.batched_robust.robust_bands`) cut the competitors out.
     """
-    mode = _as_mode(mode)
+    mode = mode_from_letters(mode)
     common = dict(mode=mode.letters, desired=desired, competitors=tuple(comps), mu_range=tuple(mu_range), shared=bool(shared))
     if not desired.feasible:
         return RobustBand(lower=np.nan, upper=np.nan, feasible=False, exact=bool(desired.exact), split=False,

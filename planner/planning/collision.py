@@ -98,18 +98,28 @@ def overlap_depth(region) -> float:
 
 @lru_cache(maxsize=16)
 def _structure(hand):
-    """``(manipulator, {(link, carrier): housing radius (m)})`` of ``hand`` (cached: hands are immutable)."""
+    """``(manipulator, palm polygon, {(link, carrier): (joint, housing radius (m), housing disk or None)})``.
+
+    Cached (hands are immutable). The disk is built here when the joint's axis cannot move (a
+    revolute joint on the palm), else per state from the joint's pose.
+    """
+    from shapely.geometry import Point
+
     from qsplan.hands.two_finger_scene import hand_manipulator
+    from qsplan.mechanics.model.manipulator import base_polygon, link_poses
 
     man = hand_manipulator(hand)
+    fixed_axes = link_poses(man, np.zeros(len(man.joints)))[:, :2]
     housings = {}
     for j, joint in enumerate(man.joints):
         if joint.link_shape is None:
             continue
         carrier = "palm" if joint.parent < 0 else man.joints[joint.parent].name
         y = np.asarray(joint.link_shape, float)[:, 1]
-        housings[(joint.name, carrier)] = (j, JOINT_HOUSING * float(y.max() - y.min()))
-    return man, housings
+        r = JOINT_HOUSING * float(y.max() - y.min())
+        disk = Point(fixed_axes[j]).buffer(r, 64) if joint.parent < 0 and joint.kind == "revolute" else None
+        housings[(joint.name, carrier)] = (j, r, disk)
+    return man, base_polygon(man), housings
 
 
 def find_collisions(hand, pose, q, first: bool = False) -> list:
@@ -136,9 +146,9 @@ def find_collisions(hand, pose, q, first: bool = False) -> list:
     from qsplan.mechanics.model.manipulator import link_polygons, link_poses
 
     q = np.asarray(q, float)
-    man, housings = _structure(hand)
+    man, palm, housings = _structure(hand)
     # the bodies of qsplan.hands.two_finger_scene.hand_polygons, from the cached manipulator (building it is 2/3 of the cost)
-    polys = {"palm": Polygon(man.base_shape), "workpiece": Polygon(workpiece_world(hand, pose))}
+    polys = {"palm": palm if palm is not None else Polygon(), "workpiece": Polygon(workpiece_world(hand, pose))}
     polys.update((j.name, p) for j, p in zip(man.joints, link_polygons(man, q)) if p is not None)
     axes = None
     out = []
@@ -149,9 +159,12 @@ def find_collisions(hand, pose, q, first: bool = False) -> list:
         region = A.intersection(B)
         joint = housings.get((a, b)) or housings.get((b, a))
         if joint is not None:
-            if axes is None:
-                axes = link_poses(man, q)[:, :2]
-            region = region.difference(Point(axes[joint[0]]).buffer(joint[1], 64))
+            j, r, disk = joint
+            if disk is None:
+                if axes is None:
+                    axes = link_poses(man, q)[:, :2]
+                disk = Point(axes[j]).buffer(r, 64)
+            region = region.difference(disk)
         if region.is_empty or region.area <= 0.0:
             continue
         depth = overlap_depth(region)

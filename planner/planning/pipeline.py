@@ -134,7 +134,7 @@ def run_plan(task, out_dir, *, seed: int = 1, planner: str = "RRTConnect", time_
     check_outputs(plan_outputs(out, plots), force)
     check_outputs([out / "failure.json"], force)  # an earlier run's report is an output too
     # with force: no output of an earlier run stays beside this run's (a failure, --no-plots, Ctrl-C)
-    remove_stale(out, [*PLAN_FILES, *(f"{n}.png" for n in PLAN_PLOTS), "failure.json"])
+    remove_stale(out, [p.name for p in plan_outputs(out, True)] + ["failure.json"])
     limit = DEFAULT_OPTIONS.time_limit if time_limit is None else time_limit
     if not (limit > 0 and limit < float("inf")):
         raise QsplanError(f"time_limit: expected a positive number of seconds; got {time_limit}")
@@ -178,8 +178,7 @@ def _certify(plan, out, files, progress):
     progress(certificate.summary())
     if certificate.ok:
         return certificate
-    for name in ("plan.csv", "plan.json"):  # never left where it looks like a plan
-        (out / name).unlink(missing_ok=True)
+    remove_stale(out, ("plan.csv", "plan.json"))  # never left where it looks like a plan
     report = CertificationReport(certificate)
     path = atomic_write(out / "failure.json", json.dumps(report.as_dict(), indent=1))
     raise PlanFailure(report, report_path=path)

@@ -5,7 +5,6 @@ from __future__ import annotations
 import numpy as np
 
 from qsplan.mechanics import SolveResult
-from qsplan.mechanics.numerics import Status
 
 __all__ = ["solve_result_to_dict", "format_solve_result"]
 
