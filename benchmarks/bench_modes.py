@@ -16,6 +16,7 @@ Usage, from the repository root, with qsplan installed (``pip install .``) or ``
 
 import argparse
 import csv
+import importlib.util
 import json
 import os
 import statistics
@@ -61,7 +62,7 @@ def time_solve(scene, repeat: int):
 
 def time_command(scene):
     """Wall-clock seconds of ``python -m qsplan.planner.cli modes FILE --json`` and its parsed output, or None."""
-    if not (ROOT / "planner" / "cli.py").exists():
+    if importlib.util.find_spec("qsplan.planner.cli") is None:  # (it was planner/cli.py, now a package)
         return None
     env = {**os.environ, "PYTHONPATH": os.pathsep.join(filter(None, [str(ROOT), os.environ.get("PYTHONPATH")]))}
     with tempfile.TemporaryDirectory() as tmp:

@@ -10,7 +10,9 @@ compute the right finger's torque band without friction (Fig. 10), at mu = 0.2
 guarantees 4S and precludes every competitor for friction in [0, 0.2] (Fig. 13):
 exactly, for independent coefficients (vertex theory) and for one shared
 coefficient (polynomial roots), beside the paper's sampled method.  The
-schedule a controller needs is exported as CSV and JSON.
+schedule a controller needs is exported as CSV and JSON, with the plans' command
+rule (one margin along the whole segment, at most two torque resolutions of
+0.02 N m), with or without a shared coefficient.
 
 A seeded spot check draws random instants, friction vectors in the box and
 torques in the guaranteed band, and confirms with the full solver that 4S is the
@@ -41,9 +43,11 @@ from qsplan.planner import (
     segment_band_figures,
     segment_bands,
 )
+from qsplan.planner.torque.command import with_segment_command
 
 SEED = 1995
 MU_RANGE = (0.0, 0.2)
+RESOLUTION = 0.02  # N m: the controller's torque resolution (the bundled tasks')
 
 
 def spot_check(bands, rng, n=40):
@@ -65,15 +69,16 @@ def main(out_dir="out"):
     rng = np.random.default_rng(SEED)
     hand = default_hand()
     samples = sample_segment(first_segment(hand, duration=10.0), 200)
-    box = segment_bands(samples, MU_RANGE, shared=False)
-    shared = segment_bands(samples, MU_RANGE, shared=True)
+    box = with_segment_command(segment_bands(samples, MU_RANGE, shared=False), RESOLUTION)
+    shared = with_segment_command(segment_bands(samples, MU_RANGE, shared=True), RESOLUTION)
 
     for name, fig in segment_band_figures(box).items():
         save_figure(fig, out / f"{name}.png")
-    fig, ax = new_axes(1, 1, size=(8.0, 5.2))
+    fig, ax = new_axes(1, 1, size=(8.0, 5.4))
     plot_guaranteed(shared, ax[0, 0])
+    ax[0, 0].set_title("Fig. 13: " + ax[0, 0].get_title(), fontsize=9.5)
     save_figure(fig, out / "fig13_guaranteed_shared.png")
-    export_schedule(box, out, stem="segment1", force=True)
+    export_schedule(box, out, stem="segment1", force=True, resolution=RESOLUTION)
 
     t = samples.t
     print(f"hand: workpiece {hand.workpiece_mass} kg, fingers {hand.finger_length} x {hand.finger_width} m at "

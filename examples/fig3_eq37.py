@@ -18,7 +18,8 @@ import numpy as np
 
 from qsplan.hands import eq37_scene
 from qsplan.mechanics import boundary_agreement, mu_slice, scene_from_dict, solve
-from qsplan.planner import new_axes, plot_contact_scene, plot_mu_map
+from qsplan.planner import new_axes, plot_contact_scene, save_figure
+from qsplan.planner.plotting.muspace import mu_slices_figure
 
 SEED = 37
 MU3 = (0.0, 0.5, 1.0, 2.0)
@@ -30,12 +31,11 @@ def main(out_dir="out") -> int:
     out.mkdir(parents=True, exist_ok=True)
     scene = scene_from_dict(eq37_scene())
     xs = np.linspace(0.0, 2.0, N)
-    fig, axes = new_axes(2, 2, size=(5.2, 4.6))
-    colours, areas = {}, {}
+    slices, areas = [], {}
     rng = np.random.default_rng(SEED)
-    for ax, mu3 in zip(axes.ravel(), MU3):
+    for mu3 in MU3:
         sl = mu_slice(scene, 0, 1, xs, xs, base_mu=[0.0, 0.0, mu3])
-        plot_mu_map(sl, ax=ax, title=f"eq. (37), $\\mu_3$ = {mu3:g}", colours=colours)
+        slices.append(sl)
         frac = sl.mumap.feasible.mean(axis=0)
         areas[mu3] = {m.name: float(f) for m, f in zip(sl.modes, frac) if f > 0}
         agree = boundary_agreement(sl)
@@ -49,8 +49,9 @@ def main(out_dir="out") -> int:
         print(f"mu3 = {mu3:<4g} areas {areas[mu3]}  jam {sl.mumap.jammed.mean():.1%}  "
               f"boundary: {agree.explained}/{agree.label_changes} label changes on exact curves, "
               f"{agree.spurious} spurious, {agree.excluded} excluded; solver spot-check mismatches {bad}/100")
-    fig.suptitle("Fig. 3 reproduced: the 3S region (1) shrinks as $\\mu_3$ grows; R1S2 (2) does not change")
-    fig.savefig(out / "fig3_eq37.png", dpi=110)
+    fig = mu_slices_figure(slices, [f"$\\mu_3$ = {mu3:g}" for mu3 in MU3],
+                           "Fig. 3 reproduced, eq. (37): the 3S region (1) shrinks as $\\mu_3$ grows; R1S2 (2) does not change")
+    save_figure(fig, out / "fig3_eq37.png")
 
     s3 = [areas[m].get("3S", 0.0) for m in MU3]
     rs = [areas[m].get("R1S2", 0.0) for m in MU3]
@@ -61,7 +62,7 @@ def main(out_dir="out") -> int:
 
     fig, axes = new_axes(1, 1, size=(6.5, 7.5))
     plot_contact_scene(scene, mode="SSS", mu=[0.3, 0.3, 0.3], ax=axes[0, 0])
-    fig.savefig(out / "fig4_eq37_scene.png", dpi=110, bbox_inches="tight")
+    save_figure(fig, out / "fig4_eq37_scene.png")
     print(f"wrote {out / 'fig3_eq37.png'} and {out / 'fig4_eq37_scene.png'}")
     return 0
 

@@ -18,7 +18,8 @@ import numpy as np
 
 from qsplan.hands import eq42_scene
 from qsplan.mechanics import boundary_agreement, mu_slice, polynomial_map, scene_from_dict, solve
-from qsplan.planner import new_axes, plot_contact_scene, plot_mu_map
+from qsplan.planner import new_axes, plot_contact_scene, save_figure
+from qsplan.planner.plotting.muspace import mu_slices_figure
 
 SEED = 42
 MU3 = (0.1, 0.3, 0.6, 1.0)
@@ -31,11 +32,10 @@ def main(out_dir="out") -> int:
     scene = scene_from_dict(eq42_scene())
     xs = np.linspace(0.0, 1.5, N)
     rng = np.random.default_rng(SEED)
-    fig, axes = new_axes(2, 2, size=(5.2, 4.6))
-    colours, seen, most = {}, set(), 0
-    for ax, mu3 in zip(axes.ravel(), MU3):
+    slices, seen, most = [], set(), 0
+    for mu3 in MU3:
         sl = mu_slice(scene, 0, 1, xs, xs, base_mu=[0.0, 0.0, mu3])
-        plot_mu_map(sl, ax=ax, title=f"eq. (42), $\\mu_3$ = {mu3:g}", colours=colours)
+        slices.append(sl)
         mm = sl.mumap
         seen |= {sl.modes[j].name for j in np.flatnonzero(mm.feasible.any(axis=0))}
         most = max(most, int(mm.feasible.sum(axis=1).max()))
@@ -48,8 +48,9 @@ def main(out_dir="out") -> int:
         print(f"mu3 = {mu3:<4g} ambiguous {mm.ambiguous.mean():.1%}, jam {mm.jammed.mean():.1%}; boundary: "
               f"{agree.explained}/{agree.label_changes} label changes on exact curves, {agree.spurious} spurious, "
               f"{agree.excluded} excluded; solver spot-check mismatches {bad}/100")
-    fig.suptitle("Fig. 6 reproduced: four modes, up to three feasible at once")
-    fig.savefig(out / "fig6_eq42.png", dpi=110)
+    fig = mu_slices_figure(slices, [f"$\\mu_3$ = {mu3:g}" for mu3 in MU3],
+                           "Fig. 6 reproduced, eq. (42): four modes, up to three feasible at once (stripes: ambiguous)")
+    save_figure(fig, out / "fig6_eq42.png")
 
     diagonal = np.repeat(np.linspace(0.0, 1.5, 1501)[:, None], 3, axis=1)
     first = int(np.flatnonzero(~polynomial_map(scene, diagonal).jammed)[0])
@@ -59,7 +60,7 @@ def main(out_dir="out") -> int:
 
     fig, axes = new_axes(1, 1, size=(6.5, 7.5))
     plot_contact_scene(scene, mode="SSS", ax=axes[0, 0])
-    fig.savefig(out / "fig5_eq42_scene.png", dpi=110, bbox_inches="tight")
+    save_figure(fig, out / "fig5_eq42_scene.png")
     print(f"wrote {out / 'fig6_eq42.png'} and {out / 'fig5_eq42_scene.png'}")
     return 0
 

@@ -4,7 +4,9 @@ A thin rod rests on two point supports at distances l1 and l2 from its centre of
 Only R1S2 and R2S1 satisfy the utility conditions; inequalities (40)-(41) put R2S1 above
 or on the line l1 mu2 = l2 mu1 and R1S2 below or on it.  The map over mu1, mu2 in [0, 1]
 is drawn with the exact region boundaries, which here are that one line through the
-origin; the script checks that every boundary point satisfies l1 mu2 = l2 mu1.
+origin, and with the paper's friction rectangle (sliding to rolling coefficients, those
+of ``rod_bouncing.py``), which lies inside the R2S1 region as in the paper's figure; the
+script checks that every boundary point satisfies l1 mu2 = l2 mu1.
 
 Usage, with qsplan installed (``pip install .``) or ``PYTHONPATH=.``:
 ``python examples/fig8_rod.py [OUT_DIR]`` (default ``out/``).
@@ -17,10 +19,12 @@ import numpy as np
 
 from qsplan.hands import rod_scene
 from qsplan.mechanics import boundary_agreement, mu_slice, scene_from_dict, solve
-from qsplan.planner import new_axes, plot_mu_map
+from qsplan.planner import save_figure
+from qsplan.planner.plotting.muspace import rod_mu_figure
 
 SEED = 8
 L1, L2 = 1.0, 0.6
+MU_STATIC, MU_KINETIC = (0.5, 0.5), (0.4, 0.4)  # the friction rectangle (rolling, sliding values), as in rod_bouncing.py
 N = 401
 
 
@@ -30,9 +34,7 @@ def main(out_dir="out") -> int:
     scene = scene_from_dict(rod_scene(l1=L1, l2=L2))
     xs = np.linspace(0.0, 1.0, N)
     sl = mu_slice(scene, 0, 1, xs, xs)
-    fig, axes = new_axes(1, 1, size=(6.0, 5.2))
-    plot_mu_map(sl, ax=axes[0, 0], title=f"rod, $l_1$ = {L1:g}, $l_2$ = {L2:g}: boundary $l_1 \\mu_2 = l_2 \\mu_1$")
-    fig.savefig(out / "fig8_rod.png", dpi=110)
+    save_figure(rod_mu_figure(sl, L1, L2, MU_STATIC, MU_KINETIC), out / "fig8_rod.png")
 
     curves = sl.boundary_curves()
     pts = np.vstack([c.points for c in curves])

@@ -1,4 +1,4 @@
-"""Plan the bundled regrasp like the paper's Fig. 9 from its task file, export it, and check it by re-simulation.
+"""Plan the bundled scripted sequence like the paper's Fig. 9 from its task file, export it, and re-simulate it.
 
 A quadrilateral workpiece slides on the palm in mode 4S three times (left, right,
 left), the fingers regrasping between segments.  The plan is written to
@@ -12,13 +12,13 @@ vectors drawn from the task's interval: all of it by one call, :func:`qsplan.pla
 
 import sys
 
-from qsplan.planner import demo_task_path, load_task, run_plan
+from qsplan.planner import load_task, run_plan, task_paths
 
 SEED = 1
 
 
 def main(out="out/examples/quadrilateral"):
-    task = load_task(demo_task_path())
+    task = load_task(task_paths()["scripted_regrasp_task"])  # waypoints given: the sequence is scripted
     run = run_plan(task, out, seed=SEED, verify=3, force=True, progress=lambda line: print("  " + line))
     plan = run.plan
     segment, t, width = plan.narrowest()

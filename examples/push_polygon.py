@@ -23,7 +23,7 @@ import numpy as np
 
 from qsplan.hands import tilted_box_example
 from qsplan.mechanics import MotionOptions, simulate
-from qsplan.planner import push_motion_figure
+from qsplan.planner import push_motion_figure, save_figure
 
 SEED = 5  # the run is deterministic; the seed only jitters the start for a robustness check
 
@@ -46,7 +46,7 @@ def main(out_dir="out"):
     jittered = simulate(*tilted_box_example(tilt=tilt), 6.0, options=MotionOptions(max_step=0.02))
     print(f"tilt {np.degrees(tilt):.2f} deg: modes {' -> '.join(jittered.labels)}")
 
-    push_motion_figure(motion).savefig(out / "push_polygon.png", dpi=110)
+    save_figure(push_motion_figure(motion), out / "push_polygon.png")
     print(f"wrote {out / 'push_polygon.png'}")
 
 

@@ -24,7 +24,7 @@ from pathlib import Path
 import numpy as np
 
 from qsplan.hands import rod_closed_form, simulate_rod
-from qsplan.planner import rod_motion_figure
+from qsplan.planner import rod_motion_figure, save_figure
 
 SEED = 20250105
 
@@ -52,12 +52,12 @@ def main(out_dir="out"):
     print("  first switches (s):", np.round(motion.switch_times[:6], 6).tolist())
     print("  closed form       :", np.round(cf.switch_times[:6], 6).tolist())
     print(f"  {motion.stopped.message}")
-    rod_motion_figure(motion, closed_form=cf).savefig(out / "rod_bouncing.png", dpi=110)
+    save_figure(rod_motion_figure(motion, closed_form=cf), out / "rod_bouncing.png")
 
     equal = dict(l1=1.0, l2=0.6, mu_static=(0.3, 0.3), mu_kinetic=(0.3, 0.3), speed=0.1, duration=20.0)
     motion, cf = compare(equal, "equal static and kinetic (0.3)")
     print(f"  {motion.stopped.message}")
-    rod_motion_figure(motion, closed_form=cf).savefig(out / "rod_equal_friction.png", dpi=110)
+    save_figure(rod_motion_figure(motion, closed_form=cf), out / "rod_equal_friction.png")
 
     for k in range(3):
         l1, l2 = rng.uniform(0.2, 1.0, size=2)

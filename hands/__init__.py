@@ -6,6 +6,9 @@
 * :mod:`qsplan.hands.two_finger` - the palm and two single-link fingers of Fig. 9 holding a polygon.
 * :mod:`qsplan.hands.two_finger_scene` - that hand's scene (geometric and raw) at a configuration.
 * :mod:`qsplan.hands.two_finger_analytic` - that scene at a grasp from the contacts the hand knows (the fast path).
+* :mod:`qsplan.hands.grasps` - where each finger touches (inner edge on a vertex, tip on an edge), in the user's numbering.
+* :mod:`qsplan.hands.grasp_geometry` - a grasp's joint angles, contacts and rates along the palm (vectorized).
+* :mod:`qsplan.hands.batch_scenes` - a grasp's scenes at many positions at once.
 * :mod:`qsplan.hands.segments` - manipulation segments of that hand (segment 1: translate left in 4S).
 
 Submodules are imported on first use so that ``import qsplan.hands`` stays light.
@@ -47,6 +50,30 @@ _LAZY = {
     "analytic_hand_scene": "qsplan.hands.two_finger_analytic",
     "grasp_contacts": "qsplan.hands.two_finger_analytic",
     "workpiece_world": "qsplan.hands.two_finger",
+    "tangency_angles": "qsplan.hands.two_finger",
+    "tangency_rates": "qsplan.hands.two_finger",
+    "scene_from_contacts": "qsplan.hands.two_finger_analytic",
+    "finger_jacobians": "qsplan.hands.two_finger_analytic",
+    "Grasp": "qsplan.hands.grasps",
+    "OnVertex": "qsplan.hands.grasps",
+    "TipOnEdge": "qsplan.hands.grasps",
+    "parse_placement": "qsplan.hands.grasps",
+    "parse_grasp": "qsplan.hands.grasps",
+    "parse_goal": "qsplan.hands.grasps",
+    "placement_matches": "qsplan.hands.grasps",
+    "internal_vertex": "qsplan.hands.grasps",
+    "internal_edge": "qsplan.hands.grasps",
+    "user_vertex": "qsplan.hands.grasps",
+    "user_edge": "qsplan.hands.grasps",
+    "GraspConfigurations": "qsplan.hands.grasp_geometry",
+    "grasp_configurations": "qsplan.hands.grasp_geometry",
+    "candidate_grasps": "qsplan.hands.grasp_geometry",
+    "tip_angles": "qsplan.hands.grasp_geometry",
+    "palm_range": "qsplan.hands.grasp_geometry",
+    "TIP_MARGIN": "qsplan.hands.grasp_geometry",
+    "SceneArrays": "qsplan.hands.batch_scenes",
+    "scene_arrays": "qsplan.hands.batch_scenes",
+    "grasp_scenes": "qsplan.hands.batch_scenes",
     "ManipulationSegment": "qsplan.hands.segments",
     "SegmentSamples": "qsplan.hands.segments",
     "first_segment": "qsplan.hands.segments",

@@ -5,12 +5,10 @@ surface is ``y = 0``.  Two fingers, thin rectangles of ``finger_length`` x
 ``finger_width`` (m), turn on revolute joints at ``(-finger_base, 0)`` ("left")
 and ``(+finger_base, 0)`` ("right"); a joint angle is the finger's direction
 measured counter-clockwise from +x (rad), so the left finger leans in at angles
-below pi/2 and the right one at angles above pi/2.  Each finger's inner long
-edge touches a vertex of the convex workpiece, whose bottom edge lies flat on
-the palm (two palm contacts, at its ends).
-
-:func:`finger_angles` puts each finger at the tangency with the workpiece (closed
-form); :mod:`qsplan.hands.two_finger_scene` turns a configuration into a scene.  Contacts are
+below pi/2 and the right one at angles above pi/2.  The convex workpiece's bottom edge
+lies flat on the palm (two palm contacts, at its ends); :func:`finger_angles` puts each
+finger's inner long edge on a workpiece vertex (the tangency, closed form), and
+:mod:`qsplan.hands.grasps` adds fingertips on edges.  Contacts are
 ordered palm (left end, right end of the bottom edge), left finger, right finger:
 mode ``"SSSS"`` is the paper's 4S and ``"RBSS"`` its R2S (the left palm vertex rolls,
 the workpiece turns counter-clockwise); with the default hand the R2S mode that
@@ -38,6 +36,8 @@ __all__ = [
     "finger_angle_rates",
     "finger_angles",
     "make_two_finger_hand",
+    "tangency_angles",
+    "tangency_rates",
     "workpiece_world",
 ]
 
@@ -78,6 +78,12 @@ class TwoFingerHand:
         m/s^2 along -y.
     mu : float
         Friction coefficient of every contact (scenes may override it).
+    vertex_order : tuple of int, shape (k,), optional
+        Internal vertex ``i`` is the vertex ``vertex_order[i]`` of the polygon as the user wrote it
+        (:func:`make_two_finger_hand` re-orders it); None: the identity (a hand built directly).
+    vertex_of_user : tuple of int, shape (k_user,), optional
+        The internal vertex of each row of the polygon as written (a repeated row, such as a closing
+        copy of the first, maps to the vertex it repeats); None: the identity.
     """
 
     workpiece: np.ndarray
@@ -90,6 +96,8 @@ class TwoFingerHand:
     palm_thickness: float
     gravity: float
     mu: float
+    vertex_order: tuple | None = None
+    vertex_of_user: tuple | None = None
 
     @property
     def rest_height(self) -> float:
@@ -134,6 +142,7 @@ def make_two_finger_hand(
     palm_thickness=0.02,
     gravity=9.81,
     mu=0.2,
+    palm_edge=None,
 ) -> TwoFingerHand:
     """Validate and build a :class:`TwoFingerHand`.
 
@@ -151,12 +160,16 @@ def make_two_finger_hand(
         m/s^2 along -y, nonnegative.
     mu : float
         Friction coefficient, nonnegative.
+    palm_edge : int, optional
+        The edge (0-based, numbered as written: edge ``K`` runs from vertex ``K`` to ``K + 1``) that
+        rests on the palm: the polygon is turned to lay it level at the bottom, and its centroid must
+        lie over it.  None: the polygon as given, whose two lowest vertices must be level.
 
     Raises
     ------
     SceneError
-        Naming the field: non-convex or degenerate workpiece, no level bottom edge,
-        non-positive sizes.
+        Naming the field: non-convex or degenerate workpiece, no level bottom edge, non-positive
+        sizes, a ``palm_edge`` out of range or that the workpiece cannot rest on.
     """
     from shapely.geometry import Polygon
 
@@ -166,15 +179,20 @@ def make_two_finger_hand(
     poly = Polygon(V)
     if abs(poly.convex_hull.area - poly.area) > 1e-12 * poly.area or len(np.asarray(poly.convex_hull.exterior.coords)) - 1 != len(V):
         raise SceneError("workpiece: expected a convex polygon with no straight vertices (the fingers touch its corners)")
+    raw = np.asarray(workpiece, dtype=float).reshape(-1, 2)  # the validated vertex of each row (repeats are dropped):
+    of_user = np.argmin(np.linalg.norm(raw[:, None] - V[None], axis=2), axis=1)
+    perm = np.arange(len(V))
     if not poly.exterior.is_ccw:
-        V = V[::-1]
+        V, perm = V[::-1], perm[::-1]
+    if palm_edge is not None:
+        V, poly = _lay_on_edge(V, perm, of_user, palm_edge)
     size = float(np.ptp(V, axis=0).max())
     order = np.argsort(V[:, 1], kind="stable")
     low = V[order[:2]]
     if abs(low[0, 1] - low[1, 1]) > _FLAT_TOL * size or abs(V[order[2], 1] - low[0, 1]) <= _FLAT_TOL * size:
         raise SceneError("workpiece: expected exactly two lowest vertices at the same height (the edge resting on the palm)")
     start = int(order[0] if V[order[0], 0] < V[order[1], 0] else order[1])
-    V = np.roll(V, -start, axis=0)
+    V, perm = np.roll(V, -start, axis=0), np.roll(perm, -start)
     if V[1, 0] <= V[0, 0] or abs(V[1, 1] - V[0, 1]) > _FLAT_TOL * size:
         raise SceneError("workpiece: the bottom edge must run left to right from vertex 0 (counter-clockwise order)")
     c = np.asarray(poly.centroid.coords[0])
@@ -191,10 +209,36 @@ def make_two_finger_hand(
         palm_thickness=_positive(palm_thickness, "palm_thickness", "m"),
         gravity=_positive(gravity, "gravity", "m/s^2", allow_zero=True),
         mu=float(check_friction(mu, "mu")),
+        vertex_order=tuple(int(np.flatnonzero(of_user == j)[0]) for j in perm),
+        vertex_of_user=tuple(int(i) for i in np.argsort(perm)[of_user]),
     )
     if hand.finger_width >= hand.finger_length:
         raise SceneError(f"finger_width: expected less than finger_length ({hand.finger_length} m); got {hand.finger_width}")
     return hand
+
+
+def _lay_on_edge(V, perm, of_user, palm_edge):
+    """``V`` (k, 2, counter-clockwise; ``perm`` its validated vertex order) turned so that the edge
+    ``palm_edge`` as written is level at the bottom, and its shapely Polygon."""
+    from shapely.geometry import Polygon
+
+    n_user = len(of_user)
+    if isinstance(palm_edge, (bool, np.bool_)) or not isinstance(palm_edge, (int, np.integer)) or not 0 <= palm_edge < n_user:
+        raise SceneError(f"palm_edge: expected an edge index in [0, {n_user}) of the workpiece as written; got {palm_edge!r}")
+    pos = np.argsort(perm)  # validated vertex -> position in V
+    a, b = pos[of_user[palm_edge]], pos[of_user[(palm_edge + 1) % n_user]]
+    if a == b:  # a row repeating its predecessor
+        raise SceneError(f"palm_edge: edge {palm_edge} of the workpiece as written has zero length")
+    a, b = (a, b) if (b - a) % len(V) == 1 else (b, a)  # counter-clockwise: the palm below the edge
+    d = V[b] - V[a]
+    V = V @ _rot(-np.arctan2(d[1], d[0])).T
+    level = 0.5 * (V[a, 1] + V[b, 1])  # the turn leaves ~1e-17 m of tilt: lay the edge exactly level
+    V[a, 1] = V[b, 1] = level
+    poly = Polygon(V)
+    if not V[a, 0] < poly.centroid.x < V[b, 0]:
+        raise SceneError(f"palm_edge: the workpiece cannot rest on edge {palm_edge}: its centroid (x = {poly.centroid.x:.6g} m "
+                         f"along the edge) is not over the edge [{V[a, 0]:.6g}, {V[b, 0]:.6g}] m")  # fmt: skip
+    return V, poly
 
 
 #: The workpiece of the default hand (m, before centring): an irregular quadrilateral 8 cm wide
@@ -225,28 +269,80 @@ def workpiece_world(hand: TwoFingerHand, pose) -> np.ndarray:
     return hand.workpiece @ _rot(pose[2]).T + pose[:2]
 
 
-def _tangency(hand: TwoFingerHand, V: np.ndarray):
-    """Finger angles (2,) touching the vertices ``V`` (k, 2) and the touching vertex of each (2,).
+def tangency_angles(hand: TwoFingerHand, V: np.ndarray):
+    """Finger angles touching the workpiece vertices ``V`` with their inner edges, batched over states.
 
     A vertex ``v`` lies outside the left finger when ``sin(phi - alpha_v) >= c / rho_v``
     (``rho_v, alpha_v`` its polar coordinates about the joint, ``c`` half the finger
     width): the finger touches the vertex with the largest ``alpha_v + asin(c / rho_v)``.
     The right finger, mirrored, touches the smallest ``alpha_v - asin(c / rho_v)``.
+
+    Parameters
+    ----------
+    V : ndarray, shape (n, k, 2)
+        World vertices of the workpiece in ``n`` states (m).
+
+    Returns
+    -------
+    phi : ndarray, shape (n, 2)
+        Left and right joint angles (rad), left in ``(-pi, 3 pi / 2]``, right in ``(-pi / 2, 2 pi)``; nan where not reached.
+    vertex : ndarray of int, shape (n, 2)
+        The touching vertex of each finger.
+    reached : ndarray of bool, shape (n, 2)
+        False where a vertex lies within ``c`` of the finger's joint axis (no tangent exists).
     """
-    c = 0.5 * hand.finger_width
-    phis, idx = np.empty(2), np.empty(2, dtype=int)
+    c, n = 0.5 * hand.finger_width, V.shape[0]
+    phis, idx, reached = np.empty((n, 2)), np.empty((n, 2), dtype=int), np.empty((n, 2), dtype=bool)
     for k, (sign, pick) in enumerate(((1.0, np.argmax), (-1.0, np.argmin))):
         d = V - hand.pivots[k]
-        rho = np.hypot(d[:, 0], d[:, 1])
-        if np.any(rho <= c):
-            raise SceneError(f"pose: the workpiece reaches the {JOINT_NAMES[k]} finger's joint axis")
-        alpha = np.arctan2(d[:, 1], d[:, 0])
+        rho = np.hypot(d[..., 0], d[..., 1])
+        reached[:, k] = np.all(rho > c, axis=1)
+        alpha = np.arctan2(d[..., 1], d[..., 0])
         if sign < 0:  # the right finger leans left: measure in [0, 2 pi) so that angles below its joint stay past pi
             alpha = np.mod(alpha, 2.0 * np.pi)
-        cand = alpha + sign * np.arcsin(c / rho)
-        i = int(pick(cand))
-        phis[k], idx[k] = cand[i], i
-    return phis, idx
+        with np.errstate(invalid="ignore", divide="ignore"):
+            cand = alpha + sign * np.arcsin(c / rho)
+        i = pick(cand, axis=1)
+        phis[:, k], idx[:, k] = cand[np.arange(n), i], i
+    phis[~reached] = np.nan
+    return phis, idx, reached
+
+
+def tangency_rates(hand: TwoFingerHand, d: np.ndarray, v: np.ndarray) -> np.ndarray:
+    """Joint rates (rad/s) that keep each finger's inner edge on its touching vertex, batched over states.
+
+    With the vertex at polar coordinates ``(rho, alpha)`` about the joint, ``phi = alpha +- asin(c / rho)``
+    (:func:`tangency_angles`), so ``dphi = dalpha -+ c drho / (rho sqrt(rho^2 - c^2))``.
+
+    Parameters
+    ----------
+    d, v : ndarray, shape (n, 2, 2)
+        The touching vertex of each finger (left, right) relative to its joint axis (m), and its velocity (m/s).
+
+    Returns
+    -------
+    ndarray, shape (n, 2)
+    """
+    c = 0.5 * hand.finger_width
+    sign = np.array([1.0, -1.0])
+    rho2 = _dot(d, d)
+    dalpha = (d[..., 0] * v[..., 1] - d[..., 1] * v[..., 0]) / rho2
+    drho = _dot(d, v) / np.sqrt(rho2)
+    return dalpha - sign * c * drho / (np.sqrt(rho2) * np.sqrt(rho2 - c * c))
+
+
+def _dot(a, b):
+    """Dot products over the last axis as ``a @ b`` computes one (matmul: the same rounding for one state or n)."""
+    return (a[..., None, :] @ b[..., :, None])[..., 0, 0]
+
+
+def _tangency(hand: TwoFingerHand, V: np.ndarray):
+    """:func:`tangency_angles` of one state ``V`` (k, 2): angles (2,) and touching vertices (2,)."""
+    phis, idx, reached = tangency_angles(hand, V[None])
+    for k in range(2):
+        if not reached[0, k]:
+            raise SceneError(f"pose: the workpiece reaches the {JOINT_NAMES[k]} finger's joint axis")
+    return phis[0], idx[0]
 
 
 def finger_angles(hand: TwoFingerHand, pose) -> tuple:
@@ -285,9 +381,7 @@ def finger_angles(hand: TwoFingerHand, pose) -> tuple:
 def finger_angle_rates(hand: TwoFingerHand, pose, pose_rate) -> np.ndarray:
     """Joint velocities (rad/s), shape (2,), that keep both fingers touching while the workpiece moves.
 
-    Differentiates :func:`finger_angles` in closed form: with the touching vertex at
-    polar coordinates ``(rho, alpha)`` about the joint, ``phi = alpha +- asin(c / rho)``
-    and ``dphi = dalpha -+ c drho / (rho sqrt(rho^2 - c^2))``.
+    Differentiates :func:`finger_angles` in closed form (:func:`tangency_rates`).
 
     Parameters
     ----------
@@ -300,15 +394,7 @@ def finger_angle_rates(hand: TwoFingerHand, pose, pose_rate) -> np.ndarray:
     rate = np.asarray(pose_rate, dtype=float)
     V = workpiece_world(hand, pose)
     _, idx = _tangency(hand, V)
-    c = 0.5 * hand.finger_width
-    out = np.empty(2)
-    for k, sign in enumerate((1.0, -1.0)):
-        p = V[idx[k]]
-        r = p - pose[:2]
-        v = rate[:2] + rate[2] * np.array([-r[1], r[0]])  # velocity of the touching vertex
-        d = p - hand.pivots[k]
-        rho2 = d @ d
-        dalpha = (d[0] * v[1] - d[1] * v[0]) / rho2
-        drho = (d @ v) / np.sqrt(rho2)
-        out[k] = dalpha - sign * c * drho / (np.sqrt(rho2) * np.sqrt(rho2 - c * c))
-    return out
+    p = V[idx]
+    r = p - pose[:2]
+    v = rate[:2] + rate[2] * np.stack([-r[:, 1], r[:, 0]], axis=1)  # velocity of the touching vertices
+    return tangency_rates(hand, (p - hand.pivots)[None], v[None])[0]

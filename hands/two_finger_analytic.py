@@ -2,12 +2,14 @@
 
 At a grasp the hand's contacts are known: the workpiece's bottom edge lies on the
 palm (contacts at its two ends, normal the edge's inward normal, +y when level) and
-each finger's inner edge touches one workpiece vertex (the tangency of
+each finger either touches one workpiece vertex with its inner edge (the tangency of
 :func:`qsplan.hands.two_finger.finger_angles`; normal the edge's outward normal,
-into the workpiece).  :func:`grasp_contacts` finds them in closed form and checks,
+into the workpiece) or one workpiece edge with a corner (a fingertip,
+:mod:`qsplan.hands.grasp_geometry`; normal the edge's inward normal).
+:func:`grasp_contacts` finds them in closed form and checks,
 with margins, that the polygon search (:func:`qsplan.mechanics.model.geometry.find_contacts`)
 would find exactly these four and nothing else; :func:`analytic_hand_scene` turns
-them into the :class:`qsplan.mechanics.Scene` that
+them into the :class:`qsplan.mechanics.Scene` (:func:`scene_from_contacts`, the one builder) that
 :func:`qsplan.hands.two_finger_scene.hand_scene` builds by the generic path, to
 round-off (the tests compare the two on hundreds of configurations).  Where the
 check fails (a finger flush with an edge, a tip or corner near the workpiece, the
@@ -28,7 +30,7 @@ from qsplan.mechanics.model.contact import wrench_matrices
 from qsplan.mechanics.model.geometry import CONTACT_TOL
 from qsplan.mechanics.model.scene import Scene
 
-__all__ = ["GraspContacts", "analytic_hand_scene", "grasp_contacts"]
+__all__ = ["GraspContacts", "analytic_hand_scene", "finger_jacobians", "grasp_contacts", "gravity_efforts", "scene_from_contacts"]
 
 #: Margins (in contact tolerances) of the closed-form check: a feature the polygon search must
 #: find lies within NEAR tolerances, one it must not find beyond FAR; values between fall back
@@ -50,16 +52,19 @@ class GraspContacts:
     Attributes
     ----------
     points : ndarray, shape (4, 2)
-        Contact points ``r_i``, world frame (m): workpiece vertices.
+        Contact points ``r_i``, world frame (m): workpiece vertices, or finger corners (tips).
     normals : ndarray, shape (4, 2)
         Unit normals ``n_i`` into the workpiece.
-    vertices : ndarray of int, shape (4,)
-        The workpiece vertex of each contact.
+    features : ndarray of int, shape (4,)
+        The workpiece vertex of each contact, or for a fingertip the workpiece edge it lies on.
+    tips : ndarray of bool, shape (2,)
+        Whether each finger touches with a tip corner (on an edge) rather than its inner edge (on a vertex).
     """
 
     points: np.ndarray
     normals: np.ndarray
-    vertices: np.ndarray
+    features: np.ndarray
+    tips: np.ndarray
 
 
 @lru_cache(maxsize=16)
@@ -74,7 +79,7 @@ def _constants(hand: TwoFingerHand):
     # hand_manipulator's link shape is (0, -w), (L, -w), (L, w), (0, w): the left finger touches with its
     # first edge (outward normal -y), the right one with its third (outward normal +y)
     inner = (((0.0, -w), (L, -w)), ((L, w), (0.0, w)))
-    return corners_only, inner, tuple(map(tuple, hand.pivots.tolist()))
+    return corners_only, inner, tuple(map(tuple, hand.pivots.tolist())), ((0.0, -w), (L, -w), (L, w), (0.0, w))
 
 
 def _segment_distance(p, a, b) -> float:
@@ -109,12 +114,13 @@ def grasp_contacts(hand: TwoFingerHand, pose, q, tol: float = CONTACT_TOL) -> Gr
     GraspContacts or None
         None unless: the bottom edge's two ends are within ``NEAR * tol`` of the palm's top and every other
         vertex above ``FAR * tol``; each finger's inner edge is within ``NEAR * tol`` of one workpiece vertex,
-        ``FAR * tol`` inside its ends, every other vertex beyond ``FAR * tol``; and no end of the palm's top
+        ``FAR * tol`` inside its ends, every other vertex beyond ``FAR * tol`` (or a finger corner within ``NEAR * tol``
+        of one workpiece edge, ``FAR * tol`` inside its ends, the finger outside its line, :func:`_tip_contact`); and no end of the palm's top
         edge or of a finger's inner edge within ``FAR * tol`` of a workpiece edge, nor a workpiece edge lying
         along one of them (an edge-edge contact) but the bottom edge on the palm.
     """
     # plain floats: a handful of numbers per state, where numpy's per-call overhead would dominate
-    corners_only, inner, pivots = _constants(hand)
+    corners_only, inner, pivots, shape = _constants(hand)
     if not corners_only:
         return None
     near, far = NEAR * tol, FAR * tol
@@ -128,8 +134,8 @@ def grasp_contacts(hand: TwoFingerHand, pose, q, tol: float = CONTACT_TOL) -> Gr
     # (edge ends, unit normal into the workpiece, workpiece edges to check (index, test facing)): the palm's top
     # edge right to left (the palm ring's order), with the edges at the bottom edge's ends; then each finger's inner edge
     bodies = [((halfwidth, 0.0), (-halfwidth, 0.0), (0.0, 1.0), ((k - 1, True), (0, False), (1, True)))]
-    touch = []
-    for (ax, ay), ends, qf in zip(pivots, inner, q):
+    touch, tips, tip_points, tip_normals = [], [False, False], {}, {}
+    for f, ((ax, ay), ends, qf) in enumerate(zip(pivots, inner, q)):
         # the link's corners as qsplan.mechanics.model.manipulator.link_polygons computes them
         c, s = math.cos(qf), math.sin(qf)
         (e0x, e0y), (e1x, e1y) = ((ax + (c * lx - s * ly), ay + (s * lx + c * ly)) for lx, ly in ends)
@@ -141,7 +147,12 @@ def grasp_contacts(hand: TwoFingerHand, pose, q, tol: float = CONTACT_TOL) -> Gr
         along = ((P[i][0] - e0x) * dx + (P[i][1] - e0y) * dy) / length
         others = min(d for j, d in enumerate(dist) if j != i)
         if not (abs(dist[i]) <= near and others > far and far < along < length - far):
-            return None
+            tip = _tip_contact(P, [(ax + (c * lx - s * ly), ay + (s * lx + c * ly)) for lx, ly in shape], near, far)
+            if tip is None:
+                return None
+            touch.append(tip[0])
+            tips[f], tip_points[f], tip_normals[f] = True, tip[1], tip[2]
+            continue
         touch.append(i)
         bodies.append(((e0x, e0y), (e1x, e1y), (nx, ny), (((i - 1) % k, True), (i, True))))
     if not _clear(P, bodies, near, far):
@@ -149,9 +160,47 @@ def grasp_contacts(hand: TwoFingerHand, pose, q, tol: float = CONTACT_TOL) -> Gr
     ex, ey = P[1][0] - P[0][0], P[1][1] - P[0][1]
     size = math.sqrt(ex * ex + ey * ey)
     bottom = _unit((-(ey / size), -(-ex / size)))  # the bottom edge's inward normal
-    normals = np.stack([bottom, bottom, _unit(bodies[1][2]), _unit(bodies[2][2])])
-    vertices = np.array([0, 1, *touch])
-    return GraspContacts(V[vertices], normals, vertices)
+    fingers = iter(bodies[1:])
+    normals, points = [bottom, bottom], [V[0], V[1]]
+    for f in range(2):
+        normals.append(_unit(tip_normals[f]) if tips[f] else _unit(next(fingers)[2]))
+        points.append(np.array(tip_points[f]) if tips[f] else V[touch[f]])
+    return GraspContacts(np.stack(points), np.stack(normals), np.array([0, 1, *touch]), np.array(tips))
+
+
+def _tip_contact(P, corners, near, far):
+    """``(edge, point, normal into the workpiece)`` where one finger corner touches one workpiece edge and nothing
+    else can touch (see :func:`grasp_contacts`), else None.  ``P``: the workpiece's world vertices, ``corners``: the
+    finger's four world corners in the link ring's order, pairs of floats."""
+    k = len(P)
+    best = None
+    for j in range(k):  # the edge whose line the finger lies outside of and touches
+        (x0, y0), (x1, y1) = P[j], P[(j + 1) % k]
+        size = math.hypot(x1 - x0, y1 - y0)
+        ex, ey = (x1 - x0) / size, (y1 - y0) / size
+        dist = [(cx - x0) * ey - (cy - y0) * ex for cx, cy in corners]  # signed, positive outside the workpiece
+        if min(dist) >= -near and (best is None or min(dist) < best[1]):
+            best = (j, min(dist), dist, (ex, ey), size)
+    if best is None:
+        return None
+    j, low, dist, (ex, ey), size = best
+    c = min(range(4), key=dist.__getitem__)
+    corner, (x0, y0) = corners[c], P[j]
+    along = (corner[0] - x0) * ex + (corner[1] - y0) * ey
+    if not (abs(low) <= near and min(d for i, d in enumerate(dist) if i != c) > far and far < along < size - far):
+        return None
+    sides = [(corners[c], corners[(c + 1) % 4]), (corners[(c - 1) % 4], corners[c])]  # the finger edges at the corner
+    if any(_segment_distance(corner, P[i], P[(i + 1) % k]) <= far for i in range(k) if i != j):
+        return None
+    if any(_segment_distance(v, a, b) <= far for v in P for a, b in sides):
+        return None
+    for a, b in sides:  # an edge of the finger lying along edge j (an edge-edge contact, the polygon search's facing test)
+        sa, sb = (a[0] - x0) * ex + (a[1] - y0) * ey, (b[0] - x0) * ex + (b[1] - y0) * ey
+        lo, hi = max(0.0, min(sa, sb)), min(size, max(sa, sb))
+        ends = [(x0 + t * ex, y0 + t * ey) for t in (lo, hi)]
+        if hi - lo >= near and all(_segment_distance(e, a, b) <= far for e in ends):
+            return None
+    return j, corner, (-ey, ex)
 
 
 def _clear(P, bodies, near, far) -> bool:
@@ -188,24 +237,39 @@ def _clear(P, bodies, near, far) -> bool:
     return True
 
 
-def _finger_jacobian(hand, points, normals):
-    """Contact Jacobian rows ``j_in, j_it`` (eq. 5), shape (2, 2, 2) [finger, row, joint], of each finger's contact
-    point ``points[k]`` (m) with normal ``normals[k]``: a point on a link turning about the fixed axis ``a_k``
-    moves at ``ez x (p - a_k) qdot_k``, the only nonzero column of its point Jacobian (the general tree is
-    :func:`qsplan.mechanics.model.manipulator.contact_jacobian`, which the tests compare against)."""
-    out = np.empty((2, 2, 2))
-    for k, ((ax, ay), (px, py), normal) in enumerate(zip(_constants(hand)[2], points.tolist(), normals)):
-        Jp = np.zeros((2, 2))
-        Jp[0, k], Jp[1, k] = -(py - ay), px - ax
-        n = normal / np.hypot(*normal)
-        out[k] = np.array([n, [-n[1], n[0]]]) @ Jp  # [n^T; t^T] Jp, t = n turned +90 degrees
-    return out
+def finger_jacobians(hand: TwoFingerHand, points, normals) -> np.ndarray:
+    """Contact Jacobian rows ``j_in, j_it`` (eq. 5) of each finger's contact, batched over states.
+
+    A point ``p`` on a link turning about the fixed axis ``a_k`` moves at ``ez x (p - a_k) qdot_k``, the only
+    nonzero column of its point Jacobian; the rows are ``[n^T; t^T] J_p`` with ``t`` the normal turned +90
+    degrees (the general tree is :func:`qsplan.mechanics.model.manipulator.contact_jacobian`, which the tests
+    compare against).
+
+    Parameters
+    ----------
+    points : ndarray, shape (..., 2, 2)
+        Each finger's contact point (m), left then right.
+    normals : ndarray, shape (..., 2, 2)
+        Their normals into the workpiece (normalised here).
+
+    Returns
+    -------
+    ndarray, shape (..., 2, 2, 2)
+        ``[finger, row (n, t), joint]`` (m).
+    """
+    rel = points - hand.pivots
+    Jp = np.zeros(rel.shape[:-2] + (2, 2, 2))  # [finger, x/y, joint]
+    for k in range(2):
+        Jp[..., k, 0, k], Jp[..., k, 1, k] = -rel[..., k, 1], rel[..., k, 0]
+    n = normals / np.hypot(normals[..., 0], normals[..., 1])[..., None]
+    return np.stack([n, np.stack([-n[..., 1], n[..., 0]], axis=-1)], axis=-2) @ Jp
 
 
-def _gravity_efforts(hand, q):
-    """``g_man`` (eq. 3), shape (2,): each finger's weight at half its length, ``m g (L/2) cos q_k`` (N m)."""
+def gravity_efforts(hand: TwoFingerHand, q) -> np.ndarray:
+    """``g_man`` (eq. 3), shape (..., 2): each finger's weight at half its length, ``m g (L/2) cos q_k`` (N m)."""
+    q = np.asarray(q, dtype=float)
     if hand.finger_mass == 0.0:
-        return np.zeros(2)
+        return np.zeros(q.shape)
     pivots = hand.pivots
     com_x = pivots[:, 0] + (np.cos(q) * (0.5 * hand.finger_length) - np.sin(q) * 0.0)
     return hand.finger_mass * hand.gravity * (com_x - pivots[:, 0])
@@ -237,16 +301,41 @@ def analytic_hand_scene(hand: TwoFingerHand, pose, q, effort_controlled, velocit
     Returns
     -------
     Scene or None
-        Equal to the generic path's scene to round-off: ``W_n, W_t`` (eq. 1), ``J_n, J_t`` (eq. 5; zero rows
-        on the palm), ``g_obj`` the workpiece weight at its centre of mass (eq. 2), ``g_man`` (eq. 3).
+        :func:`scene_from_contacts` at the contacts of :func:`grasp_contacts`: equal to the generic path's
+        scene to round-off.
     """
     pose = np.asarray(pose, dtype=float)
     q = np.asarray(q, dtype=float)
     found = grasp_contacts(hand, pose, q)
     if found is None:
         return None
-    Wn, Wt = wrench_matrices(found.points, found.normals)
-    J = _finger_jacobian(hand, found.points[2:], found.normals[2:])
+    return scene_from_contacts(hand, pose, q, found.points, found.normals, effort_controlled, velocity, effort, mu)
+
+
+def scene_from_contacts(hand: TwoFingerHand, pose, q, points, normals, effort_controlled, velocity=0.0, effort=0.0,
+                        mu=None):  # fmt: skip
+    """The hand's :class:`qsplan.mechanics.Scene` with the four contacts ``points``, ``normals`` (the one builder).
+
+    Parameters
+    ----------
+    pose : ndarray, shape (3,)
+        Workpiece ``(x, y, theta)`` (m, m, rad).
+    q : ndarray, shape (2,)
+        Joint angles (rad).
+    points, normals : ndarray, shape (4, 2)
+        Contacts in the hand's order (palm left end, palm right end, left finger, right finger): points (m) and
+        normals into the workpiece (eq. 1).
+    effort_controlled, velocity, effort, mu
+        As :func:`analytic_hand_scene` takes them (validated by the caller).
+
+    Returns
+    -------
+    Scene
+        ``W_n, W_t`` (eq. 1), ``J_n, J_t`` (eq. 5; zero rows on the palm), ``g_obj`` the workpiece weight at its
+        centre of mass (eq. 2), ``g_man`` (eq. 3).
+    """
+    Wn, Wt = wrench_matrices(points, normals)
+    J = finger_jacobians(hand, points[2:], normals[2:])
     Jn, Jt = np.zeros((4, 2)), np.zeros((4, 2))  # the palm's rows are zero
     Jn[2:], Jt[2:] = J[:, 0], J[:, 1]
     weight = -hand.workpiece_mass * hand.gravity
@@ -255,7 +344,7 @@ def analytic_hand_scene(hand: TwoFingerHand, pose, q, effort_controlled, velocit
     return Scene(
         Wn=_frozen(Wn), Wt=_frozen(Wt), Jn=_frozen(Jn), Jt=_frozen(Jt),
         mu=_frozen(np.full(4, hand.mu if mu is None else float(mu))), g_obj=_frozen(g_obj),
-        g_man=_frozen(_gravity_efforts(hand, q)), effort_controlled=_frozen(e),
+        g_man=_frozen(gravity_efforts(hand, q)), effort_controlled=_frozen(e),
         joint_velocity=_frozen(np.where(e, np.nan, float(velocity))),
         joint_effort=_frozen(np.where(e, float(effort), np.nan)),
         joint_names=JOINT_NAMES, contact_names=_CONTACT_NAMES,

@@ -48,7 +48,8 @@ def hand_geometric_scene(hand: TwoFingerHand, pose, q=None, effort_joint="right"
     pose : array-like, shape (3,)
         Workpiece ``(x, y, theta)`` (m, m, rad).
     q : array-like, shape (2,), optional
-        Joint angles (rad); default :func:`finger_angles`.
+        Joint angles (rad); default :func:`finger_angles` (both inner edges on vertices; a fingertip grasp's
+        come from :func:`qsplan.hands.grasp_geometry.grasp_configurations`).
     effort_joint : {"left", "right"}
         The effort-controlled (torque) joint; the other is velocity-controlled.
     velocity : float

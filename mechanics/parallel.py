@@ -18,16 +18,15 @@ when a scheduler is given.
 from __future__ import annotations
 
 import dataclasses
-import multiprocessing
 import os
 import pickle
 import threading
-from concurrent.futures import ProcessPoolExecutor
-from concurrent.futures.process import BrokenProcessPool
 from functools import partial
 
-from qsplan.mechanics.cluster import connect, gather_with_progress, quiet_dask_logs
 from qsplan.mechanics.errors import ParallelError, QsplanError
+
+# multiprocessing, concurrent.futures and the Dask helpers (asyncio, ssl) are imported where a pool
+# or a cluster is used: ~45 ms that a command solving in-process (`qsplan modes` up to n_c ~ 16) skips.
 
 __all__ = [
     "map_chunks",
@@ -124,10 +123,18 @@ def _pool_context():
     # fork starts a worker in ~10 ms instead of ~0.5 s (spawn re-imports numpy and
     # scipy), but forking a process that runs other threads (a Dask client's event
     # loop, say) can deadlock the child, so only fork a single-threaded process.
+    import multiprocessing
+
     methods = multiprocessing.get_all_start_methods()
     if "fork" in methods and threading.active_count() == 1:
         return multiprocessing.get_context("fork")
     return multiprocessing.get_context("forkserver" if "forkserver" in methods else "spawn")
+
+
+def _in_daemon() -> bool:
+    import multiprocessing
+
+    return multiprocessing.current_process().daemon
 
 
 def _check_client(scheduler):
@@ -156,6 +163,9 @@ def no_progress_timeout() -> float:
 
 def _in_pool(fn, items: list, n: int, progress=None) -> list:
     """``[fn(item) ...]`` on ``n`` local processes; a pool that breaks is replaced once for the missing items."""
+    from concurrent.futures import ProcessPoolExecutor
+    from concurrent.futures.process import BrokenProcessPool
+
     results: list = [_MISSING] * len(items)
     todo = list(range(len(items)))
     for attempt in (1, 2):
@@ -196,6 +206,8 @@ def _call_unpickled(fn, payload: bytes):
 
 
 def _on_cluster(client, fn, items: list, address: str, timeout: float, progress) -> list:
+    from qsplan.mechanics.cluster import gather_with_progress
+
     payloads = [pickle.dumps(item, protocol=_PROTOCOL) for item in items]
     futures = client.map(partial(_call_unpickled, fn), payloads, pure=False)
     return gather_with_progress(client, futures, address, timeout, progress)
@@ -250,6 +262,8 @@ def map_chunks(fn, items, *, workers=None, scheduler=None, progress=None) -> lis
             raise QsplanError(
                 f"scheduler: {scheduler} needs Dask distributed; install it with: pip install 'qsplan[cluster]'"
             ) from None
+        from qsplan.mechanics.cluster import connect, quiet_dask_logs
+
         with quiet_dask_logs():
             client = connect(scheduler, CONNECT_TIMEOUT)
             try:
@@ -260,7 +274,7 @@ def map_chunks(fn, items, *, workers=None, scheduler=None, progress=None) -> lis
                 except Exception:  # noqa: BLE001 - a dead scheduler: the error raised above says so
                     pass
     n = min(resolve_workers(workers), len(items))
-    if n <= 1 or multiprocessing.current_process().daemon:  # a daemon (a Dask worker) may not start processes
+    if n <= 1 or _in_daemon():  # a daemon (a Dask worker) may not start processes
         out = []
         for item in items:
             out.append(fn(item))

@@ -7,6 +7,9 @@ Public API (loaded on first use, so ``import qsplan.planner`` stays light):
   :class:`RegraspPlan`, :class:`PlannerOptions`, :data:`DEFAULT_OPTIONS`; judged states
   :func:`check_contact_state`, :func:`check_free_state`, :class:`StateCheck`
 * the whole pipeline (plan, export, plots, re-simulation): :func:`run_plan`, :class:`PlanRun`
+* automatic planning (a start and a :class:`Goal`, no waypoints; :func:`plan_task` dispatches to it):
+  :func:`plan_automatic`, :func:`band_tables`, :class:`BandTables`, :func:`widest_route`,
+  :func:`search_route`, :data:`SEQUENCE_PLANNERS`
 * no plan: :class:`PlanFailure` (a :class:`NoAnswerError`) with its :class:`FailureReport`
 * export: :func:`export_plan`, :func:`read_plan_csv`, :func:`export_schedule`, :func:`check_outputs`
 * replay and verification: :func:`replay_plan`, :func:`friction_samples`, :class:`Replay`
@@ -56,7 +59,19 @@ _LAZY = {
     "PLANNERS": "qsplan.planner.planning.ompl_bridge",
     "plan_path": "qsplan.planner.planning.ompl_bridge",
     "ompl_available": "qsplan.planner.planning.ompl_bridge",
+    "Goal": "qsplan.planner.planning.goal",
+    # automatic planning: the sequence search (issue 14)
+    "plan_automatic": "qsplan.planner.sequence.autoplan",
+    "SEQUENCE_PLANNERS": "qsplan.planner.sequence.ompl_search",
+    "search_route": "qsplan.planner.sequence.ompl_search",
+    "band_tables": "qsplan.planner.sequence.tables",
+    "BandTables": "qsplan.planner.sequence.tables",
+    "widest_route": "qsplan.planner.sequence.widest",
     "run_plan": "qsplan.planner.planning.pipeline",
+    "segment_command": "qsplan.planner.torque.command",
+    "with_segment_command": "qsplan.planner.torque.command",
+    "command_rule": "qsplan.planner.torque.command",
+    "check_schedule_files": "qsplan.planner.export.schema",
     "PlanRun": "qsplan.planner.planning.pipeline",
     "certify_plan": "qsplan.planner.planning.certify",
     "Certificate": "qsplan.planner.planning.certify",
@@ -101,6 +116,7 @@ _LAZY = {
     "solve_result_to_dict": "qsplan.planner.reports.solve_report",
     # plots (matplotlib is imported inside the functions)
     "plan_figures": "qsplan.planner.plotting.plan",
+    "plan_card": "qsplan.planner.plotting.card",
     "plot_plan_bands": "qsplan.planner.plotting.plan",
     "plot_mode_timeline": "qsplan.planner.plotting.plan",
     "plan_snapshots_figure": "qsplan.planner.plotting.plan",
@@ -112,6 +128,9 @@ _LAZY = {
     "plot_hand": "qsplan.planner.plotting.hands",
     "hand_strip_figure": "qsplan.planner.plotting.hands",
     "plot_mu_map": "qsplan.planner.plotting.muspace",
+    "mu_slices_figure": "qsplan.planner.plotting.muspace",
+    "rod_mu_figure": "qsplan.planner.plotting.muspace",
+    "plot_friction_rectangle": "qsplan.planner.plotting.muspace",
     "plot_contact_scene": "qsplan.planner.plotting.muspace",
     "rod_motion_figure": "qsplan.planner.plotting.motion",
     "push_motion_figure": "qsplan.planner.plotting.motion",

@@ -20,6 +20,7 @@ from dataclasses import replace
 import numpy as np
 
 from qsplan.mechanics.bands.batched import (
+    BatchKinematics,
     StateBatch,
     batch_kinematics,
     batch_rows,
@@ -111,7 +112,8 @@ def _root_search(cell, lo_, hi_, flip, atol, tol):
 
 
 def competitor_torques_batch(batch: StateBatch, mode, lo, hi, g_lo, g_hi, shared=False, tol: Tolerances = DEFAULT_TOLERANCES,
-                             rtol: float = PRECLUSION_RTOL, max_cells: int = MAX_CELLS, stats: RootStats | None = None) -> list:  # fmt: skip
+                             rtol: float = PRECLUSION_RTOL, max_cells: int = MAX_CELLS, stats: RootStats | None = None,
+                             bk: BatchKinematics | None = None) -> list:  # fmt: skip
     """:func:`qsplan.mechanics.bands.preclusion.competitor_torques` at every state of ``batch``.
 
     Parameters
@@ -120,6 +122,8 @@ def competitor_torques_batch(batch: StateBatch, mode, lo, hi, g_lo, g_hi, shared
         Each state's effort interval (N m or N).
     stats : RootStats, optional
         Counts the states the root cell resolved and those searched one at a time.
+    bk : BatchKinematics, optional
+        ``mode``'s kinematic stage on ``batch`` if already computed (the same arrays :func:`batch_kinematics` gives).
 
     Returns
     -------
@@ -133,7 +137,7 @@ def competitor_torques_batch(batch: StateBatch, mode, lo, hi, g_lo, g_hi, shared
     if not np.all(g_lo <= g_hi):
         k = int(np.flatnonzero(~(g_lo <= g_hi))[0])
         raise SceneError(f"effort interval: expected g_lo <= g_hi; got {g_lo[k]}, {g_hi[k]}")
-    bk = batch_kinematics(batch, mode, tol)
+    bk = batch_kinematics(batch, mode, tol) if bk is None else bk
     out = [None] * S
     for s in np.flatnonzero(~bk.ok):
         out[s] = CompetitorTorques(mode.letters, np.nan, np.nan, True, True, f"kinematics: {bk.status_name(s)}")
@@ -171,9 +175,10 @@ def _take_kin(bk, rows):
     return bk if rows.size == bk.status.size else replace(bk, status=bk.status[rows], xi=bk.xi[rows])
 
 
-def admissible_competitors_batch(batch: StateBatch, mode, tol: Tolerances = DEFAULT_TOLERANCES) -> tuple:
+def admissible_competitors_batch(batch: StateBatch, mode, tol: Tolerances = DEFAULT_TOLERANCES, kin: dict | None = None) -> tuple:
     """Per state, the modes other than ``mode`` kinematically admissible there, in enumeration order;
     and the union (:func:`qsplan.mechanics.bands.robust.admissible_competitors` of the whole batch).
+    ``kin``, if given, receives each mode's :class:`BatchKinematics` (the competitors' preclusion reuses them).
 
     Returns
     -------
@@ -182,7 +187,11 @@ def admissible_competitors_batch(batch: StateBatch, mode, tol: Tolerances = DEFA
     """
     mode = mode_from_letters(mode)
     s0 = batch.scenes[0]
-    oks = [(m.letters, batch_kinematics(batch, m, tol).ok) for m in enumerate_modes(s0.n_contacts, s0.dof) if m.letters != mode.letters]
+    kin = {} if kin is None else kin
+    for m in enumerate_modes(s0.n_contacts, s0.dof):
+        if m.letters != mode.letters:
+            kin[m.letters] = batch_kinematics(batch, m, tol)
+    oks = [(c, bk.ok) for c, bk in kin.items()]
     per_state = [tuple(c for c, ok in oks if ok[s]) for s in range(batch.size)]
     return per_state, tuple(c for c, ok in oks if ok.any())
 
@@ -202,8 +211,9 @@ def robust_bands(scenes, mode, mu_range, *, shared: bool = False, competitors=No
     mode = mode_from_letters(mode)
 
     def per_batch(batch):
+        kin = {}
         if competitors is None:
-            per_state, union = admissible_competitors_batch(batch, mode)
+            per_state, union = admissible_competitors_batch(batch, mode, kin=kin)
         else:
             union = tuple(competitors)
             per_state = [union] * batch.size
@@ -216,7 +226,8 @@ def robust_bands(scenes, mode, mu_range, *, shared: bool = False, competitors=No
             g_lo = np.array([desired[s].lower + 0.0 for s in idx])  # + 0.0: no negative zero
             g_hi = np.array([desired[s].upper + 0.0 for s in idx])
             for c in union:
-                for s, ct in zip(idx, competitor_torques_batch(sub, c, lo, hi, g_lo, g_hi, shared, stats=stats)):
+                bk = _take_kin(kin[c], idx) if c in kin else None
+                for s, ct in zip(idx, competitor_torques_batch(sub, c, lo, hi, g_lo, g_hi, shared, stats=stats, bk=bk)):
                     torques[s][c] = ct
         return [assemble_robust_band(mode, d, comps, t, (lo, hi), shared) for d, comps, t in zip(desired, per_state, torques)]
 

@@ -4,11 +4,14 @@
 scene's control-mode partition (their number is eq. (49)), in batches
 (:func:`qsplan.mechanics.solver.batch.solve_batches`), on local processes or a Dask
 cluster when there are enough of them (:mod:`qsplan.mechanics.solver.chunks`).  From
-:data:`SEARCH_MIN_MODES` modes on, ``search="auto"`` tries the exact pruning of
-:mod:`qsplan.mechanics.solver.search` (same solutions) within a budget of breaking-set
-programmes worth the plain test of every mode (:func:`estimate_seconds`), and tests every
-mode when the pruning would cost more: so ``auto`` costs at most about 1.5 times ``all``
-(:data:`AUTO_PROGRAMME_SHARE`) and 3 times ``prune``.
+:data:`SEARCH_MIN_MODES` modes on, ``search="auto"`` uses the exact pruned search of
+:mod:`qsplan.mechanics.solver.search` (same solutions): it screens every mode
+(:func:`~qsplan.mechanics.solver.search.all_breaking_sets`) when that costs less than
+:data:`SCREEN_ALL_SECONDS`, else prunes breaking sets by programmes within a budget worth the
+cheaper of screening and testing every mode (:func:`estimate_seconds`,
+:func:`~qsplan.mechanics.solver.search.screen_all_seconds`), and falls back to the cheaper of
+those two when the budget runs out: so ``auto`` costs at most about 1.5 times the cheaper
+(:data:`AUTO_PROGRAMME_SHARE`).
 """
 
 from __future__ import annotations
@@ -18,13 +21,11 @@ from qsplan.mechanics.model.scene import Scene
 from qsplan.mechanics.modes.contact_mode import count_modes
 from qsplan.mechanics.numerics import DEFAULT_TOLERANCES, Tolerances
 from qsplan.mechanics.solver.batch import DEFAULT_BATCH, solve_batches
-from qsplan.mechanics.solver.chunks import solve_in_chunks
 from qsplan.mechanics.solver.result import SolveResult
-from qsplan.mechanics.solver.breaking_sets import feasible_breaking_sets
-from qsplan.mechanics.solver.search import modes_with_breaking_sets, search_solve
+from qsplan.mechanics.solver.search import all_breaking_sets, screen_all_seconds, search_solve
 
-__all__ = ["SEARCH_MIN_MODES", "AUTO_PROGRAMME_SHARE", "MODE_SECONDS_PER_CONSTRAINT", "PROGRAMME_SECONDS", "SET_SECONDS",
-           "estimate_seconds", "solve"]  # fmt: skip
+__all__ = ["SEARCH_MIN_MODES", "AUTO_PROGRAMME_SHARE", "MODE_SECONDS_PER_CONSTRAINT", "PROGRAMME_SECONDS",
+           "SCREEN_ALL_SECONDS", "estimate_seconds", "solve"]  # fmt: skip
 
 #: Fewest modes (eq. 49) for which ``search="auto"`` prunes breaking sets
 #: (:mod:`qsplan.mechanics.solver.search`).  Measured on planted scenes with dof = n_c, one core:
@@ -37,17 +38,19 @@ SEARCH_MIN_MODES = 20_000
 #: dof = 4 (n_c = 12), 6.3 us at dof = 6 (n_c = 16), 17 us at dof = 12 (n_c = 12).
 MODE_SECONDS_PER_CONSTRAINT = 1.4e-6
 
-#: Seconds of one breaking-set programme (highspy, warm-started): 0.19-0.95 ms measured at n_c = 12-16.
+#: Seconds of one breaking-set programme (highspy, warm-started): 0.19-0.95 ms measured at n_c = 12-16,
+#: ~0.3 ms at n_c = 20.
 PROGRAMME_SECONDS = 4e-4
 
-#: Share of the plain path's estimated time that ``search="auto"`` may spend on breaking-set
-#: programmes before it gives up pruning: when it gives up, pruning would have cost more than
-#: this share, so ``auto`` stays within 1.5x the plain path and 3x the pruned one.
-AUTO_PROGRAMME_SHARE = 0.5
+#: Seconds of screening every mode (no programme) under which ``search="auto"`` does so: the
+#: programmes would cost about as much (importing highspy alone takes ~13 ms, the first levels'
+#: programmes ~10-30 ms at n_c = 12).
+SCREEN_ALL_SECONDS = 0.02
 
-#: Seconds of the pruned test stage per surviving breaking set (the reduced solve of
-#: :func:`qsplan.mechanics.solver.search.penetrates`): ~130 us measured at n_c = 16.
-SET_SECONDS = 1.3e-4
+#: Share of the cheaper of testing and screening every mode that ``search="auto"`` may spend on
+#: breaking-set programmes before it gives up pruning by them: then it does the cheaper, so it
+#: stays within 1.5x of it.
+AUTO_PROGRAMME_SHARE = 0.5
 
 
 def estimate_seconds(n_contacts: int, dof: int, workers: int = 1) -> float:
@@ -59,23 +62,23 @@ def estimate_seconds(n_contacts: int, dof: int, workers: int = 1) -> float:
     return count_modes(n_contacts, dof) * dof * MODE_SECONDS_PER_CONSTRAINT / max(1, workers)
 
 
-def _auto(scene, tol, workers, scheduler):
-    """The breaking sets for the pruned test, or None when testing every mode is cheaper."""
+def _auto(scene, tol, batch, residuals, workers, scheduler, progress):
+    """The pruned search's result, or None when testing every mode is cheaper (module docstring)."""
     n_c, dof = scene.n_contacts, scene.dof
-    n_modes = count_modes(n_c, dof)
-    if n_modes < SEARCH_MIN_MODES:
+    if count_modes(n_c, dof) < SEARCH_MIN_MODES:
         return None
-    plain = estimate_seconds(n_c, dof)
-    budget = int(AUTO_PROGRAMME_SHARE * plain / PROGRAMME_SECONDS)  # both run in chunks alike: compare one core
-    if budget <= n_c:
-        return None
-    sets, _ = feasible_breaking_sets(scene, tol, workers=workers, scheduler=scheduler, max_programmes=budget)
-    if sets is None:
-        return None
-    tested = modes_with_breaking_sets(n_c, dof, sets)
-    if tested * dof * MODE_SECONDS_PER_CONSTRAINT + len(sets) * SET_SECONDS > plain:
-        return None
-    return sets
+    plain, everything = estimate_seconds(n_c, dof), screen_all_seconds(n_c, dof)
+    kw = dict(workers=workers, scheduler=scheduler, progress=progress)
+    if everything <= min(SCREEN_ALL_SECONDS, plain):
+        return search_solve(scene, tol, batch, residuals, sets=all_breaking_sets(n_c, dof), **kw)
+    budget = int(AUTO_PROGRAMME_SHARE * min(plain, everything) / PROGRAMME_SECONDS)
+    if budget > n_c:
+        result = search_solve(scene, tol, batch, residuals, max_programmes=budget, max_seconds=plain, **kw)
+        if result is not None:
+            return result
+    if everything < plain:
+        return search_solve(scene, tol, batch, residuals, sets=all_breaking_sets(n_c, dof), **kw)
+    return None
 
 
 def solve(
@@ -114,9 +117,10 @@ def solve(
     search : {"auto", "prune", "all"}
         ``"all"`` tests every mode; ``"prune"`` tests only the modes whose breaking
         set admits equilibrium (:func:`qsplan.mechanics.solver.search.search_solve`, the same
-        solutions, the untested modes counted under ``PRUNED``); ``"auto"``, from
-        :data:`SEARCH_MIN_MODES` modes on, prunes unless the breaking-set programmes would
-        cost more than testing every mode (:func:`estimate_seconds`).  ``keep_statuses``
+        solutions, the untested modes counted under ``PRUNED`` and the screened-out ones under
+        ``PRUNED_KINEMATIC`` and ``PRUNED_COULOMB``); ``"auto"``, from :data:`SEARCH_MIN_MODES`
+        modes on, screens or prunes whichever the estimates say is cheapest (module docstring),
+        testing every mode when that is cheaper still.  ``keep_statuses``
         and ``batches`` always test every mode.
     progress : callable, optional
         ``progress(done, total, unit)`` as the work advances (``unit``: ``"modes"`` or
@@ -138,13 +142,14 @@ def solve(
     if search not in ("auto", "prune", "all"):
         raise QsplanError(f"search: expected 'auto', 'prune' or 'all'; got {search!r}")
     if search == "auto" and batches is None and not keep_statuses:
-        sets = _auto(scene, tol, workers, scheduler)
-        if sets is not None:
-            return search_solve(scene, tol, batch, residuals, workers=workers, scheduler=scheduler, sets=sets,
-                                progress=progress)  # fmt: skip
+        pruned = _auto(scene, tol, batch, residuals, workers, scheduler, progress)
+        if pruned is not None:
+            return pruned
     elif search == "prune" and batches is None and not keep_statuses:
         return search_solve(scene, tol, batch, residuals, workers=workers, scheduler=scheduler, progress=progress)
     if batches is None and (workers != 1 or scheduler is not None):
+        from qsplan.mechanics.solver.chunks import solve_in_chunks  # process pools: not on the pruned path
+
         chunked = solve_in_chunks(scene, tol, batch, residuals, keep_statuses, workers=workers, scheduler=scheduler,
                                   progress=progress)  # fmt: skip
         if chunked is not None:

@@ -10,6 +10,7 @@ Subcommands, one module each in :mod:`qsplan.planner.cli` (``add_parser(subparse
     qsplan partition SCENE [--mode LETTERS] [--json]  control-mode partitioner (eq. 32)
     qsplan paper [--out DIR]                        reproduce the paper's examples into DIR
     qsplan muspace | band | simulate | sweep | plan | demo | verify   (see each module)
+    qsplan --version                                the version (qsplan.__version__)
 
 Bad input prints one line on stderr naming the field and the problem and
 exits with status 2; so does valid input without an answer (no plan, no band).
@@ -45,8 +46,24 @@ COMMANDS = {"modes": modes, "count": count, "partition": partition, "paper": pap
             "band": band, "simulate": simulate, "sweep": sweep, "plan": plan, "demo": demo, "verify": verify}  # fmt: skip
 
 
+class _VersionShown(Exception):
+    """``--version`` was given: its line is the message (printed on stdout, exit 0)."""
+
+
+class _Version(argparse.Action):
+    def __init__(self, option_strings, dest, **kwargs):
+        super().__init__(option_strings, dest, nargs=0, default=argparse.SUPPRESS,
+                         help="print qsplan's version and exit")  # fmt: skip
+
+    def __call__(self, parser, namespace, values, option_string=None):
+        from qsplan import __version__
+
+        raise _VersionShown(f"qsplan {__version__}")
+
+
 def build_parser() -> argparse.ArgumentParser:
     p = Parser(prog="qsplan", description="Quasistatic planar contact-mode prediction (Trinkle & Zeng 1995).")
+    p.add_argument("--version", action=_Version)
     sub = p.add_subparsers(dest="command", required=True, parser_class=Parser)
     for module in COMMANDS.values():
         module.add_parser(sub)
@@ -83,6 +100,9 @@ def _dispatch(argv) -> int:
         module = COMMANDS[args.command]
         flags = getattr(module, "FLAGS", {})
         return module.run(args, sys.stdout)
+    except _VersionShown as shown:
+        print(shown, file=sys.stdout)
+        return 0
     except UsageError as exc:
         _say(str(exc))
         return EXIT_USAGE

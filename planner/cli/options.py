@@ -132,7 +132,11 @@ def add_plan_options(p, default_out):
 
     p.add_argument("--out", default=default_out, metavar="DIR", help=f"output directory (default {default_out})")
     p.add_argument("--seed", type=int, default=1, metavar="S", help="OMPL's random seed (default 1)")
-    p.add_argument("--planner", choices=PLANNERS, default="RRTConnect", help="OMPL planner (default RRTConnect)")
+    p.add_argument("--planner", choices=PLANNERS, default="RRTConnect",
+                   help="OMPL planner of the regrasps' finger motions (default RRTConnect)")  # fmt: skip
+    p.add_argument("--sequence-planner", choices=("widest", "RRTstar", "BITstar"), default="widest",
+                   help="tasks with a [goal]: the search of the sequence of slides and regrasps in OMPL (default widest: "
+                        "exact on the band tables; RRTstar, BITstar: OMPL's sampling planners, minimax objective)")  # fmt: skip
     p.add_argument("--time-limit", type=float, default=None, metavar="SECONDS",
                    help="time limit of each OMPL query (default 120; the iteration budget decides first)")
     p.add_argument("--force", action="store_true",

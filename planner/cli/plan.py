@@ -2,11 +2,14 @@
 
 ::
 
-    qsplan plan TASK.toml [--out DIR] [--seed S] [--planner NAME] [--time-limit SECONDS] [--force] [--quiet] [--no-plots] [--verify N]
+    qsplan plan TASK.toml [--out DIR] [--seed S] [--planner NAME] [--sequence-planner NAME] [--time-limit SECONDS]
+                          [--force] [--quiet] [--no-plots] [--verify N]
 
 Reads the task (:mod:`qsplan.planner.planning.task`) and runs the pipeline
-(:func:`qsplan.planner.planning.pipeline.run_plan`): plans it (in-contact segments
-through OMPL with the band validity checker, regrasps in joint space), and writes
+(:func:`qsplan.planner.planning.pipeline.run_plan`): plans it (a task with a ``[goal]``
+automatically: band tables of every grasp and the widest route through them, searched in OMPL,
+:mod:`qsplan.planner.sequence`; a task with ``waypoints`` as scripted; in-contact segments
+judged by their dense sweeps, regrasps planned in joint space by OMPL), and writes
 into DIR (default ``out/plan``) ``plan.csv`` and ``plan.json`` (the torque
 trajectory), ``replay.json`` (the exported file re-simulated at ``--verify``
 friction vectors of the interval; exit 1 if any run leaves the planned modes) and,
@@ -41,6 +44,7 @@ def add_parser(subparsers):
 def run_task(task, args, out) -> int:
     """Run the pipeline on ``task`` as ``args`` ask and print the summary (shared by ``qsplan demo``)."""
     from qsplan.planner.planning.pipeline import run_plan
+    from qsplan.planner.plotting.style import torque_text
 
     err = sys.stderr
 
@@ -50,14 +54,21 @@ def run_task(task, args, out) -> int:
             err.flush()
 
     result = run_plan(task, args.out, seed=args.seed, planner=args.planner, time_limit=args.time_limit,
-                      verify=args.verify, force=args.force, plots=not args.no_plots, progress=progress)  # fmt: skip
+                      verify=args.verify, force=args.force, plots=not args.no_plots, progress=progress,
+                      sequence_planner=args.sequence_planner)  # fmt: skip
     plan = result.plan
     _, t, w = plan.narrowest()
     out.write(f"{task.name}: planned {len(plan.segments)} in-contact segments and {len(plan.phases) - len(plan.segments)} "
               f"regrasps, {plan.duration:.4g} s of motion\n")  # fmt: skip
-    out.write(f"planning: {plan.seconds:.3g} s, {plan.validity_checks} validity checks "
-              f"({plan.checks_per_second:.4g} per second inside OMPL)\n")  # fmt: skip
-    out.write(f"narrowest guaranteed band: {w:.6g} N m at t = {t:.4g} s (resolution {task.torque_resolution:g} N m)\n")
+    out.write(f"planning: {plan.seconds:.3g} s, {plan.validity_checks} states judged "
+              f"({plan.checks_per_second:.4g} per second: band tables, dense sweeps and the regrasps' OMPL checks)\n")  # fmt: skip
+    if plan.sequence:
+        search = plan.sequence[-1]
+        out.write(f"sequence found by the {search['planner']!r} search on band tables of {search['grasps']} grasps x "
+                  f"{search['grid_points']} positions ({search['table_states']} configurations, {search['band_states']} "
+                  f"guaranteed bands in {search['table_seconds']:.3g} s; search {search['search_seconds']:.3g} s)\n")  # fmt: skip
+    width = torque_text(w, side="upper").replace("unbounded above", "unbounded")
+    out.write(f"narrowest guaranteed band: {width} at t = {t:.4g} s (resolution {task.torque_resolution:g} N m)\n")
     out.write(f"{result.certificate.summary()}\n")
     for r in result.replays:
         out.write(f"re-simulated at {r.summary()}\n")

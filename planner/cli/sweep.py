@@ -3,8 +3,8 @@
 ::
 
     qsplan sweep [--segment 1] [--mu-range LO HI] [--shared-mu] [--samples N] [--duration T]
-                 [--effort-joint left|right] [--paper-samples K] [--safety-margin M] [--max-margin M]
-                 [--min-normal N] [--min-slack N]
+                 [--effort-joint left|right] [--paper-samples K] [--torque-resolution R]
+                 [--safety-margin M] [--max-margin M] [--min-normal N] [--min-slack N]
                  [--display-limit L] [--out DIR] [--force] [--no-plots] [--json]
                  [--workers N] [--scheduler ADDRESS]
 
@@ -20,6 +20,10 @@ coefficient), exactly, beside the paper's sampled method with K values: all by
 ``--min-slack`` (N, default 0) narrow Fig. 13's bands (exact and sampled) to efforts
 that keep every loaded contact's normal force and every rolling contact's cone
 slacks at least that large for all friction in the range (Figs. 10-12 stay eq. 28 as is).
+The exported command follows the plans' rule (:func:`qsplan.planner.torque.command.segment_command`):
+one margin kept from both band edges along the whole segment, half the narrowest band and at most
+two torque resolutions (``--torque-resolution``, N m), so it is continuous and near the torque
+the mode needs, with or without ``--shared-mu``.
 
 Into DIR (default ``out/sweep``) it writes ``segment1.csv`` and ``segment1.json``
 (the torque schedule: see :mod:`qsplan.planner.export.schedule`) and, unless ``--no-plots``,
@@ -34,7 +38,7 @@ stdout: a summary; with ``--json`` one object::
      "frictionless_upper_infinite": [[t0, t1], ...], "mu_high_upper_infinite": [[t0, t1], ...],
      "guaranteed": {"exact", "points_without_band", "split_points", "narrowest": {"t", "width", "lower", "upper"}},
      "paper_method": {"samples", "narrowest": {...}, "wider_than_exact_points"},
-     "safety_margin", "max_margin", "force_margin": {"min_normal_force_N", "min_coulomb_slack_N"},
+     "safety_margin", "max_margin", "torque_resolution", "force_margin": {"min_normal_force_N", "min_coulomb_slack_N"},
      "command_max", "files": [...]}
 
 Efforts in N m, times in s.  Bad arguments raise a :class:`qsplan.mechanics.QsplanError` naming the option (exit 2).
@@ -64,10 +68,15 @@ def add_parser(subparsers):
                    help="torque-controlled finger (default right; the other is velocity-controlled)")  # fmt: skip
     p.add_argument("--paper-samples", type=int, default=21, metavar="K",
                    help="friction values of the paper's sampled method (default 21: 0, 0.01, ..., 0.2)")  # fmt: skip
+    p.add_argument("--torque-resolution", type=float, default=0.02, metavar="R",
+                   help="the controller's torque resolution, N m (default 0.02, the bundled tasks'): the command's "
+                        "margin is at most two of it")  # fmt: skip
     p.add_argument("--safety-margin", type=float, metavar="M",
-                   help="N m kept from a finite edge where the band is unbounded (default: half the narrowest band)")  # fmt: skip
+                   help="N m kept from both band edges along the segment (default: half the narrowest band, at most "
+                        "two torque resolutions)")  # fmt: skip
     p.add_argument("--max-margin", type=float, metavar="M",
-                   help="N m cap on the command's margin: a wider band gets lower + M (default: midpoints)")  # fmt: skip
+                   help="N m: a larger margin where the band is bounded: lower + M where wider than 2 M (default: "
+                        "the safety margin)")  # fmt: skip
     add_force_margin_options(p)
     p.add_argument("--display-limit", type=float, metavar="L", help="N m at which plotted bands are truncated (default: per figure)")
     p.add_argument("--out", default="out/sweep", metavar="DIR", help="output directory (default out/sweep)")
@@ -92,7 +101,7 @@ def _check(args):
     if args.paper_samples < 1:
         raise QsplanError(f"--paper-samples: expected a positive integer; got {args.paper_samples}")
     for option, v in (("--safety-margin", args.safety_margin), ("--max-margin", args.max_margin),
-                      ("--display-limit", args.display_limit)):  # fmt: skip
+                      ("--display-limit", args.display_limit), ("--torque-resolution", args.torque_resolution)):  # fmt: skip
         if v is not None and not (math.isfinite(v) and v > 0):
             raise QsplanError(f"{option}: expected a positive finite torque (N m); got {v}")
     force_margin_option(args)
@@ -110,7 +119,8 @@ def run(args, out) -> int:
     result = sweep_segment(samples, args.out, tuple(args.mu_range), shared=args.shared_mu,
                            paper_samples=args.paper_samples, safety_margin=args.safety_margin,
                            max_margin=args.max_margin, display_limit=args.display_limit, force=args.force,
-                           plots=not args.no_plots, force_margin=force_margin_option(args), **parallel)  # fmt: skip
+                           plots=not args.no_plots, force_margin=force_margin_option(args),
+                           resolution=args.torque_resolution, **parallel)  # fmt: skip
     if args.json:
         json.dump(result.document, out)
         out.write("\n")

@@ -185,9 +185,12 @@ def remove_stale(out_dir, names) -> list:
 
 
 def csv_cell(v) -> str:
-    """A CSV cell: strings as they are, numbers in full precision (``repr``; ``inf``, ``nan``)."""
+    """A CSV cell: strings as they are, integers as integers, other numbers in full precision (``repr``;
+    ``inf``, ``nan``)."""
     if isinstance(v, str):
         return v
+    if isinstance(v, int) and not isinstance(v, bool):
+        return str(v)
     return repr(float(v))
 
 

@@ -1,26 +1,39 @@
 """Export a whole two-finger plan: one torque schedule (CSV and JSON) for every phase, in time order.
 
-The columns are those of :mod:`qsplan.planner.export.schedule` (the band issue's format), for
-both joints since the effort-controlled finger changes between segments, then
-extra columns (extended, never renamed)::
+Format ``qsplan.torque_schedule.plan``, version 1: the columns of :mod:`qsplan.planner.export.schedule`
+(the band issue's format) for both joints, since the torque-controlled finger may change between
+segments, then extra columns (extended, never renamed).  One row per sample, in this order:
 
-    t, q_left, q_right, qd_left, qd_right,
-    tau_left, tau_left_min, tau_left_max, tau_right, tau_right_min, tau_right_max,
-    mode, margin, x_workpiece, y_workpiece, theta_workpiece, phase, effort_joint
+=====================  =======  ==============================================================================
+column                 unit     meaning
+=====================  =======  ==============================================================================
+``t``                  s        time from the plan's start
+``q_<joint>``          rad      joint angle (``q_left``, ``q_right``)
+``qd_<joint>``         rad/s    velocity command while the joint is velocity-controlled; ``nan`` while it is
+                                torque-controlled
+``tau_<joint>``        N m      torque command while the joint is torque-controlled; ``nan`` while it is
+                                velocity-controlled (every regrasp row, and the other finger in contact)
+``tau_<joint>_min``    N m      lower edge of its guaranteed band (``-inf``: unbounded below); ``nan`` as above
+``tau_<joint>_max``    N m      upper edge of its guaranteed band (``inf``: unbounded above); ``nan`` as above
+``mode``               -        contact mode the command guarantees, one letter per contact (palm:0, palm:1,
+                                left, right; ``SSSS`` = 4S); ``free`` on regrasp rows
+``margin``             N m      distance from the torque command to the nearer band edge; ``nan`` on regrasps
+``x_workpiece``        m        workpiece pose: x of its centre of mass
+``y_workpiece``        m        workpiece pose: y of its centre of mass
+``theta_workpiece``    rad      workpiece pose: orientation
+``phase``              -        index of the phase, an integer (0, 1, 2, ...: in-contact segments and regrasps
+                                in time order); ``metadata.phases[phase]`` names and describes it
+``effort_joint``       -        the torque-controlled finger (``left``, ``right``); ``none`` on regrasp rows
+=====================  =======  ==============================================================================
 
-* in-contact rows: ``qd_<joint>`` is the velocity command of the velocity-controlled
-  joint and ``nan`` for the effort-controlled one; ``tau_<joint>*`` are the command and
-  guaranteed band of the effort-controlled joint and ``nan`` for the other; ``mode``
-  is the contact mode (``SSSS``); ``effort_joint`` names the torque-controlled finger;
-* regrasp rows: both joints velocity-controlled (``qd`` of both), every ``tau`` and
-  ``margin`` ``nan``, ``mode`` ``free``, ``effort_joint`` ``none``;
-* ``x_workpiece, y_workpiece, theta_workpiece`` (m, m, rad): the workpiece's pose, so
-  the scene of any row can be rebuilt from the file alone;
-* ``phase``: the index of the phase (0, 1, ...: segment, regrasp, segment, ...).
-
-Times are continuous over the plan; a phase's last row and the next phase's first
-row share a time (the switch).  Unbounded band sides are ``inf`` (CSV) / ``null``
-(JSON), as in :mod:`qsplan.planner.export.schedule`.  Files are never overwritten without ``force``.
+Times are continuous over the plan; a phase's last row and the next phase's first row share a
+time (the switch).  CSV numbers are full precision (``repr``), ``phase`` an integer.  JSON:
+``{"format", "version", "columns", "units", "descriptions", "data", "metadata", "null"}``, with
+non-finite numbers ``null`` (``tau_<joint>_min``: unbounded below, ``tau_<joint>_max``: unbounded
+above, elsewhere not applicable); the schema is ``torque_schedule.schema.json`` beside this module
+(:func:`qsplan.planner.export.schema.check_schedule_document`).  ``metadata`` records the task, the
+friction model, limits, force margin, the command rule and each phase, and the planned ``sequence``
+when the plan has one.  Files are never overwritten without ``force``.
 """
 
 from __future__ import annotations
@@ -30,25 +43,58 @@ import math
 
 import numpy as np
 
-
 from qsplan.planner.export.files import atomic_write, check_out_dir, check_outputs, csv_cell, json_value
 from qsplan.planner.export.schedule import FORMAT, VERSION
 
-__all__ = ["PLAN_FORMAT", "plan_columns", "plan_metadata", "export_plan", "read_plan_csv"]
+__all__ = ["PLAN_COLUMNS", "PLAN_FORMAT", "column_meanings", "export_plan", "plan_columns", "plan_metadata",
+           "plain_json", "read_plan_csv"]
 
 PLAN_FORMAT = FORMAT + ".plan"
 
-_UNITS = {"t": "s", "q": "rad", "qd": "rad/s", "tau": "N m", "margin": "N m", "x_workpiece": "m", "y_workpiece": "m",
-          "theta_workpiece": "rad", "mode": None, "phase": None, "effort_joint": None}  # fmt: skip
+#: Every column family of a plan file: ``(name, unit, meaning)``, ``<joint>`` standing for ``left`` and ``right``.
+PLAN_COLUMNS = (
+    ("t", "s", "time from the plan's start"),
+    ("q_<joint>", "rad", "joint angle"),
+    ("qd_<joint>", "rad/s", "velocity command while the joint is velocity-controlled; nan (null) while torque-controlled"),
+    ("tau_<joint>", "N m", "torque command while the joint is torque-controlled, inside its guaranteed band; nan "
+                           "(null) while velocity-controlled (every regrasp row, and the other finger in contact)"),
+    ("tau_<joint>_min", "N m", "lower edge of the guaranteed band (-inf, JSON null: unbounded below); nan (null) "
+                               "while velocity-controlled"),
+    ("tau_<joint>_max", "N m", "upper edge of the guaranteed band (inf, JSON null: unbounded above); nan (null) "
+                               "while velocity-controlled"),
+    ("mode", None, "contact mode the command guarantees, one letter per contact (palm:0, palm:1, left, right; "
+                   "SSSS = 4S); free on regrasp rows"),
+    ("margin", "N m", "distance from the torque command to the nearer band edge; nan (null) on regrasp rows"),
+    ("x_workpiece", "m", "workpiece pose: x of its centre of mass"),
+    ("y_workpiece", "m", "workpiece pose: y of its centre of mass"),
+    ("theta_workpiece", "rad", "workpiece pose: orientation"),
+    ("phase", None, "index of the phase, an integer (0, 1, 2, ...: segments and regrasps in time order); "
+                    "metadata.phases[phase] names it"),
+    ("effort_joint", None, "the torque-controlled finger (left, right); none on regrasp rows"),
+)  # fmt: skip
+
+_JOINTS = ("left", "right")
+
+
+def _family(name: str) -> tuple:
+    """The :data:`PLAN_COLUMNS` entry of column ``name``."""
+    for joint in _JOINTS:
+        if f"_{joint}" in name:
+            name = name.replace(f"_{joint}", "_<joint>", 1)
+            break
+    return next(c for c in PLAN_COLUMNS if c[0] == name)
 
 
 def plan_columns(plan) -> tuple:
-    """The plan as ordered columns ``{name: list}`` and units ``{name: str or None}``."""
+    """The plan as ordered columns ``{name: list}`` and units ``{name: str or None}`` (:data:`PLAN_COLUMNS`).
+
+    Reads the plan's public fields only (``phases``; a phase that is not a
+    :class:`~qsplan.planner.planning.results.ContactSegmentPlan` is a free motion of both fingers).
+    """
     from qsplan.planner.planning.results import ContactSegmentPlan
 
-    names = ("left", "right")
-    order = ["t", *(f"q_{n}" for n in names), *(f"qd_{n}" for n in names)]
-    for n in names:
+    order = ["t", *(f"q_{n}" for n in _JOINTS), *(f"qd_{n}" for n in _JOINTS)]
+    for n in _JOINTS:
         order += [f"tau_{n}", f"tau_{n}_min", f"tau_{n}_max"]
     order += ["mode", "margin", "x_workpiece", "y_workpiece", "theta_workpiece", "phase", "effort_joint"]
     cols = {k: [] for k in order}
@@ -57,32 +103,38 @@ def plan_columns(plan) -> tuple:
         n = ph.t.size
         nan = [math.nan] * n
         cols["t"] += ph.t.tolist()
-        for j, name in enumerate(names):
+        for j, name in enumerate(_JOINTS):
             cols[f"q_{name}"] += ph.q[:, j].tolist()
             cols[f"qd_{name}"] += ph.qd[:, j].tolist()
         contact = isinstance(ph, ContactSegmentPlan)
-        for name in names:
+        for name in _JOINTS:
             mine = contact and ph.effort_joint == name
             cols[f"tau_{name}"] += ph.command.tolist() if mine else nan
             cols[f"tau_{name}_min"] += ph.lower.tolist() if mine else nan
             cols[f"tau_{name}_max"] += ph.upper.tolist() if mine else nan
         cols["mode"] += [ph.mode if contact else "free"] * n
         cols["margin"] += ph.margin.tolist() if contact else nan
-        cols["x_workpiece"] += ph.x.tolist() if contact else [ph.x] * n
+        cols["x_workpiece"] += np.broadcast_to(np.asarray(ph.x, float), (n,)).tolist()
         cols["y_workpiece"] += [y0] * n
         cols["theta_workpiece"] += [0.0] * n
-        cols["phase"] += [float(i)] * n
+        cols["phase"] += [i] * n
         cols["effort_joint"] += [ph.effort_joint if contact else "none"] * n
-    units = {}
-    for k in order:
-        units[k] = _UNITS.get(k, _UNITS.get(k.split("_")[0]))
-    units["phase"] = None
-    return cols, units
+    return cols, {k: _family(k)[1] for k in order}
+
+
+def column_meanings(names) -> dict:
+    """``{column: meaning}`` of a plan file's columns (:data:`PLAN_COLUMNS`)."""
+    return {k: _family(k)[2] for k in names}
 
 
 def plan_metadata(plan) -> dict:
-    """What a controller engineer needs to trust the plan (all SI)."""
+    """What a controller engineer needs to trust the plan (all SI).
+
+    Reads ``Plan``'s public fields; ``sequence`` (the planned sequence, a tuple of plain dicts) is
+    written under ``"sequence"`` when the plan has one.
+    """
     from qsplan.planner.planning.results import ContactSegmentPlan
+    from qsplan.planner.torque.command import MAX_MARGIN_RESOLUTIONS
 
     task = plan.task
     h = task.hand
@@ -94,11 +146,13 @@ def plan_metadata(plan) -> dict:
             k = int(np.argmin(ph.width))
             d.update(kind="contact", mode=ph.mode, effort_joint=ph.effort_joint, competitors_precluded=list(ph.competitors),
                      workpiece_speed_m_s=ph.speed, ompl_states=int(ph.x_path.size),
-                     narrowest_band={"t_s": float(ph.t[k]), "width_N_m": _num(ph.width[k])})  # fmt: skip
+                     narrowest_band={"t_s": float(ph.t[k]), "width_N_m": _num(ph.width[k])},
+                     command={"margin_N_m": _num(np.min(ph.margin)), "half_narrowest_band_N_m": _num(0.5 * ph.width[k]),
+                              "max_N_m": _num(np.max(ph.command)), "lower_edge_max_N_m": _num(np.max(ph.lower))})  # fmt: skip
         else:
-            d.update(kind="regrasp", x_workpiece_m=ph.x)
+            d.update(kind="regrasp", x_workpiece_m=float(np.ravel(ph.x)[0]))
         phases.append(d)
-    return {
+    doc = {
         "source": "qsplan: Trinkle & Zeng (1995), Section 5.2, Figs. 9-13; planned with OMPL",
         "task": task.name,
         "friction": {"range": list(task.mu_range), "model": "one coefficient shared by all contacts" if task.shared_mu
@@ -108,6 +162,12 @@ def plan_metadata(plan) -> dict:
                              meaning="inside every band, for every friction in the range, every loaded contact's "
                                      "normal force and every rolling contact's friction-cone slacks are at least "
                                      "these (eq. 28 made strict)"),
+        "command": {"rule": "per in-contact segment one margin m kept from both band edges at every row: lower + m "
+                            "where the band is wider than 2 m, the midpoint where it is narrower; m = min(half the "
+                            "segment's narrowest band, max_margin_resolutions x torque_resolution_N_m); each phase "
+                            "records its m (command.margin_N_m)",
+                    "max_margin_resolutions": MAX_MARGIN_RESOLUTIONS, "torque_resolution_N_m": task.torque_resolution,
+                    "velocity_controlled_torque_cells": "nan in CSV, null in JSON"},
         "limits": {"joints_rad": task.joint_limits.tolist(), "joint_speed_rad_s": task.joint_speed,
                    "workpiece_speed_m_s": task.workpiece_speed},
         "narrowest_band": {"phase": name, "t_s": _num(t), "width_N_m": _num(w)},
@@ -118,6 +178,28 @@ def plan_metadata(plan) -> dict:
                  "finger_base_m": h.finger_base, "finger_length_m": h.finger_length, "finger_width_m": h.finger_width,
                  "finger_mass_kg": h.finger_mass, "palm_halfwidth_m": h.palm_halfwidth, "gravity_m_s2": h.gravity},
     }  # fmt: skip
+    sequence = getattr(plan, "sequence", None)
+    if sequence is not None:
+        doc["sequence"] = plain_json(list(sequence))
+    return doc
+
+
+def plain_json(value):
+    """``value`` as plain JSON: numpy scalars and arrays, tuples and sets as numbers and lists; non-finite
+    floats ``None``; other objects as their ``str``."""
+    if isinstance(value, dict):
+        return {str(k): plain_json(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple, set, frozenset, np.ndarray)):
+        return [plain_json(v) for v in (sorted(value, key=str) if isinstance(value, (set, frozenset)) else value)]
+    if isinstance(value, (bool, np.bool_)):
+        return bool(value)
+    if isinstance(value, (int, np.integer)):
+        return int(value)
+    if isinstance(value, (float, np.floating)):
+        return json_value(float(value))
+    if value is None or isinstance(value, str):
+        return value
+    return str(value)
 
 
 def _num(v):
@@ -134,6 +216,7 @@ def export_plan(plan, out_dir, stem: str = "plan", force: bool = False) -> list:
     cols, units = plan_columns(plan)
     names = list(cols)
     doc = {"format": PLAN_FORMAT, "version": VERSION, "columns": names, "units": units,
+           "descriptions": column_meanings(names),
            "data": {k: [json_value(v) for v in vals] for k, vals in cols.items()}, "metadata": plan_metadata(plan),
            "null": "tau_<joint>_min: unbounded below; tau_<joint>_max: unbounded above; elsewhere: not applicable "
                    "(the joint is velocity-controlled, or a regrasp row)"}  # fmt: skip
@@ -150,7 +233,11 @@ def export_plan(plan, out_dir, stem: str = "plan", force: bool = False) -> list:
 
 
 def read_plan_csv(path) -> dict:
-    """Read a plan CSV back: ``{column: ndarray}`` (floats; ``mode`` and ``effort_joint`` as str arrays)."""
+    """Read a plan CSV back: ``{column: ndarray}`` (floats; ``mode`` and ``effort_joint`` as str arrays).
+
+    ``phase`` (an integer since issue 16; ``0.0``, ``1.0``, ... in older files) is read as floats like
+    the other numbers, so files of either kind read alike.
+    """
     import csv
 
     with open(path, newline="") as f:

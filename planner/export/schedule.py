@@ -18,8 +18,10 @@ column                 unit     meaning
 CSV: a header line with the column names, then numbers written in full
 precision (``repr``); an unbounded band side is ``-inf`` / ``inf``; a sample
 with no guaranteed band has ``nan`` in ``tau_*`` and ``margin``.  JSON: an object
-``{"format", "version", "columns", "units", "data", "metadata"}`` with ``data``
-holding one list per column; JSON has no infinity, so non-finite numbers are
+``{"format", "version", "columns", "units", "descriptions", "data", "metadata", "null"}`` with
+``data`` holding one list per column (the schema: :mod:`qsplan.planner.export.schema`);
+``metadata["command"]`` states the command rule
+(:func:`qsplan.planner.torque.command.command_rule`); JSON has no infinity, so non-finite numbers are
 ``null`` (in ``tau_<joint>_min``: unbounded below; ``tau_<joint>_max``: unbounded
 above; elsewhere: no guaranteed band).
 
@@ -36,10 +38,34 @@ from pathlib import Path
 
 from qsplan.planner.export.files import atomic_write, check_out_dir, check_outputs, csv_cell, json_value
 
-__all__ = ["FORMAT", "VERSION", "export_schedule", "schedule_columns", "schedule_metadata", "write_csv", "write_json"]
+__all__ = ["FORMAT", "SCHEDULE_COLUMNS", "VERSION", "export_schedule", "schedule_columns", "schedule_metadata",
+           "write_csv", "write_json"]
 
 FORMAT = "qsplan.torque_schedule"
 VERSION = 1
+
+#: Every column family of a schedule: ``(name, unit, meaning)``, ``<joint>`` standing for a joint's name.
+SCHEDULE_COLUMNS = (
+    ("t", "s", "time from the segment's start"),
+    ("q_<joint>", "rad", "joint angle"),
+    ("qd_<joint>", "rad/s", "velocity command of a velocity-controlled joint"),
+    ("tau_<joint>", "N m", "torque command of a torque-controlled joint, inside its guaranteed band; nan (null) "
+                           "where the sample has no band"),
+    ("tau_<joint>_min", "N m", "lower edge of the guaranteed band (-inf, JSON null: unbounded below)"),
+    ("tau_<joint>_max", "N m", "upper edge of the guaranteed band (inf, JSON null: unbounded above)"),
+    ("mode", None, "the contact mode the command guarantees, one letter per contact (SSSS = 4S)"),
+    ("margin", "N m", "distance from the command to the nearer band edge"),
+)  # fmt: skip
+
+
+def _meaning(name: str) -> str:
+    for family, _, meaning in SCHEDULE_COLUMNS:
+        head, _, tail = family.partition("<joint>")
+        if name == family or (tail is not None and "<joint>" in family and name.startswith(head)
+                              and name.endswith(tail) and len(name) > len(head) + len(tail)
+                              and "_" not in name[len(head):len(name) - len(tail)]):  # fmt: skip
+            return meaning
+    return ""
 
 
 def schedule_columns(bands) -> tuple:
@@ -82,13 +108,16 @@ def schedule_columns(bands) -> tuple:
     return cols, units
 
 
-def schedule_metadata(bands) -> dict:
-    """What a controller engineer needs to trust the schedule (all SI)."""
+def schedule_metadata(bands, resolution=None) -> dict:
+    """What a controller engineer needs to trust the schedule (all SI); ``resolution``: the controller's torque
+    resolution (N m) the command's margin was sized with, if any."""
     from qsplan.mechanics.bands.effort import check_force_margin
     from qsplan.mechanics.modes.contact_mode import ContactMode
 
-    from qsplan.planner.torque.pointwise import narrowest
     from qsplan.mechanics.bands.preclusion import PRECLUSION_RTOL
+
+    from qsplan.planner.torque.command import command_rule
+    from qsplan.planner.torque.pointwise import narrowest
 
     S = bands.samples
     seg = S.segment
@@ -124,13 +153,7 @@ def schedule_metadata(bands) -> dict:
             "narrowest": None if k is None else {"t_s": float(S.t[k]), "width_N_m": w, "lower_N_m": float(band.lower[k]),
                                                  "upper_N_m": float(band.upper[k])},
         },
-        "command": {
-            "rule": "midpoint of a bounded band (lower + max_margin if the band is wider than twice max_margin); "
-                    "lower + safety_margin when unbounded above (upper - safety_margin when unbounded below); "
-                    "0 when unbounded on both sides",
-            "safety_margin_N_m": bands.safety_margin,
-            "max_margin_N_m": bands.max_margin,
-        },
+        "command": command_rule(bands.safety_margin, bands.max_margin, resolution),
         "hand": {
             "workpiece_vertices_m": hand.workpiece.tolist(), "workpiece_mass_kg": hand.workpiece_mass,
             "finger_base_m": hand.finger_base, "finger_length_m": hand.finger_length,
@@ -155,7 +178,7 @@ def write_csv(bands, path, force: bool = False) -> Path:
     return atomic_write(path, write, force=True)
 
 
-def write_json(bands, path, force: bool = False) -> Path:
+def write_json(bands, path, force: bool = False, resolution=None) -> Path:
     """Write the schedule as JSON with units and metadata (see the module docstring); returns the path."""
     path = Path(path)
     check_outputs([path], force)
@@ -165,17 +188,19 @@ def write_json(bands, path, force: bool = False) -> Path:
         "version": VERSION,
         "columns": list(cols),
         "units": units,
+        "descriptions": {k: _meaning(k) for k in cols},
         "data": {k: [json_value(v) for v in vals] for k, vals in cols.items()},
-        "metadata": schedule_metadata(bands),
+        "metadata": schedule_metadata(bands, resolution),
         "null": "tau_<joint>_min: unbounded below; tau_<joint>_max: unbounded above; elsewhere: no guaranteed band",
     }
     return atomic_write(path, json.dumps(doc, indent=1, allow_nan=False) + "\n", force=True)
 
 
-def export_schedule(bands, out_dir, stem: str = "segment1", force: bool = False) -> list:
+def export_schedule(bands, out_dir, stem: str = "segment1", force: bool = False, resolution=None) -> list:
     """Write ``<stem>.csv`` and ``<stem>.json`` into ``out_dir``; refuse to overwrite unless ``force``.
 
     Both files are checked before either is written, so a refusal leaves nothing half done.
+    ``resolution`` (N m), the controller's torque resolution the command was sized with, is recorded.
 
     Returns
     -------
@@ -184,4 +209,4 @@ def export_schedule(bands, out_dir, stem: str = "segment1", force: bool = False)
     out = check_out_dir(out_dir)
     paths = [out / f"{stem}.csv", out / f"{stem}.json"]
     check_outputs(paths, force)
-    return [write_csv(bands, paths[0], force=True), write_json(bands, paths[1], force=True)]
+    return [write_csv(bands, paths[0], force=True), write_json(bands, paths[1], force=True, resolution=resolution)]

@@ -39,9 +39,12 @@ def hand_scene_at(task, x, effort_joint, velocity):
     return pose, q, touching, hand_scene(task.hand, pose, q, effort_joint, velocity=velocity, effort=0.0)
 
 
-def contact_samples(task, xs, effort_joint, speed, name="segment"):
+def contact_samples(task, xs, effort_joint, speed, name="segment", grasp=None):
     """The configurations at workpiece ``xs`` (m, shape (n,)) moving at ``speed`` (m/s, signed) as
     :class:`qsplan.hands.segments.SegmentSamples` (times 0, 1, ...: bands do not depend on them).
+
+    ``grasp`` (:class:`qsplan.hands.grasps.Grasp`): the features the fingers touch; default both inner
+    edges on the vertices of tangency (:func:`qsplan.hands.two_finger.finger_angles`, the scripted tasks).
 
     Raises
     ------
@@ -52,12 +55,18 @@ def contact_samples(task, xs, effort_joint, speed, name="segment"):
     from qsplan.hands.two_finger import JOINT_NAMES, finger_angle_rates
 
     v = 1 - JOINT_NAMES.index(effort_joint)
-    poses, qs, qds, touch, scenes = [], [], [], [], []
-    for x in np.atleast_1d(np.asarray(xs, float)):
-        pose = task.pose(x)
-        qd = finger_angle_rates(task.hand, pose, (speed, 0.0, 0.0))
-        _, q, t, scene = hand_scene_at(task, x, effort_joint, qd[v])
-        poses.append(pose), qs.append(q), qds.append(qd), touch.append(t), scenes.append(scene)
+    xs = np.atleast_1d(np.asarray(xs, float))
+    if grasp is not None:
+        from qsplan.planner.planning.grasped import grasp_samples
+
+        poses, qs, qds, touch, scenes = grasp_samples(task.hand, grasp, xs, effort_joint, speed)
+    else:
+        poses, qs, qds, touch, scenes = [], [], [], [], []
+        for x in xs:
+            pose = task.pose(x)
+            qd = finger_angle_rates(task.hand, pose, (speed, 0.0, 0.0))
+            _, q, t, scene = hand_scene_at(task, x, effort_joint, qd[v])
+            poses.append(pose), qs.append(q), qds.append(qd), touch.append(t), scenes.append(scene)
     n = len(poses)
     poses = np.array(poses)
     seg = ManipulationSegment(task.hand, name, poses[0], poses[-1], float(max(n - 1, 1)), MODE, effort_joint)
@@ -92,12 +101,13 @@ def configuration_problem(task, pose, q) -> str | None:
 
 
 def check_contact_state(task: Task, x: float, effort_joint: str, direction: float, touching=None,
-                        competitors=None) -> StateCheck:  # fmt: skip
+                        competitors=None, grasp=None) -> StateCheck:  # fmt: skip
     """Judge workpiece ``x`` (m) of an in-contact segment moving in ``direction`` (sign of xdot).
 
     Valid when the four contacts are found (the same finger vertices as ``touching``),
     the joints are inside their limits, no two bodies overlap (:func:`configuration_problem`: every
     pair, finger against finger too), the 4S kinematics hold and the guaranteed band, competitors precluded, is at least ``task.torque_resolution`` wide.
+    ``grasp``: as in :func:`contact_samples`.
     """
     from qsplan.mechanics.bands.effort import band_kinematics
     from qsplan.mechanics.modes.contact_mode import ContactMode
@@ -105,7 +115,7 @@ def check_contact_state(task: Task, x: float, effort_joint: str, direction: floa
     from qsplan.planner.torque.pointwise import guaranteed_sweep
 
     try:
-        S = contact_samples(task, [x], effort_joint, float(np.sign(direction)) * task.workpiece_speed)
+        S = contact_samples(task, [x], effort_joint, float(np.sign(direction)) * task.workpiece_speed, grasp=grasp)
     except QsplanError as exc:
         return StateCheck(float(x), False, f"no four-contact grasp: {exc}")
     if touching is not None and np.any(S.touching[0] != touching):

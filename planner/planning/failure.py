@@ -189,7 +189,7 @@ def _num(v):
     return float(v) if np.isfinite(v) else None
 
 
-def _edge_corners(task, x, effort, direction):
+def _edge_corners(task, x, effort, direction, grasp=None):
     """Box corners where the desired band's lower and upper edges are attained (vertex theory)."""
     from qsplan.mechanics.bands.effort import effort_bands
     from qsplan.mechanics.modes.contact_mode import ContactMode
@@ -197,7 +197,7 @@ def _edge_corners(task, x, effort, direction):
     from qsplan.planner.planning.contact_state import MODE, contact_samples
 
     lo, hi = task.mu_range
-    scene = contact_samples(task, [x], effort, direction * task.workpiece_speed).scenes[0]
+    scene = contact_samples(task, [x], effort, direction * task.workpiece_speed, grasp=grasp).scenes[0]
     n = scene.n_contacts
     rows = np.array([[lo] * n, [hi] * n]) if task.shared_mu else np.array(list(product((lo, hi), repeat=n)))
     low, up, ok = effort_bands(scene, ContactMode(MODE), rows, force_margin=task.force_margin)
@@ -208,14 +208,16 @@ def _edge_corners(task, x, effort, direction):
     return tuple(float(m) for m in rows[i]), tuple(float(m) for m in rows[j])
 
 
-def failure_report(task, name, x0, x1, effort, direction, competitors, result=None, xs=None) -> FailureReport:
-    """The report for a segment from ``x0`` to ``x1`` (m) with no plan (see the module docstring)."""
+def failure_report(task, name, x0, x1, effort, direction, competitors, result=None, xs=None,
+                   grasp=None) -> FailureReport:  # fmt: skip
+    """The report for a segment from ``x0`` to ``x1`` (m) with no plan (see the module docstring); ``grasp``
+    (:class:`qsplan.hands.grasps.Grasp`) the features the fingers touch (default both inner edges)."""
     from qsplan.planner.planning.contact_state import check_contact_state
 
     xs = np.linspace(x0, x1, REPORT_SAMPLES) if xs is None else np.asarray(xs, float)
     if xs.size > REPORT_SAMPLES:
         xs = xs[np.linspace(0, xs.size - 1, REPORT_SAMPLES).astype(int)]
-    checks = [check_contact_state(task, x, effort, direction, None, competitors) for x in xs]
+    checks = [check_contact_state(task, x, effort, direction, None, competitors, grasp) for x in xs]
     closed = []
     for c in checks:
         if c.ok:
@@ -230,15 +232,15 @@ def failure_report(task, name, x0, x1, effort, direction, competitors, result=No
         if narrowest.reason.startswith(("band", "no guaranteed band")):
             # box corners of the edges mean nothing where the mode is degenerate (Q_AI singular inside the box)
             if "degenerate" not in narrowest.reason:
-                lo_e, hi_e = _edge_corners(task, narrowest.x, effort, direction)
+                lo_e, hi_e = _edge_corners(task, narrowest.x, effort, direction, grasp)
                 narrowest = replace(narrowest, mu_lower_edge=lo_e, mu_upper_edge=hi_e)
-            mu_closes = _mu_closes(task, narrowest.x, effort, direction, competitors)
+            mu_closes = _mu_closes(task, narrowest.x, effort, direction, competitors, grasp)
     status = "not run (start or goal invalid)" if result is None else result.status
     return FailureReport(name, float(x0), float(x1), effort, task.torque_resolution, task.mu_range, status,
                          tuple(closed), narrowest, mu_closes)  # fmt: skip
 
 
-def _mu_closes(task, x, effort, direction, competitors, iterations=30):
+def _mu_closes(task, x, effort, direction, competitors, grasp=None, iterations=30):
     """The friction upper bound at which the band at ``x`` shrinks to the resolution (bisection), or None."""
     from dataclasses import replace as dc_replace
 
@@ -247,7 +249,7 @@ def _mu_closes(task, x, effort, direction, competitors, iterations=30):
     lo, hi = task.mu_range
 
     def ok(m):
-        return check_contact_state(dc_replace(task, mu_range=(lo, m)), x, effort, direction, None, competitors).ok
+        return check_contact_state(dc_replace(task, mu_range=(lo, m)), x, effort, direction, None, competitors, grasp).ok
 
     if not ok(lo) or ok(hi):
         return None

@@ -3,10 +3,12 @@
 :func:`run_plan` is what ``qsplan plan`` and ``qsplan demo`` run, and what a planning
 script calls: it checks its outputs before planning (nothing is overwritten without
 ``force``), plans (:func:`qsplan.planner.planning.plan.plan_task`), writes ``plan.csv`` and
-``plan.json`` (:func:`qsplan.planner.export.plan_files.export_plan`), the operator plots
-(:func:`qsplan.planner.plotting.plan.plan_figures`) and ``replay.json``: the exported file
-re-simulated (:func:`qsplan.planner.planning.replay.replay_plan`) at ``verify`` friction
-vectors of the interval.  Before anything is presented as a plan, the exported file is
+``plan.json`` (:func:`qsplan.planner.export.plan_files.export_plan`), ``replay.json``: the
+exported file re-simulated (:func:`qsplan.planner.planning.replay.replay_plan`) at ``verify``
+friction vectors of the interval, and the operator plots with the plan card
+(:func:`qsplan.planner.plotting.plan.plan_figures`).  Outputs it wrote are recorded in
+``.qsplan-outputs.json``, so a second run into the same directory replaces them (and only them)
+without ``force``.  Before anything is presented as a plan, the exported file is
 certified row by row from the task alone (:func:`qsplan.planner.planning.certify.certify_plan`,
 ``certificate.json``): a plan that fails is removed, ``failure.json`` names the rows and
 reasons, and :class:`~qsplan.planner.planning.results.PlanFailure` is raised.  When no plan exists it writes ``failure.json`` (the report of
@@ -22,7 +24,8 @@ from pathlib import Path
 
 from qsplan.mechanics.errors import QsplanError
 
-from qsplan.planner.export.files import atomic_write, check_out_dir, check_outputs, remove_stale
+from qsplan.planner.export.files import atomic_write, check_out_dir, check_output_path, check_outputs, remove_stale
+from qsplan.planner.export.manifest import MANIFEST, own_outputs, record_outputs
 from qsplan.planner.planning.plan import DEFAULT_OPTIONS, plan_task
 from qsplan.planner.planning.results import Plan, PlanFailure
 
@@ -52,8 +55,8 @@ class CertificationReport:
     def as_dict(self) -> dict:
         return {"kind": "certification", "message": self.message, "certificate": self.certificate.to_dict()}
 
-#: Plots it writes (``<name>.png``) unless ``plots=False``.
-PLAN_PLOTS = ("plan_bands", "mode_timeline", "hand_snapshots")
+#: Plots it writes (``<name>.png``) unless ``plots=False``; ``plan_card`` is the one page for the operator.
+PLAN_PLOTS = ("plan_bands", "mode_timeline", "hand_snapshots", "plan_card")
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -92,7 +95,8 @@ def plan_outputs(out_dir, plots: bool = True) -> list:
 
 
 def run_plan(task, out_dir, *, seed: int = 1, planner: str = "RRTConnect", time_limit: float | None = None,
-             verify: int = 3, force: bool = False, plots: bool = True, progress=None) -> PlanRun:  # fmt: skip
+             verify: int = 3, force: bool = False, plots: bool = True, progress=None,
+             sequence_planner: str = "widest") -> PlanRun:  # fmt: skip
     """Plan ``task``, export it into ``out_dir``, draw it and re-simulate the exported file.
 
     Parameters
@@ -102,7 +106,9 @@ def run_plan(task, out_dir, *, seed: int = 1, planner: str = "RRTConnect", time_
     seed : int
         OMPL's random seed.
     planner : str
-        OMPL planner, one of :data:`qsplan.planner.planning.ompl_bridge.PLANNERS`.
+        OMPL planner of the regrasps, one of :data:`qsplan.planner.planning.ompl_bridge.PLANNERS`.
+    sequence_planner : str
+        A task with a ``goal``: the sequence search (:data:`qsplan.planner.sequence.ompl_search.SEQUENCE_PLANNERS`).
     time_limit : float, optional
         Seconds per OMPL query; default that of :data:`qsplan.planner.planning.plan.DEFAULT_OPTIONS`.
     verify : int
@@ -110,9 +116,12 @@ def run_plan(task, out_dir, *, seed: int = 1, planner: str = "RRTConnect", time_
         random ones: :func:`qsplan.planner.planning.replay.friction_samples`); 0 skips.
     force : bool
         Replace existing outputs; an earlier run's outputs (``failure.json`` included) are removed first,
-        so the directory never mixes two runs. Without it any existing output is refused.
+        so the directory never mixes two runs.  Without it, outputs an earlier run wrote and nobody
+        changed since (recorded in ``.qsplan-outputs.json``: :mod:`qsplan.planner.export.manifest`)
+        are replaced all the same, and any other existing output is refused.
     plots : bool
-        Draw ``plan_bands.png``, ``mode_timeline.png`` and ``hand_snapshots.png``.
+        Draw ``plan_card.png`` (:func:`qsplan.planner.plotting.card.plan_card`), ``plan_bands.png``,
+        ``mode_timeline.png`` and ``hand_snapshots.png``.
     progress : callable, optional
         ``progress(line)`` for progress messages.
 
@@ -131,39 +140,49 @@ def run_plan(task, out_dir, *, seed: int = 1, planner: str = "RRTConnect", time_
     if isinstance(verify, bool) or int(verify) != verify or verify < 0:
         raise QsplanError(f"verify: expected a nonnegative number of friction vectors; got {verify}")
     out = check_out_dir(out_dir)
-    check_outputs(plan_outputs(out, plots), force)
-    check_outputs([out / "failure.json"], force)  # an earlier run's report is an output too
-    # with force: no output of an earlier run stays beside this run's (a failure, --no-plots, Ctrl-C)
-    remove_stale(out, [p.name for p in plan_outputs(out, True)] + ["failure.json"])
+    check_output_path(out / MANIFEST)  # the record of what qsplan wrote: never through a link, checked up front
+    own = own_outputs(out)  # written by an earlier run and unchanged since: replaced without force
+    check_outputs([p for p in plan_outputs(out, plots) if p.name not in own], force)
+    if "failure.json" not in own:
+        check_outputs([out / "failure.json"], force)  # an earlier run's report is an output too
+    # no output of an earlier run stays beside this run's (a failure, --no-plots, Ctrl-C)
+    names = [p.name for p in plan_outputs(out, True)] + ["failure.json"]
+    remove_stale(out, names if force else [n for n in names if n in own])
     limit = DEFAULT_OPTIONS.time_limit if time_limit is None else time_limit
     if not (limit > 0 and limit < float("inf")):
         raise QsplanError(f"time_limit: expected a positive number of seconds; got {time_limit}")
     progress = progress or (lambda line: None)
     options = replace(DEFAULT_OPTIONS, seed=seed, planner=planner, time_limit=limit)
-    progress(f"task {task.name!r}: {len(task.waypoints)} in-contact segments, mu in {list(task.mu_range)}, "
+    what = f"goal {task.goal.describe()}" if task.goal is not None else f"{len(task.waypoints)} in-contact segments"
+    progress(f"task {task.name!r}: {what}, mu in {list(task.mu_range)}, "
              f"torque resolution {task.torque_resolution:g} N m")  # fmt: skip
     try:
-        plan = plan_task(task, options, progress)
+        plan = plan_task(task, options, progress, sequence_planner=sequence_planner)
     except PlanFailure as exc:
         path = atomic_write(out / "failure.json", json.dumps(exc.report.as_dict(), indent=1))
+        record_outputs(out, [path])
         raise PlanFailure(exc.report, report_path=path) from None
     from qsplan.planner.export.plan_files import export_plan
 
     files = [str(p) for p in export_plan(plan, out, force=True)]
     certificate = _certify(plan, out, files, progress)
-    if plots:
-        progress("drawing the plots")
-        from qsplan.planner.plotting.plan import plan_figures
-        from qsplan.planner.plotting.style import save_figure
-
-        for name, fig in plan_figures(plan).items():
-            path = out / f"{name}.png"
-            save_figure(fig, path, option="out_dir")
-            files.append(str(path))
     replays = _verify(plan, out / "plan.csv", int(verify), seed, progress)
     if replays:
         atomic_write(out / "replay.json", json.dumps([r.as_dict() for r in replays], indent=1))
         files.append(str(out / "replay.json"))
+    record_outputs(out, files)
+    if plots:  # after the re-simulation: the plan card states its verdict
+        progress("drawing the plots")
+        from qsplan.planner.plotting.card import CARD_DPI
+        from qsplan.planner.plotting.plan import plan_figures
+        from qsplan.planner.plotting.style import save_figure
+
+        for name, fig in plan_figures(plan, certificate, replays).items():
+            path = out / f"{name}.png"
+            card = name == "plan_card"  # an A4 page: kept at its size
+            save_figure(fig, path, option="out_dir", dpi=CARD_DPI if card else 110, tight=not card)
+            files.append(str(path))
+            record_outputs(out, [path])
     return PlanRun(plan, out, tuple(files), tuple(replays), certificate)
 
 
@@ -181,6 +200,7 @@ def _certify(plan, out, files, progress):
     remove_stale(out, ("plan.csv", "plan.json"))  # never left where it looks like a plan
     report = CertificationReport(certificate)
     path = atomic_write(out / "failure.json", json.dumps(report.as_dict(), indent=1))
+    record_outputs(out, [out / "certificate.json", path])
     raise PlanFailure(report, report_path=path)
 
 

@@ -215,6 +215,9 @@ def friction_samples(mu_range, n, seed=1, shared=False) -> list:
 def replay_segments(columns) -> list:
     """Split plan columns (:func:`qsplan.planner.export.plan_files.read_plan_csv`) into in-contact segments.
 
+    ``phase`` is the phase's integer index (``0``, ``1``, ...; files before issue 16 wrote ``0.0``,
+    ``1.0``, ...: both read alike).
+
     Returns
     -------
     list of dict
@@ -223,7 +226,13 @@ def replay_segments(columns) -> list:
     for key in ("t", "phase", "mode", "effort_joint", "x_workpiece", "q_left", "q_right"):
         if key not in columns:
             raise QsplanError(f"plan: column {key!r} missing; expected the columns of qsplan.planner.export.plan_files")
-    phases = np.asarray(columns["phase"], float).astype(int)
+    try:
+        values = np.asarray(columns["phase"], float)
+    except (TypeError, ValueError):
+        values = np.array([np.nan])
+    if not (np.all(np.isfinite(values)) and np.all(values == np.round(values)) and np.all(values >= 0)):
+        raise QsplanError("plan: column 'phase' holds a value that is not a phase index (0, 1, 2, ...)")
+    phases = values.astype(int)
     out = []
     for p in np.unique(phases):
         rows = np.flatnonzero(phases == p)
@@ -232,6 +241,41 @@ def replay_segments(columns) -> list:
             continue
         out.append(dict(phase=int(p), rows=rows, mode=mode, effort_joint=str(columns["effort_joint"][rows[0]])))
     return out
+
+
+def rows_pose(columns, k) -> np.ndarray:
+    """The planned workpiece pose at row ``k`` (m, m, rad), shape (3,)."""
+    return np.array([columns["x_workpiece"][k], columns["y_workpiece"][k], columns["theta_workpiece"][k]], float)
+
+
+#: Joint angles (rad) within which an exported row's fingers are taken to realise a grasp's closed form:
+#: the export writes angles to 1e-12 or better (repr of floats), tangency round-off is ~1e-15.
+GRASP_MATCH_TOL = 1e-9
+
+
+def grasp_angles(hand, pose, q_planned, planned_pose) -> np.ndarray:
+    """Joint angles (rad, shape (2,)) that put both fingers on the workpiece at ``pose`` with the grasp the plan
+    uses at ``planned_pose`` (its exported angles ``q_planned``): both inner edges on their vertices of
+    tangency (:func:`qsplan.hands.two_finger.finger_angles`) when those are the planned angles, else the
+    candidate grasp (:func:`qsplan.hands.grasp_geometry.candidate_grasps`) whose closed form gives them.
+    At the planned pose these are the planned angles; after a re-simulated segment the workpiece may stand a
+    little elsewhere and the fingers close on it there, with the same grasp."""
+    from qsplan.hands.two_finger import finger_angles
+
+    try:
+        q_inner = finger_angles(hand, planned_pose)[0]
+    except QsplanError:
+        q_inner = None
+    if q_inner is not None and np.allclose(q_inner, q_planned, rtol=0.0, atol=GRASP_MATCH_TOL):
+        return finger_angles(hand, pose)[0]
+    from qsplan.hands.grasp_geometry import candidate_grasps, grasp_configurations
+
+    for grasp in candidate_grasps(hand):
+        at = grasp_configurations(hand, grasp, np.array([planned_pose[0], pose[0]]))
+        if at.ok[0] and np.allclose(at.q[0], q_planned, rtol=0.0, atol=GRASP_MATCH_TOL) and at.ok[1]:
+            return at.q[1]
+    raise QsplanError(f"q: the planned angles {np.round(q_planned, 6).tolist()} rad at x = {planned_pose[0]:.6g} m "
+                      "are no grasp of this hand")  # fmt: skip
 
 
 def replay_plan(columns, hand, mu, options=None, scenes=None) -> Replay:
@@ -255,7 +299,6 @@ def replay_plan(columns, hand, mu, options=None, scenes=None) -> Replay:
     -------
     Replay
     """
-    from qsplan.hands.two_finger import finger_angles
     from qsplan.mechanics.motion.simulator import simulate
     from qsplan.mechanics.motion.system import make_friction
 
@@ -274,10 +317,10 @@ def replay_plan(columns, hand, mu, options=None, scenes=None) -> Replay:
                               np.asarray(columns[f"tau_{e}"], float)[rows], friction,
                               scenes.setdefault(seg["phase"], {}))  # fmt: skip
         k = rows[0]
-        pose = np.array([columns["x_workpiece"][k], columns["y_workpiece"][k], columns["theta_workpiece"][k]], float)
+        pose = rows_pose(columns, k)
         if x_prev is not None:
             pose = x_prev[:3]  # the regrasp leaves the workpiece where the simulation put it
-        q = finger_angles(hand, pose)[0]  # both fingers on the workpiece (the grasp)
+        q = grasp_angles(hand, pose, np.array([columns["q_left"][k], columns["q_right"][k]], float), rows_pose(columns, k))
         x0 = np.concatenate([pose, q, [t[0]]])
         start = _start_modes(system, x0, mu)
         if start != (seg["mode"],):

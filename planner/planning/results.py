@@ -152,6 +152,11 @@ class Plan:
     ompl_seconds : float
         Time judging them (s): the in-contact dense sweeps (scenes, overlaps, guaranteed bands)
         plus the regrasps' OMPL queries; ``checks_per_second`` is their ratio.
+    options : PlannerOptions
+    sequence : tuple of dict
+        The sequence the planner chose (automatic planning, :mod:`qsplan.planner.sequence`): one plain dict per
+        phase (``kind`` "slide" or "regrasp", the grasp's features, ``x`` from and to (m), the effort-controlled
+        finger, the narrowest band (N m)), and the search's figures; empty for a scripted task.
     """
 
     task: Task
@@ -160,6 +165,7 @@ class Plan:
     validity_checks: int
     ompl_seconds: float
     options: PlannerOptions = field(default_factory=PlannerOptions)
+    sequence: tuple = ()
 
     @property
     def segments(self) -> tuple:

@@ -50,6 +50,7 @@ import numpy as np
 from qsplan.mechanics.bands.effort import ForceMargin, check_force_margin
 from qsplan.mechanics.errors import QsplanError
 from qsplan.mechanics.model.friction import check_mu_range
+from qsplan.planner.planning.goal import Goal, make_goal, make_start_features
 from qsplan.planner.torque.command import PLAN_FORCE_MARGIN, plan_force_margin
 
 __all__ = ["Task", "load_task", "make_task", "demo_task_path", "task_paths", "TASK_RANGES", "MAX_WAYPOINTS",
@@ -131,6 +132,10 @@ class Task:
     force_margin : ForceMargin
         Minimum normal force and Coulomb slack (N) every guaranteed band keeps for all friction in the range
         (default :data:`qsplan.planner.torque.command.PLAN_FORCE_MARGIN`, with its reason).
+    goal : qsplan.planner.planning.goal.Goal or None
+        Where an automatically planned task ends (then ``waypoints`` is empty).
+    start_features : ((str, int or None), (str, int or None))
+        Where each finger touches at the start: ``("inner", None)`` or ``(kind, K)`` (polygon as written).
     """
 
     name: str
@@ -144,6 +149,13 @@ class Task:
     joint_speed: float
     workpiece_speed: float
     force_margin: ForceMargin = PLAN_FORCE_MARGIN
+    goal: Goal | None = None
+    start_features: tuple = (("inner", None), ("inner", None))
+
+    @property
+    def automatic(self) -> bool:
+        """Whether the planner finds the sequence (a ``[goal]``, no scripted waypoints)."""
+        return self.goal is not None
 
     def pose(self, x) -> np.ndarray:
         """Workpiece pose ``(x, rest height, 0)`` (m, m, rad), shape (3,)."""
@@ -228,11 +240,13 @@ def _pair(value, field, unit) -> tuple:
     return lo, hi
 
 
-def make_task(hand, start_x, waypoints, mu_range=(0.0, 0.2), torque_resolution=0.02, shared_mu=False,
+def make_task(hand, start_x, waypoints=None, mu_range=(0.0, 0.2), torque_resolution=0.02, shared_mu=False,
               joint_limits=((0.05, 3.09), (0.05, 3.09)), joint_speed=0.5, workpiece_speed=0.01,
-              name="task", force_margin=None) -> Task:  # fmt: skip
+              name="task", force_margin=None, goal=None, start=None) -> Task:  # fmt: skip
     """Validate and build a :class:`Task` (parameters as its attributes; ``hand`` a TwoFingerHand or a dict of
-    :func:`qsplan.hands.two_finger.make_two_finger_hand` arguments).
+    :func:`qsplan.hands.two_finger.make_two_finger_hand` arguments).  Either ``waypoints`` (a scripted
+    sequence) or ``goal`` (the ``[goal]`` table as a dict, or a :class:`Goal`: the planner finds the sequence);
+    ``start`` the ``[start]`` table as a dict (default both fingers ``"inner"``).
 
     Raises
     ------
@@ -249,11 +263,22 @@ def make_task(hand, start_x, waypoints, mu_range=(0.0, 0.2), torque_resolution=0
     if not isinstance(name, str) or len(name) > 200:
         raise QsplanError(f"name: expected a string of at most 200 characters; got {_short(name)}")
     start_x = _in_range(_number(start_x, "motion.start_x", "m"), "motion.start_x", "position")
-    if not isinstance(waypoints, (list, tuple, np.ndarray)) or not 1 <= len(waypoints) <= MAX_WAYPOINTS:
+    n_v = len(hand.workpiece)
+    start_features = make_start_features({} if start is None else start, n_v)
+    if goal is not None and waypoints is not None:
+        raise QsplanError("goal: give either motion.waypoints (a scripted sequence) or [goal] (the planner finds the "
+                          "sequence), not both")  # fmt: skip
+    if goal is not None:
+        number = lambda v, field, unit: _in_range(_number(v, field, unit), field, "position")  # noqa: E731
+        goal = goal if isinstance(goal, Goal) else make_goal(goal, n_v, number)
+        waypoints = ()
+    elif waypoints is None:
+        raise QsplanError("motion.waypoints: missing (or give a [goal] table: the planner then finds the sequence)")
+    elif not isinstance(waypoints, (list, tuple, np.ndarray)) or not 1 <= len(waypoints) <= MAX_WAYPOINTS:
         raise QsplanError(f"motion.waypoints: expected a list of 1 to {MAX_WAYPOINTS} workpiece x (m); "
                           f"got {_short(waypoints)}")  # fmt: skip
     wp = np.array([_in_range(_number(v, f"motion.waypoints[{i}]", "m"), f"motion.waypoints[{i}]", "position")
-                   for i, v in enumerate(waypoints)])  # fmt: skip
+                   for i, v in enumerate(waypoints)], dtype=float)  # fmt: skip
     prev = np.concatenate([[start_x], wp[:-1]])
     short = np.abs(wp - prev) < MIN_SEGMENT_LENGTH
     if np.any(short):
@@ -287,10 +312,10 @@ def make_task(hand, start_x, waypoints, mu_range=(0.0, 0.2), torque_resolution=0
                                          ("workpiece_speed", "limits.workpiece_speed", workpiece_speed))}  # fmt: skip
     force_margin = PLAN_FORCE_MARGIN if force_margin is None else check_force_margin(force_margin)
     return Task(name, hand, start_x, wp, (lo, hi), bool(shared_mu), checked["torque_resolution"], limits,
-                checked["joint_speed"], checked["workpiece_speed"], force_margin)  # fmt: skip
+                checked["joint_speed"], checked["workpiece_speed"], force_margin, goal, start_features)  # fmt: skip
 
 
-_KNOWN = {"name", "hand", "motion", "friction", "controller", "limits"}
+_KNOWN = {"name", "hand", "motion", "friction", "controller", "limits", "goal", "start"}
 
 
 def _table(doc, key):
@@ -322,18 +347,21 @@ def load_task(path) -> Task:
     unknown = sorted(set(doc) - _KNOWN)
     if unknown:
         raise QsplanError(f"{unknown[0]}: unknown task field; expected one of {', '.join(sorted(_KNOWN))}")
+    kw = {}
     motion, friction = _table(doc, "motion"), _table(doc, "friction")
     controller, limits = _table(doc, "controller"), _table(doc, "limits")
     for key, table in (("motion", motion), ("friction", friction), ("controller", controller), ("limits", limits)):
         extra = sorted(set(table) - _TABLE_KEYS[key])
         if extra:
             raise QsplanError(f"{key}.{extra[0]}: unknown field; expected some of {', '.join(sorted(_TABLE_KEYS[key]))}")
-    for key, table in (("motion.start_x", motion), ("motion.waypoints", motion)):
-        if key.split(".")[1] not in table:
-            raise QsplanError(f"{key}: missing")
+    if "start_x" not in motion:
+        raise QsplanError("motion.start_x: missing")
+    if "goal" in doc:
+        kw["goal"] = _table(doc, "goal")
+    if "start" in doc:
+        kw["start"] = _table(doc, "start")
     if "torque_resolution" not in controller:
         raise QsplanError("controller.torque_resolution: missing (N m)")
-    kw = {}
     if "range" in friction:
         kw["mu_range"] = friction["range"]
     if "shared" in friction:
@@ -346,7 +374,7 @@ def load_task(path) -> Task:
         if key in limits:
             kw[key] = limits[key]
     kw["force_margin"] = plan_force_margin(controller.get("min_normal_force"), controller.get("min_coulomb_slack"))
-    return make_task(_table(doc, "hand"), motion["start_x"], motion["waypoints"],
+    return make_task(_table(doc, "hand"), motion["start_x"], motion.get("waypoints"),
                      torque_resolution=controller["torque_resolution"], name=doc.get("name", path.stem), **kw)  # fmt: skip
 
 

@@ -1,26 +1,36 @@
-"""Plots for operators: torque bands along a segment (Figs. 10-13); hand snapshots are in :mod:`.hands`.
+"""Plots for operators: torque bands along a segment (Figs. 10-13) and the speed/accuracy chart of bands.
 
-Compute lives in :mod:`qsplan.planner.torque`; this module only draws.
-As in the paper, upper bounds are bold solid curves and lower bounds bold dashed
-ones; a side beyond the display limit (or infinite) is drawn along the limit with
-up (down) arrows and said so in the legend, as the paper truncated Fig. 10 "at 200
-oz.-in.".  Efforts are in N m; a right-hand axis repeats them in the paper's oz in.
+Compute lives in :mod:`qsplan.planner.torque`; this module only draws.  The panels are drawn by
+:mod:`qsplan.planner.plotting.band_panels` (upper edges solid, lower edges dashed, infinite and
+off-plot sides marked apart); this module composes the paper's figures: Fig. 10 (frictionless),
+Fig. 11 (the highest friction) and Fig. 12 (the competing modes), each with a zoom on the lower edge
+(the torque the mode needs) when the full range would hide it, and Fig. 13 (the guaranteed band).
 
-Every ``plot_*`` function takes ``ax=None`` (a new figure is made) and returns the
-axes; ``*_figure`` functions return a ``matplotlib.figure.Figure`` (no pyplot).
+Every ``plot_*`` function takes ``ax=None`` (a new figure is made) and returns the axes;
+``*_figure`` functions return a ``matplotlib.figure.Figure`` (no pyplot).
 matplotlib is imported inside the functions.
 """
 
 from __future__ import annotations
 
+import textwrap
+
 import numpy as np
 
+from qsplan.planner.plotting.band_panels import (
+    OZ_IN_PER_N_M,
+    auto_display_limit,
+    plot_band_sweep,
+    plot_guaranteed,
+    secondary_oz_in,
+)
 from qsplan.planner.plotting.hands import hand_strip_figure, plot_hand
-from qsplan.planner.plotting.style import axes_or_new
+from qsplan.planner.plotting.style import COMPETITOR, FONT, PALETTE, axes_or_new, legend_below
 
 __all__ = [
     "OZ_IN_PER_N_M",
     "auto_display_limit",
+    "competitor_note",
     "hand_strip_figure",
     "plot_band_sweep",
     "plot_guaranteed",
@@ -29,217 +39,83 @@ __all__ = [
     "segment_band_figures",
 ]
 
-#: 1 N m in ounce-force inches (the paper's torque unit): 1 / (0.0283495 kg * 9.80665 m/s^2 * 0.0254 m).
-OZ_IN_PER_N_M = 141.61193227806
-
-_UPPER = "#1f3b73"
-_LOWER = "#1f3b73"
-_FILL = "#9ecae1"
-_COMP = "#c44e52"
-_NOBAND = "#eeeeee"
-
-#: A competitor is drawn inside the desired mode's band only where it reaches more than this
-#: (relative) past the band's edge; touching the edge (a shared boundary) cuts nothing.
-_DRAW_RTOL = 1e-6
+#: A zoom panel on the lower edge is added when the lower edge stays under this fraction of the display limit.
+ZOOM_FRACTION = 0.15
 
 
-def _axes(ax, size=(6.4, 3.6)):
-    return axes_or_new(ax, size)
+def _contact_words(samples) -> dict:
+    """Contact name -> words (``"palm:0"`` -> ``"the left palm vertex"``), from the first sample's geometry."""
+    from qsplan.mechanics.muspace.graphical import contact_points
+
+    scene = samples.scenes[0]
+    names = list(scene.contact_names)
+    palm = [i for i, n in enumerate(names) if n.startswith("palm")]
+    words = {n: n for n in names}
+    if len(palm) == 2:
+        x = contact_points(scene)[palm, 0]
+        left, right = (palm[0], palm[1]) if x[0] <= x[1] else (palm[1], palm[0])
+        words[names[left]], words[names[right]] = "the left palm vertex", "the right palm vertex"
+    for n in names:
+        if n.startswith(("left", "right")):
+            words[n] = f"the {n.split(':')[0]} finger's contact"
+    return words
 
 
-def _nice_ceiling(x: float) -> float:
-    """Smallest of 1, 1.5, 2, 3, 4, 5, 6, 8 times a power of ten at or above ``x`` (> 0)."""
-    if not np.isfinite(x) or x <= 0:
-        return 1.0
-    e = 10.0 ** np.floor(np.log10(x))
-    for m in (1.0, 1.5, 2.0, 3.0, 4.0, 5.0, 6.0, 8.0, 10.0):
-        if m * e >= x * (1 - 1e-12):
-            return float(m * e)
-    return float(10 * e)
-
-
-def auto_display_limit(*sweeps) -> float:
-    """A display limit (N m) for bands: twice the upper quartile of their finite edges, rounded up."""
-    vals = np.concatenate([np.abs(np.r_[s.lower, s.upper]) for s in sweeps]) if sweeps else np.array([])
-    vals = vals[np.isfinite(vals)]
-    if not vals.size:
-        return 1.0
-    return _nice_ceiling(2.0 * float(np.percentile(vals, 75)))
-
-
-def _secondary_oz_in(ax):
-    sec = ax.secondary_yaxis("right", functions=(lambda y: y * OZ_IN_PER_N_M, lambda y: y / OZ_IN_PER_N_M))
-    sec.set_ylabel("oz in (the paper's unit)", fontsize=8)
-    sec.tick_params(labelsize=7)
-    return sec
-
-
-def _shade_no_band(ax, t, feasible, label="no band"):
-    dt = (t[-1] - t[0]) / max(len(t) - 1, 1)
-    labelled = False
-    k = 0
-    while k < len(t):
-        if feasible[k]:
-            k += 1
-            continue
-        j = k
-        while j + 1 < len(t) and not feasible[j + 1]:
-            j += 1
-        ax.axvspan(t[k] - dt / 2, t[j] + dt / 2, color=_NOBAND, zorder=0, label=None if labelled else label)
-        labelled = True
-        k = j + 1
-
-
-def _clipped(values, limit):
-    """Values clipped to ``[-limit, limit]`` and the mask of clipped (or infinite) points."""
-    v = np.asarray(values, dtype=float)
-    over = np.isfinite(v) & (np.abs(v) > limit) | np.isinf(v)
-    return np.clip(v, -limit, limit), over
-
-
-def plot_band_sweep(sweep, ax=None, display_limit=None, color=_UPPER, fill=_FILL, name=None, title=None, oz_in=True,
-                    thin=False):
-    """One band along a segment, the paper's way (Figs. 10-12).
-
-    Parameters
-    ----------
-    sweep : qsplan.planner.torque.pointwise.BandSweep
-    ax : matplotlib Axes, optional
-    display_limit : float, optional
-        N m; sides beyond it (or infinite) are drawn along it with arrows.  Default
-        :func:`auto_display_limit`.
-    color, fill : colours of the edges and of the band.
-    name : str, optional
-        Legend prefix (default the sweep's label).
-    title : str, optional
-    oz_in : bool
-        Add the right-hand axis in oz in.
-    thin : bool
-        Thin lines (for an overlay).
-
-    Returns
-    -------
-    matplotlib.axes.Axes
-    """
-    ax = _axes(ax)
-    had, prev = bool(ax.lines), ax.get_ylim()  # overlaying on another band: keep its range too
-    limit = auto_display_limit(sweep) if display_limit is None else float(display_limit)
-    t, feas = sweep.t, sweep.feasible
-    name = name or sweep.label
-    lo, lo_cut = _clipped(sweep.lower, limit)
-    up, up_cut = _clipped(sweep.upper, limit)
-    lo, up = np.where(feas, lo, np.nan), np.where(feas, up, np.nan)
-    if fill:
-        ax.fill_between(t, lo, up, where=feas, color=fill, alpha=0.45, lw=0, label=f"{name}: band")
-    lw = 1.1 if thin else 2.6
-    ax.plot(t, up, color=color, lw=lw, ls="-", label=f"{name}: upper bound")
-    ax.plot(t, lo, color=color, lw=lw, ls="--", label=f"{name}: lower bound")
-    step = max(1, len(t) // 14)
-    raw = np.r_[sweep.upper, sweep.lower]
-    ys = np.r_[up, lo]
-    cut = np.r_[up_cut, lo_cut] & np.r_[feas, feas]
-    tt = np.r_[t, t]
-    for sign, marker in ((1.0, "^"), (-1.0, "v")):
-        idx = np.flatnonzero(cut & (np.sign(raw) == sign))
-        if idx.size:
-            idx = idx[:: step] if idx.size > step else idx
-            ax.plot(tt[idx], ys[idx], ls="none", marker=marker, ms=5 if thin else 6, color=color,
-                    label=f"{name}: beyond {sign * limit:+g} N m (or infinite)")  # fmt: skip
-    if not thin:  # say where a side is infinite, not merely off scale
-        for a, b in sweep.infinite_upper_spans():
-            ax.annotate(f"infinite for t in [{a:.3g}, {b:.3g}] s", ((a + b) / 2, limit), xytext=(0, 4),
-                        textcoords="offset points", ha="center", va="bottom", fontsize=7, color=color)  # fmt: skip
-    if not feas.all():
-        _shade_no_band(ax, t, feas, label=f"{name}: infeasible for every torque")
-    finite = np.r_[lo[np.isfinite(lo)], up[np.isfinite(up)]]
-    bottom = min(0.0, float(finite.min())) if finite.size else 0.0
-    b0, t0 = prev if had else (np.inf, -np.inf)
-    ax.set_ylim(min(b0, bottom - 0.04 * limit), max(t0, limit * 1.08))
-    ax.set_xlim(t[0], t[-1])
-    ax.set_xlabel("t (s)")
-    ax.set_ylabel(f"torque of joint {sweep.joint!r} (N m)")
-    ax.axhline(0.0, color="0.6", lw=0.6, zorder=0)
-    if title:
-        ax.set_title(title, fontsize=10)
-    _legend(ax)
-    if oz_in:
-        _secondary_oz_in(ax)
-    return ax
-
-
-def _legend(ax):
-    """The legend under the axes, so that it never hides a band."""
-    ax.legend(fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.16), ncol=2, frameon=False)
-
-
-def plot_guaranteed(bands, ax=None, display_limit=None, show_sampled=True, show_command=True, title=None, oz_in=True):
-    """Fig. 13: the band guaranteeing the desired mode and precluding the competitors, with its narrowest point.
-
-    Parameters
-    ----------
-    bands : qsplan.planner.torque.sweep.SegmentBands
-    ax : matplotlib Axes, optional
-    display_limit : float, optional
-        N m; default :func:`auto_display_limit` of the guaranteed band.
-    show_sampled : bool
-        Overlay the paper's sampled band (thin lines).
-    show_command : bool
-        Overlay the exported command (dotted).
-
-    Returns
-    -------
-    matplotlib.axes.Axes
-    """
+def competitor_note(bands) -> str:
+    """Which competitor Fig. 12 shows, in words, and whether the paper's R2S (the left palm vertex rolling, the
+    right one lifting) competes at all on this segment."""
     from qsplan.mechanics.modes.contact_mode import ContactMode
 
-    from qsplan.planner.torque.pointwise import narrowest
+    S = bands.samples
+    words = _contact_words(S)
+    names = list(S.scenes[0].contact_names)
+    verbs = {"R": "rolls", "S": "slides", "B": "lifts off"}
+    hi = bands.guaranteed.mu_range[1]
+    lines = []
+    for c, sw in bands.competitors_at_high_mu.items():
+        if not sw.feasible.any():
+            continue
+        what = ", ".join(f"{words[n]} {verbs[ch]}" for n, ch in zip(names, c) if ch != "S")
+        spans = ", ".join(f"[{a:.3g}, {b:.3g}] s" for a, b in sw.feasible_spans())
+        lines.append(f"{ContactMode(c).kind} {c}: {what}; feasible at mu = {hi:g} for t in {spans}")
+    paper = [c for c in bands.competitors_at_high_mu if ContactMode(c).kind == "R2S"
+             and all((ch == "R") == (words[n] == "the left palm vertex") and (ch == "B") == (words[n] == "the right palm vertex")
+                     for n, ch in zip(names, c) if n.startswith("palm"))]  # fmt: skip
+    for c in paper:
+        if not bands.competitors_at_high_mu[c].feasible.any():
+            lines.append(f"the paper's R2S ({c}: the left palm vertex rolls, the workpiece turns counter-clockwise) "
+                         f"is nowhere feasible here: our hand's dimensions are not the paper's (it gives none)")  # fmt: skip
+    return "\n".join(lines) or f"no competing mode is feasible at mu = {hi:g}"
 
-    ax = _axes(ax, size=(7.0, 4.0))
-    g = bands.guaranteed
-    band = g.band
-    k, w = narrowest(band)
-    if display_limit is None:  # show the narrowest point whole, truncate blow-ups
-        limit = auto_display_limit(band)
-        if k is not None and np.isfinite(band.upper[k]):
-            limit = max(limit, _nice_ceiling(4.0 * abs(float(band.upper[k]))))
-    else:
-        limit = float(display_limit)
-    kind = "one shared mu" if g.shared else "each contact's mu"
-    where = f"{kind} in [{g.mu_range[0]:g}, {g.mu_range[1]:g}]"
-    plot_band_sweep(band, ax, limit, name="guaranteed", oz_in=False)
-    t = band.t
-    for c, (clo, chi) in g.competitors.items():
-        # a competitor that only touches the band's edge (shared boundary) cuts nothing: not drawn
-        d_lo, d_hi = g.desired.lower, g.desired.upper
-        with np.errstate(invalid="ignore"):
-            inside = (clo < d_hi - _DRAW_RTOL * np.maximum(1.0, np.abs(d_hi))) & (
-                chi > d_lo + _DRAW_RTOL * np.maximum(1.0, np.abs(d_lo)))
-        hit = np.isfinite(clo) & inside
-        if hit.any():
-            ax.fill_between(t, np.clip(clo, -limit, limit), np.clip(chi, -limit, limit), where=hit, color=_COMP,
-                            alpha=0.3, hatch="//", lw=0, label=f"{c} possible (precluded)")  # fmt: skip
-    if show_sampled:
-        s = bands.sampled
-        n = s.label.split("sampling ")[1].split(" friction")[0]
-        plot_band_sweep(s, ax, limit, color="#e377c2", fill=None, name=f"paper's method ({n} mu)",
-                        oz_in=False, thin=True)  # fmt: skip
-    if show_command:
-        ax.plot(t, np.clip(bands.command, -limit, limit), color="k", lw=1.0, ls=":", label="exported command")
-    if k is not None and np.isfinite(w):
-        ax.annotate("", xy=(t[k], band.upper[k]), xytext=(t[k], band.lower[k]),
-                    arrowprops={"arrowstyle": "<->", "color": "#d62728", "lw": 1.6})  # fmt: skip
-        ha = "right" if t[k] > 0.5 * (t[0] + t[-1]) else "left"
-        ax.annotate(f"narrowest: {w:.3g} N m ({w * OZ_IN_PER_N_M:.3g} oz in)\nat t = {t[k]:.3g} s: the torque\n"
-                    "resolution the controller needs",
-                    xy=(t[k], band.upper[k]), xytext=(-14 if ha == "right" else 14, 40),
-                    textcoords="offset points", ha=ha, fontsize=8, color="#d62728")  # fmt: skip
-    exact = "exact" if band.exact[band.feasible].all() else f"conservative at {int((~band.exact & band.feasible).sum())} points"
-    ax.set_title(title or f"{ContactMode(band.mode).kind} guaranteed for {where}, competitors precluded ({exact})", fontsize=10)
-    _legend(ax)
-    if oz_in:
-        _secondary_oz_in(ax)
+
+def _with_zoom(size=(8.0, 6.4)):
+    """A figure with a full panel over a zoom panel sharing the time axis."""
+    from matplotlib.figure import Figure
+
+    fig = Figure(figsize=size, layout="constrained")
+    top, zoom = fig.subplots(2, 1, sharex=True, height_ratios=[2.2, 1.0])
+    top.tick_params(labelbottom=False)
+    return fig, top, zoom
+
+
+def _zoom_panel(ax, sweeps, styles, top_ax):
+    """The band edges of ``sweeps`` up to three times the first one's largest lower edge (the torque the mode needs)."""
+    first = sweeps[0]
+    lows = first.lower[first.feasible & np.isfinite(first.lower)]
+    top = 3.0 * float(np.max(np.abs(lows))) if lows.size and np.max(np.abs(lows)) > 0 else 0.1
+    for s, kw in zip(sweeps, styles):
+        plot_band_sweep(s, ax, top, oz_in=False, legend=False, notes=False, markers=False, **kw)
+    ax.set_ylim(min(0.0, float(np.min(lows)) if lows.size else 0.0) - 0.05 * top, top)
+    ax.set_title("zoom on the lower edge: the torque the mode needs", fontsize=FONT["label"], loc="left")
+    top_ax.set_xlabel("")
+    legend_below(ax, handles=top_ax.get_legend_handles_labels()[0], ncol=2)
+    secondary_oz_in(ax)
     return ax
 
+
+def _needs_zoom(limit, *sweeps) -> bool:
+    lows = np.concatenate([s.lower[s.feasible & np.isfinite(s.lower)] for s in sweeps])
+    return bool(lows.size) and float(np.max(np.abs(lows))) < ZOOM_FRACTION * limit and float(np.max(np.abs(lows))) > 0
 
 
 def segment_band_figures(bands, display_limit=None, strip=5) -> dict:
@@ -265,38 +141,48 @@ def segment_band_figures(bands, display_limit=None, strip=5) -> dict:
     out = {}
     hi = bands.guaranteed.mu_range[1]
     lim = display_limit
-    fig, ax = new_axes(1, 1, size=(8.0, 4.6))
-    plot_band_sweep(bands.frictionless, ax[0, 0], lim if lim else auto_display_limit(bands.frictionless),
-                    title=f"Fig. 10: {bands.frictionless.label}")  # fmt: skip
-    out["fig10_frictionless"] = fig
-    fig, ax = new_axes(1, 1, size=(8.0, 4.6))
-    plot_band_sweep(bands.at_high_mu, ax[0, 0], lim if lim else auto_display_limit(bands.at_high_mu),
-                    title=f"Fig. 11: {bands.at_high_mu.label}")  # fmt: skip
-    out["fig11_mu_high"] = fig
-    fig, ax = new_axes(1, 1, size=(8.0, 4.6))
+    kind = ContactMode(bands.frictionless.mode).kind
+    for key, sweep, title in (("fig10_frictionless", bands.frictionless, f"Fig. 10: the {kind} band without friction (mu = 0)"),
+                              ("fig11_mu_high", bands.at_high_mu, f"Fig. 11: the {kind} band at mu = {hi:g}")):  # fmt: skip
+        limit = lim or auto_display_limit(sweep)
+        if _needs_zoom(limit, sweep):
+            fig, ax, zoom = _with_zoom()
+            plot_band_sweep(sweep, ax, limit, title=title, name=kind, legend=False)
+            _zoom_panel(zoom, [sweep], [{"name": kind}], ax)
+        else:
+            fig, axes = new_axes(1, 1, size=(8.0, 4.8))
+            plot_band_sweep(sweep, axes[0, 0], limit, title=title, name=kind)
+        out[key] = fig
     live = {c: s for c, s in bands.competitors_at_high_mu.items() if s.feasible.any()}
-    lim12 = lim if lim else auto_display_limit(bands.at_high_mu, *live.values())
-    plot_band_sweep(bands.at_high_mu, ax[0, 0], lim12, color="0.55", fill=None,
-                    name=ContactMode(bands.at_high_mu.mode).kind, oz_in=False, thin=True)  # fmt: skip
+    lim12 = lim or auto_display_limit(bands.at_high_mu, *live.values())
+    fig, ax, zoom = _with_zoom(size=(8.0, 7.0))
+    grey = {"color": "0.45", "fill": None, "name": f"{kind} (Fig. 11)", "thin": True}
+    plot_band_sweep(bands.at_high_mu, ax, lim12, oz_in=False, legend=False, **grey)
+    styles = [grey]
     for c, s in live.items():
-        plot_band_sweep(s, ax[0, 0], lim12, color=_COMP, fill="#f4a582", name=f"{ContactMode(c).kind} {c}", oz_in=False)
-    names = ", ".join(f"{ContactMode(c).kind} ({ContactMode(c).name}, {c})" for c in live) or "none feasible"
-    ax[0, 0].set_title(f"Fig. 12: competing modes at mu = {hi:g}: {names}", fontsize=10)
-    if not live:
-        ax[0, 0].text(0.5, 0.5, f"no competing mode is feasible at mu = {hi:g}", transform=ax[0, 0].transAxes,
-                      ha="center", fontsize=9, color=_COMP)  # fmt: skip
-    _secondary_oz_in(ax[0, 0])
+        style = {"color": COMPETITOR, "fill": "#f4a582", "name": f"{ContactMode(c).kind} {c}"}
+        plot_band_sweep(s, ax, lim12, oz_in=False, legend=False, **style)
+        styles.append(style)
+    names = ", ".join(f"{ContactMode(c).kind} ({c})" for c in live) or "none feasible"
+    note = "\n".join(textwrap.fill(line, 100) for line in competitor_note(bands).split("\n"))
+    ax.set_title(f"Fig. 12: the competing modes at mu = {hi:g}: {names}\n{note}", fontsize=FONT["label"])
+    secondary_oz_in(ax)
+    _zoom_panel(zoom, [bands.at_high_mu, *live.values()], styles, ax)
     out["fig12_competitors"] = fig
-    fig, ax = new_axes(1, 1, size=(8.0, 5.2))
-    plot_guaranteed(bands, ax[0, 0], lim, title=None)
-    ax[0, 0].set_title("Fig. 13: " + ax[0, 0].get_title(), fontsize=10)
+    fig, axes = new_axes(1, 1, size=(8.0, 5.4))
+    plot_guaranteed(bands, axes[0, 0], lim)
+    axes[0, 0].set_title("Fig. 13: " + axes[0, 0].get_title(), fontsize=FONT["title"] - 0.5)
     out["fig13_guaranteed"] = fig
     out["hand_strip"] = hand_strip_figure(bands.samples, strip)
     return out
 
 
 def plot_speed_accuracy(rows, ax=None, title=None):
-    """Band error against computing time for exact and sampled guaranteed bands (log-log).
+    """Band error against computing time for exact and sampled guaranteed bands.
+
+    Sampled methods are points (error on a log axis, labelled with their sample count); exact methods
+    have no error, so they are not drawn as if they had one: each is a vertical line at its time,
+    labelled in words.
 
     Parameters
     ----------
@@ -309,26 +195,34 @@ def plot_speed_accuracy(rows, ax=None, title=None):
     -------
     matplotlib.axes.Axes
     """
-    ax = _axes(ax, size=(6.4, 4.2))
-    errs = [r["error"] for r in rows if r["error"] > 0 and np.isfinite(r["error"])]
-    floor = (min(errs) / 10.0) if errs else 1e-12
-    colours = {"box": "#4c72b0", "shared": "#dd8452"}
+    from matplotlib.ticker import FuncFormatter, LogLocator, NullFormatter
+
+    ax = axes_or_new(ax, size=(6.8, 4.6))
+    colours = {"box": PALETTE[0], "shared": PALETTE[1]}
+    words = {"box": "each contact's mu", "shared": "one shared mu"}
     for kind in ("box", "shared"):
-        samp = sorted((r for r in rows if r["method"] == f"sampled {kind}"), key=lambda r: r["samples"])
+        samp = sorted((r for r in rows if r["method"] == f"sampled {kind}" and r["error"] > 0), key=lambda r: r["samples"])
         if samp:
             x = [r["time"] for r in samp]
-            y = [max(r["error"], floor) for r in samp]
-            ax.plot(x, y, "o-", color=colours[kind], label=f"sampled, {kind} mu (n = {samp[0]['samples']}..{samp[-1]['samples']})")
-            for r, xx, yy in zip(samp, x, y):
-                ax.annotate(str(r["samples"]), (xx, yy), xytext=(3, 3), textcoords="offset points", fontsize=7)
+            y = [r["error"] for r in samp]
+            ax.plot(x, y, "o-", color=colours[kind], ms=5,
+                    label=f"paper's sampling, {words[kind]} ({samp[0]['samples']}..{samp[-1]['samples']} samples)")  # fmt: skip
+            for k, (r, xx, yy) in enumerate(zip(samp, x, y)):
+                ax.annotate(str(r["samples"]), (xx, yy), xytext=(4, 4 if k % 2 else -10), textcoords="offset points",
+                            fontsize=FONT["note"], color=colours[kind])  # fmt: skip
         for r in rows:
             if r["method"] == f"exact {kind}":
-                ax.plot([r["time"]], [floor], "*", ms=14, color=colours[kind], label=f"exact, {kind} mu (error 0, drawn at the floor)")
+                ax.axvline(r["time"], color=colours[kind], ls="--", lw=1.4,
+                           label=f"exact, {words[kind]}: {r['time']:.2g} s, no error")  # fmt: skip
     ax.set_xscale("log")
     ax.set_yscale("log")
-    ax.set_xlabel("time for the whole segment (s)")
-    ax.set_ylabel("band error: largest excess width (N m)")
-    ax.set_title(title or "guaranteed torque band: speed against accuracy", fontsize=10)
-    _legend(ax)
-    ax.grid(True, which="both", lw=0.3, alpha=0.5)
+    plain = FuncFormatter(lambda v, _: f"{v:g}")
+    ax.xaxis.set_major_locator(LogLocator(base=10, subs=(1.0, 2.0, 5.0)))
+    ax.xaxis.set_major_formatter(plain)
+    ax.xaxis.set_minor_formatter(NullFormatter())
+    ax.set_xlabel("time for the whole segment (s)", fontsize=FONT["label"])
+    ax.set_ylabel("band error: largest excess width (N m)", fontsize=FONT["label"])
+    ax.set_title(title or "guaranteed torque band: speed against accuracy", fontsize=FONT["title"])
+    ax.grid(True, which="major", lw=0.3, alpha=0.6)
+    legend_below(ax, ncol=1)
     return ax

@@ -10,7 +10,12 @@ from __future__ import annotations
 
 import numpy as np
 
+from qsplan.planner.plotting.style import FONT, legend_below
+
 __all__ = [
+    "STOP_WORDS",
+    "contact_words",
+    "stop_words",
     "plot_rod_distances",
     "plot_rod_mu_space",
     "plot_mode_timeline",
@@ -22,14 +27,27 @@ __all__ = [
 _SLIDE = "#c44e52"
 _ROLL = "#4c72b0"
 
+#: Why a simulation stopped, in words (:data:`qsplan.mechanics.motion.trajectory.STOP_KINDS`).
+STOP_WORDS = {"ambiguous": "several modes possible (ambiguous)", "jam": "no mode possible (jam)",
+              "no_persistent_mode": "no mode can continue", "zeno": "the switches accumulate (Zeno)",
+              "limit": "a limit is reached", "max_switches": "too many switches"}  # fmt: skip
+
+
+def stop_words(kind: str) -> str:
+    """A stop kind in words (``"zeno"`` -> ``"the switches accumulate (Zeno)"``)."""
+    return STOP_WORDS.get(kind, str(kind).replace("_", " "))
+
+
+def contact_words(name: str) -> str:
+    """A contact's name for people (``"floor@v2"`` -> ``"floor under corner 3"``)."""
+    head, sep, vertex = str(name).partition("@v")
+    return f"{head} under corner {int(vertex) + 1}" if sep and vertex.isdigit() else str(name)
+
 
 def _axes(ax, size=(6.0, 4.0)):
-    if ax is not None:
-        return ax
-    from qsplan.planner.plotting.style import new_axes
+    from qsplan.planner.plotting.style import axes_or_new
 
-    _, axes = new_axes(1, 1, size=size)
-    return axes[0, 0]
+    return axes_or_new(ax, size=size)
 
 
 def plot_rod_distances(motion, ax=None, closed_form=None):
@@ -64,20 +82,21 @@ def plot_rod_distances(motion, ax=None, closed_form=None):
             ax.plot(seg.times, L[:, i], **kw)
     for t in motion.switch_times[:60]:
         ax.axvline(t, color="0.75", lw=0.5, zorder=0)
-    if closed_form is not None:
+    if closed_form is not None and len(closed_form.segments) > 1:  # on top of the curves, hollow: never hidden
         ends = closed_form.segments[:-1]
-        ax.plot([c.t_end for c in ends] * 2, [c.l1_end for c in ends] + [c.l2_end for c in ends], "k.", ms=3,
-                label="closed-form switches")  # fmt: skip
+        ax.plot([c.t_end for c in ends] * 2, [c.l1_end for c in ends] + [c.l2_end for c in ends], ls="none",
+                marker="o", ms=4.5, mfc="white", mec="k", mew=0.9, zorder=5, label="switch of the closed form")  # fmt: skip
     stop = motion.stopped
     n = len(motion.segments)
-    title = f"rod on two supports: {n} segment{'s' if n != 1 else ''}" + (f", stop: {stop.kind}" if stop else "")
+    title = f"rod on two supports: {n} stretch{'es' if n != 1 else ''} of one mode"
     if stop is not None:
-        ax.axvline(stop.time, color="k", ls="--", lw=1.0, label=f"stop: {stop.kind}")
-    ax.set_xlabel("t (s)")
-    ax.set_ylabel("distance from the centre of mass (m)")
-    ax.set_title(title, fontsize=10)
+        title += f"; stops at t = {stop.time:.3g} s: {stop_words(stop.kind)}"
+        ax.axvline(stop.time, color="k", ls="--", lw=1.0, label="stop")
+    ax.set_xlabel("t (s)", fontsize=FONT["label"])
+    ax.set_ylabel("distance from the centre of mass (m)", fontsize=FONT["label"])
+    ax.set_title(title, fontsize=FONT["label"])
     ax.set_ylim(bottom=0.0)
-    ax.legend(fontsize=8, loc="upper right")
+    legend_below(ax, ncol=2)
     return ax
 
 
@@ -108,9 +127,13 @@ def plot_rod_mu_space(motion, ax=None, max_lines=20):
     fr = motion.system.friction
     (m1R, m2R), (m1S, m2S) = fr.static, fr.kinetic
     top = 1.35 * max(m1R, m2R, 1e-3)
-    ax.add_patch(Rectangle((m1S, m2S), m1R - m1S, m2R - m2S, fc="#f0e6c8", ec="k", lw=1.0, label="friction rectangle"))
-    ax.plot([m1S], [m2R], "o", color=_SLIDE, ms=7, label="SR: $(\\mu_{1S}, \\mu_{2R})$")
-    ax.plot([m1R], [m2S], "s", color=_ROLL, ms=7, label="RS: $(\\mu_{1R}, \\mu_{2S})$")
+    if m1R > m1S and m2R > m2S:  # a rectangle with an area (equal static and kinetic friction: a point)
+        ax.add_patch(Rectangle((m1S, m2S), m1R - m1S, m2R - m2S, fc="#f0e6c8", ec="k", lw=1.0, zorder=3,
+                               label="friction rectangle (sliding to rolling values)"))  # fmt: skip
+    # the two corners may coincide (equal static and kinetic friction): a big hollow circle around a small square
+    ax.plot([m1S], [m2R], "o", ms=11, mfc="none", mec=_SLIDE, mew=2.0, zorder=6,
+            label="SR (R2S1) runs at $(\\mu_{1S}, \\mu_{2R})$")  # fmt: skip
+    ax.plot([m1R], [m2S], "s", color=_ROLL, ms=6, zorder=7, label="RS (R1S2) runs at $(\\mu_{1R}, \\mu_{2S})$")
     mu = np.linspace(0.0, top, 2)
     if motion.segments:
         l1, l2 = rod_distances(motion.segments[0].states[:1])[0]
@@ -132,10 +155,13 @@ def plot_rod_mu_space(motion, ax=None, max_lines=20):
     ax.set_xlim(0, top)
     ax.set_ylim(0, top)
     ax.set_aspect("equal")
-    ax.set_xlabel("$\\mu_1$")
-    ax.set_ylabel("$\\mu_2$")
-    ax.set_title(f"partition line $l_1 \\mu_2 = l_2 \\mu_1$, {len(motion.segments[:-1])} switches", fontsize=10)
-    ax.legend(fontsize=7, loc="lower right")
+    ax.set_xlabel("$\\mu_1$", fontsize=FONT["label"])
+    ax.set_ylabel("$\\mu_2$", fontsize=FONT["label"])
+    n = len(motion.segments[:-1])
+    at = f"at each of the {n} switches" if n > 1 else ("at the switch" if n else "at the start and the end, no switch")
+    ax.set_title(f"Fig. 8 along the motion: the partition line $l_1 \\mu_2 = l_2 \\mu_1$\n{at} "
+                 "(faint: between switches)", fontsize=FONT["label"])  # fmt: skip
+    legend_below(ax, ncol=1)
     return ax
 
 
@@ -155,17 +181,24 @@ def plot_mode_timeline(motion, ax=None):
         ax.barh(0, seg.duration, left=seg.t_start, color=c, edgecolor="k", lw=0.5)
         if seg.duration > 0.06 * max(motion.duration, 1e-12):
             ax.text(seg.t_start + seg.duration / 2, 0, seg.label, ha="center", va="center", fontsize=9, family="monospace")
+    end = max(motion.duration if motion.stopped is None else motion.stopped.time, 1e-12)
     for ev in motion.events:
         ax.plot(ev.time, 0.5, "kv", ms=5)
         if ev.kind in ("contact", "limit"):
-            ax.text(ev.time, 0.62, ev.kind, ha="center", fontsize=7)
+            words = "a contact appears" if ev.kind == "contact" else "a limit is reached"
+            right = ev.time > 0.8 * end
+            ax.annotate(words, (ev.time, 0.62), xytext=(-4 if right else 4, 2), textcoords="offset points",
+                        ha="right" if right else "left", fontsize=FONT["note"])  # fmt: skip
     if motion.stopped is not None:
-        ax.text(motion.stopped.time, -0.7, f"stop: {motion.stopped.kind}", ha="center", fontsize=8)
+        ax.annotate(f"stop: {stop_words(motion.stopped.kind)}", (motion.stopped.time, -0.7), xytext=(-4, 0),
+                    textcoords="offset points", ha="right", fontsize=FONT["note"])  # fmt: skip
     ax.set_yticks([])
     ax.set_ylim(-1, 1)
-    ax.set_xlim(0, max(motion.duration if motion.stopped is None else motion.stopped.time, 1e-12))
-    ax.set_xlabel("t (s)")
-    ax.set_title("contact mode: " + ", ".join(motion.system.contact_names), fontsize=9)
+    ax.set_xlim(0, end)
+    names = ", ".join(contact_words(n) for n in motion.system.contact_names)
+    ax.set_xlabel(f"t (s)\nmode: one letter per contact ({names}): R rolls, S slides, - not touching",
+                  fontsize=FONT["label"])  # fmt: skip
+    ax.set_title("contact mode of each stretch of the motion", fontsize=FONT["label"])
     return ax
 
 
@@ -205,11 +238,12 @@ def plot_push_snapshots(motion, ax=None, n_frames=6):
     ax.plot(tips[:, 0], tips[:, 1], "k-", lw=1.0, label="finger tip")
     lo, hi = ax.get_xlim()
     ax.fill_between([lo - 0.05, hi + 0.05], [-0.03, -0.03], [0, 0], color="0.6", label="floor")
+    ax.plot([], [], "o", color="0.3", ms=4, label="a point in contact at that frame")
     ax.set_aspect("equal")
-    ax.set_xlabel("x (m)")
-    ax.set_ylabel("y (m)")
-    ax.legend(fontsize=8, loc="upper right")
-    ax.set_title("polygon pushed across the floor (frames at events and evenly in time)", fontsize=10)
+    ax.set_xlabel("x (m)", fontsize=FONT["label"])
+    ax.set_ylabel("y (m)", fontsize=FONT["label"])
+    legend_below(ax, ncol=3)
+    ax.set_title("a box pushed across the floor by a finger (frames at events and evenly in time)", fontsize=FONT["label"])
     from matplotlib.cm import ScalarMappable
     from matplotlib.colors import Normalize
 

@@ -1,8 +1,13 @@
-"""Pictures of mu-space (Figs. 3, 6, 8) and of the graphical test (Fig. 4).
+"""Pictures of mu-space (the paper's Figs. 3, 6, 8 and ``qsplan muspace``) and of the graphical test (Fig. 4).
 
-Compute lives in ``mechanics`` (:func:`qsplan.mechanics.muspace.slices.mu_slice`,
-:mod:`qsplan.mechanics.muspace.graphical`); this module only draws.  Every function takes
-``ax=None`` (a new figure is made) and returns the axes; matplotlib is imported
+Compute lives in ``mechanics`` (:func:`qsplan.mechanics.muspace.slices.mu_slice`, the modes' exact
+regions :class:`qsplan.mechanics.muspace.regions.MuRegion`); this module only draws.  The fill is
+painted from the exact regions at the resolution of the picture, not from the map's cells, so it meets
+the exact boundary curves without staircase nicks; a mode has the same colour in every figure
+(:func:`qsplan.planner.plotting.style.mode_set_colour`), a region where several modes are feasible
+(ambiguous) is striped in their colours, and
+the legend (outside the axes, one per figure) lists only the sets that cover an area.  Every function
+takes ``ax=None`` (a new figure is made) and returns the axes or the figure; matplotlib is imported
 inside the functions.
 """
 
@@ -10,188 +15,253 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["plot_mu_map", "plot_contact_scene", "MODE_LINE_COLOURS"]
+from qsplan.planner.plotting.scene import plot_contact_scene
+from qsplan.planner.plotting.style import (
+    FONT,
+    JAM,
+    PALETTE,
+    axes_or_new,
+    legend_below,
+    mode_set_colour,
+)
 
-#: Boundary-curve colours per mode (enumeration index modulo the list): dark, to stand out on the fills.
-MODE_LINE_COLOURS = ["#1b1b1b", "#8b0000", "#00008b", "#006400", "#8b008b", "#b8860b", "#008b8b", "#4b0082"]
+__all__ = ["MODE_LINE_COLOURS", "legend_handles", "mu_slices_figure", "plot_contact_scene", "plot_friction_rectangle",
+           "plot_mu_map", "rod_mu_figure"]
+
+#: Boundary-curve colours by mode enumeration number: each mode's fill colour, darkened.
+MODE_LINE_COLOURS = ["#1b355e", "#7a3d12", "#24572f", "#6e1f22", "#3c3161", "#4d3b2c", "#7a3c66", "#3d3d3d",
+                     "#6b5f1f", "#1f5f70"]  # fmt: skip
+
+#: Pixels per axis the exact regions are painted at.
+PAINT = 480
+
+#: A set of modes gets a legend entry only when it covers at least this fraction of the slice.
+MIN_AREA = 1e-3
 
 
-def _label_regions(ax, sl, min_fraction=0.01):
+def _paint(sl, n=PAINT):
+    """Sets of feasible modes on an ``n`` x ``n`` raster of the slice, from the exact regions (or the cells)."""
+    xs = np.linspace(sl.xs[0], sl.xs[-1], n)
+    ys = np.linspace(sl.ys[0], sl.ys[-1], n)
+    if getattr(sl, "regions", None) and len(sl.regions) == len(sl.modes):
+        P = np.broadcast_to(np.asarray(sl.base_mu, float), (n, n, np.size(sl.base_mu))).copy()
+        P[..., sl.x], P[..., sl.y] = xs[None, :], ys[:, None]
+        feas = np.stack([reg.contains(P) for reg in sl.regions], axis=-1)
+    else:  # nearest cell of the map
+        i = np.clip(np.searchsorted(sl.xs, xs), 0, sl.xs.size - 1)
+        j = np.clip(np.searchsorted(sl.ys, ys), 0, sl.ys.size - 1)
+        feas = sl.feasible[j][:, i]
+    keys = np.packbits(feas, axis=-1, bitorder="little").reshape(n * n, -1)
+    uniq, inverse = np.unique(keys, axis=0, return_inverse=True)
+    sets = [tuple(int(k) for k in np.flatnonzero(np.unpackbits(u, bitorder="little")[: feas.shape[-1]])) for u in uniq]
+    return xs, ys, sets, inverse.reshape(n, n)
+
+
+#: Width (pixels of the painted raster) of the stripes of an ambiguous region, one stripe per feasible mode.
+STRIPE = 14
+
+
+def _light(colour, amount=0.25):
+    """``colour`` mixed with ``amount`` of white (fills stay light under text and curves)."""
+    from matplotlib.colors import to_rgb
+
+    return tuple(c + (1.0 - c) * amount for c in to_rgb(colour))
+
+
+def _image(sets, index):
+    """RGB raster: one colour per mode, diagonal stripes of the members' colours where several are feasible."""
+    n_y, n_x = index.shape
+    J, I = np.mgrid[0:n_y, 0:n_x]
+    out = np.zeros((n_y, n_x, 3))
+    for u, s in enumerate(sets):
+        mask = index == u
+        if not s:
+            out[mask] = _light(JAM, 0.0)
+            continue
+        colours = np.array([_light(mode_set_colour((j,))) for j in s])
+        out[mask] = colours[((I + J) // STRIPE % len(s))[mask]]
+    return out
+
+
+def _set_label(sl, s):
+    return " + ".join(f"{sl.modes[j].name} ({j + 1})" for j in s) or "jam (no mode)"
+
+
+def _label_regions(ax, xs, ys, sets, index, min_fraction=0.01):
     """Write the enumeration numbers of the feasible modes inside each sizeable region (as the paper does)."""
     from scipy import ndimage
 
-    f = sl.feasible
-    keys = np.packbits(f, axis=-1, bitorder="little").reshape(f.shape[0] * f.shape[1], -1)
-    uniq, inverse = np.unique(keys, axis=0, return_inverse=True)
-    inverse = inverse.reshape(f.shape[:2])
-    X, Y = np.meshgrid(sl.xs, sl.ys)
-    for u, key in enumerate(uniq):
-        modes = np.flatnonzero(np.unpackbits(key, bitorder="little")[: f.shape[-1]])
-        text = ",".join(str(j + 1) for j in modes) if modes.size else "Jam"
-        comps, count = ndimage.label(inverse == u)
+    X, Y = np.meshgrid(xs, ys)
+    for u, s in enumerate(sets):
+        text = ",".join(str(j + 1) for j in s) if s else "Jam"
+        comps, count = ndimage.label(index == u)
         for c in range(1, count + 1):
             cells = comps == c
             if cells.sum() < min_fraction * cells.size:
                 continue
-            cx, cy = X[cells].mean(), Y[cells].mean()
-            k = np.argmin((X[cells] - cx) ** 2 + (Y[cells] - cy) ** 2)  # a cell of the region near its centroid
-            ax.text(X[cells][k], Y[cells][k], text, ha="center", va="center", fontsize=8, weight="bold")
+            inner = ndimage.distance_transform_edt(np.pad(cells, 1))[1:-1, 1:-1]  # far from its edge and the axes
+            deep = np.argwhere(inner >= 0.8 * inner.max())  # of those, the one nearest the region's centre
+            k = tuple(deep[np.argmin(np.sum((deep - np.argwhere(cells).mean(axis=0)) ** 2, axis=1))])
+            ax.text(X[k], Y[k], text, ha="center", va="center", fontsize=FONT["note"] + 0.5, weight="bold",
+                    bbox={"boxstyle": "round,pad=0.15", "fc": "white", "ec": "none", "alpha": 0.6})  # fmt: skip
 
 
-def plot_mu_map(sl, ax=None, curves=True, numbers=True, title=None, colours=None, samples=400):
-    """Draw a :class:`qsplan.mechanics.muspace.slices.MuSlice`: cells by mode set, exact region boundaries on top.
+def legend_handles(sl, sets, index, curves=True) -> list:
+    """Legend entries of a drawn slice: the mode sets covering an area, then each mode's boundary curve."""
+    from matplotlib.lines import Line2D
+    from matplotlib.patches import Patch
 
-    Cells take the colour of their set of feasible modes (jams light grey, overlaps
-    their own colour, see :func:`qsplan.planner.plotting.style.plot_mu_slice`).  The boundary of each
-    mode's region is drawn from the zero sets of its boundary polynomials
-    (:meth:`qsplan.mechanics.muspace.regions.MuRegion.boundary_curves`), not from the cells.
+    out = []
+    area = np.bincount(index.ravel(), minlength=len(sets)) / index.size
+    for u, s in enumerate(sets):
+        if area[u] < MIN_AREA:
+            continue  # no legend entry without an area (a set on a line only)
+        if len(s) > 1:  # stripes of the members' colours, as in the picture (two shown in the legend)
+            out.append(Patch(fc=_light(mode_set_colour(s[:1])), hatch="////", ec=_light(mode_set_colour(s[1:2])),
+                             lw=0.0, label=_set_label(sl, s) + "  [ambiguous]"))  # fmt: skip
+        else:
+            out.append(Patch(fc=_light(mode_set_colour(s)), ec="0.3", lw=0.4, label=_set_label(sl, s)))
+    if curves:
+        for j in sorted({j for s in sets for j in s}):
+            out.append(Line2D([], [], color=MODE_LINE_COLOURS[j % len(MODE_LINE_COLOURS)], lw=1.3,
+                              label=f"boundary of {sl.modes[j].name} ({j + 1})"))  # fmt: skip
+    return out
+
+
+def plot_mu_map(sl, ax=None, curves=True, numbers=True, title=None, colours=None, samples=400, legend=True):
+    """Draw a :class:`qsplan.mechanics.muspace.slices.MuSlice`: regions by mode set, exact boundaries on top.
 
     Parameters
     ----------
     sl : MuSlice
     ax : matplotlib Axes, optional
     curves : bool
-        Draw the exact boundaries.
+        Draw the exact boundaries (zero sets of the boundary polynomials,
+        :meth:`qsplan.mechanics.muspace.regions.MuRegion.boundary_curves`).
     numbers : bool
         Write the modes' enumeration numbers (3S=1, R1S2=2, ... for three contacts) in the regions.
     title : str, optional
     colours : dict, optional
-        Shared mode-set colours across panels (see :func:`qsplan.planner.plotting.style.plot_mu_slice`).
+        Ignored (kept for compatibility): a mode set's colour no longer depends on drawing order.
     samples : int
         Samples per axis of each boundary curve.
+    legend : bool
+        Put the legend under the axes; :func:`mu_slices_figure` draws one for all panels instead.
 
     Returns
     -------
     matplotlib.axes.Axes
+        With ``ax.mu_legend_handles`` (the entries the legend would hold).
     """
-    from matplotlib.lines import Line2D
-
-    from qsplan.planner.plotting.style import plot_mu_slice
-
-    ax = plot_mu_slice(sl.mumap, sl.xs, sl.ys, ax=ax, xlabel=f"$\\mu_{sl.x + 1}$", ylabel=f"$\\mu_{sl.y + 1}$",
-                       title=title, colours=colours)  # fmt: skip
-    handles = list(ax.get_legend().legend_handles)
+    ax = axes_or_new(ax, size=(5.2, 4.6))
+    xs, ys, sets, index = _paint(sl)
+    ax.imshow(_image(sets, index), origin="lower", extent=(xs[0], xs[-1], ys[0], ys[-1]), aspect="auto",
+              interpolation="nearest")  # fmt: skip
     if curves and sl.xs[-1] > sl.xs[0] and sl.ys[-1] > sl.ys[0]:
-        drawn = set()
         for c in sl.boundary_curves(samples):
             j = sl.modes.index(c.mode)
-            colour = MODE_LINE_COLOURS[j % len(MODE_LINE_COLOURS)]
-            ax.plot(c.points[:, 0], c.points[:, 1], color=colour, lw=1.3)
-            if j not in drawn:
-                drawn.add(j)
-                handles.append(Line2D([], [], color=colour, lw=1.3, label=f"boundary of {c.mode.name} ({j + 1})"))
+            ax.plot(c.points[:, 0], c.points[:, 1], color=MODE_LINE_COLOURS[j % len(MODE_LINE_COLOURS)], lw=1.3)
     if numbers:
-        _label_regions(ax, sl)
+        _label_regions(ax, xs, ys, sets, index)
     ax.set_xlim(sl.xs[0], sl.xs[-1])
     ax.set_ylim(sl.ys[0], sl.ys[-1])
-    ax.legend(handles=handles, loc="upper right", fontsize=6, framealpha=0.85)
+    ax.set_xlabel(f"$\\mu_{sl.x + 1}$", fontsize=FONT["label"])
+    ax.set_ylabel(f"$\\mu_{sl.y + 1}$", fontsize=FONT["label"])
+    if title:
+        ax.set_title(title, fontsize=FONT["title"])
+    ax.mu_legend_handles = legend_handles(sl, sets, index, curves)
+    if legend:
+        legend_below(ax, ax.mu_legend_handles, ncol=2)
     return ax
 
 
-def plot_contact_scene(scene, mode=None, mu=None, ax=None, title=None):
-    """Draw a scene for operators, with the graphical test of Corollary 1 (Fig. 4).
-
-    Shows the workpiece (the convex hull of the contacts and the centre of mass at
-    the origin: raw scenes carry no outline), the contacts, their inward normals,
-    friction-cone edges, the lines of action of the active contact forces of
-    ``mode``, the line of action of ``g_obj``, and the triangle ``p12 p23 p31``.
+def mu_slices_figure(slices, titles, suptitle=None, ncols=2, size=(4.4, 3.9)):
+    """Several slices in one figure with one legend for all, outside the panels.
 
     Parameters
     ----------
-    scene : Scene
-    mode : ContactMode or str, optional
-        A 3S or RS mode; default the first kinematically admissible 3S mode, else RS mode.
-    mu : array-like, shape (n_c,), optional
-        Friction coefficients (default the scene's).
-    ax : matplotlib Axes, optional
-    title : str, optional
+    slices : sequence of MuSlice
+    titles : sequence of str
+    suptitle : str, optional
+    ncols : int
+    size : (float, float)
+        One panel's size (inches).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    from qsplan.planner.plotting.style import figure_legend, new_axes
+
+    nrows = -(-len(slices) // ncols)
+    fig, axes = new_axes(ncols, nrows, size=size)
+    seen = {}
+    for ax, sl, title in zip(axes.ravel(), slices, titles):
+        plot_mu_map(sl, ax=ax, title=title, legend=False)
+        for h in ax.mu_legend_handles:
+            seen.setdefault(h.get_label(), h)
+    for ax in axes.ravel()[len(slices):]:
+        ax.set_visible(False)
+    patches = [h for h in seen.values() if not hasattr(h, "get_xdata")]
+    lines = [h for h in seen.values() if hasattr(h, "get_xdata")]
+    figure_legend(fig, patches + lines, ncol=2)
+    if suptitle:
+        fig.suptitle(suptitle, fontsize=FONT["suptitle"])
+    return fig
+
+
+def plot_friction_rectangle(ax, mu_static, mu_kinetic, corners=True):
+    """The friction rectangle of Fig. 8: ``[mu_1S, mu_1R] x [mu_2S, mu_2R]``, its corners named.
+
+    Parameters
+    ----------
+    ax : matplotlib Axes
+    mu_static, mu_kinetic : (float, float)
+        Rolling (static) and sliding (kinetic) coefficients of contacts 1 and 2.
+    corners : bool
+        Mark the corners where R2S1 (upper left) and R1S2 (lower right) run.
 
     Returns
     -------
     matplotlib.axes.Axes
     """
-    from matplotlib.lines import Line2D
-    from matplotlib.patches import Polygon
-    from shapely.geometry import MultiPoint
+    from matplotlib.patches import Rectangle
 
-    from qsplan.mechanics import ContactMode, ModeError, enumerate_modes
-    from qsplan.mechanics.muspace.graphical import active_wrenches, contact_points, graphical_test
-    from qsplan.mechanics.muspace.regions import mode_kinematics
+    (m1R, m2R), (m1S, m2S) = mu_static, mu_kinetic
+    ax.add_patch(Rectangle((m1S, m2S), m1R - m1S, m2R - m2S, fc="#f0e6c8", ec="k", lw=1.2, alpha=0.9, zorder=3,
+                           label="friction rectangle (sliding to rolling values)"))  # fmt: skip
+    if corners:
+        ax.plot([m1S], [m2R], "o", color=PALETTE[3], ms=7, zorder=4, label="R2S1 runs at ($\\mu_{1S}$, $\\mu_{2R}$)")
+        ax.plot([m1R], [m2S], "s", color=PALETTE[0], ms=7, zorder=4, label="R1S2 runs at ($\\mu_{1R}$, $\\mu_{2S}$)")
+    return ax
 
+
+def rod_mu_figure(sl, l1, l2, mu_static=None, mu_kinetic=None):
+    """Fig. 8: the rod's slice of mu-space, its boundary ``l1 mu2 = l2 mu1`` and the friction rectangle.
+
+    Parameters
+    ----------
+    sl : MuSlice
+        The rod's slice (:func:`qsplan.hands.paper.rod_scene`).
+    l1, l2 : float
+        Distances of the supports from the centre of mass (the paper's rod has no units).
+    mu_static, mu_kinetic : (float, float), optional
+        Rolling and sliding coefficients of the two supports: the friction rectangle.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
     from qsplan.planner.plotting.style import new_axes
 
-    if ax is None:
-        _, axes = new_axes(size=(6.0, 5.5))
-        ax = axes[0, 0]
-    mu = scene.mu if mu is None else np.broadcast_to(np.asarray(mu, float), (scene.n_contacts,))
-    if mode is not None and not isinstance(mode, ContactMode):
-        mode = ContactMode(str(mode).upper())
-    if mode is None:
-        candidates = [m for m in enumerate_modes(scene.n_contacts, scene.dof) if m.kind in ("3S", "RS")]
-        candidates.sort(key=lambda m: m.kind != "3S")
-        mode = next((m for m in candidates if mode_kinematics(scene, m)[1] is not None), None)
-        if mode is None:
-            raise ModeError("mode: no 3S or RS mode of this scene passes the kinematic stage")
-    W = active_wrenches(scene, mode, mu)
-    gt = graphical_test(W, scene.g_obj)
-
-    pts = contact_points(scene)
-    R = max(1.0, float(np.max(np.linalg.norm(pts, axis=1))))
-    L = 0.3 * R
-    hull = MultiPoint([tuple(p) for p in pts] + [(0.0, 0.0)]).convex_hull
-    if hull.geom_type == "Polygon":
-        ax.add_patch(Polygon(np.asarray(hull.exterior.coords), closed=True, fc="#f1e7d0", ec="#a08050", lw=1.0))
-    ax.plot([0], [0], "k+", ms=10, mew=1.5)
-    handles = [
-        Polygon([[0, 0]], fc="#f1e7d0", ec="#a08050", label="workpiece (hull of contacts, centre of mass)"),
-        Line2D([], [], color="k", marker="+", ls="", ms=8, label="centre of mass (origin)"),
-    ]
-    for i, p in enumerate(pts):
-        n, t = scene.Wn[:2, i], scene.Wt[:2, i]
-        ax.annotate("", xy=p + L * n, xytext=p, arrowprops=dict(arrowstyle="->", color="#2060c0", lw=1.2), in_layout=False)
-        for s in (1, -1):
-            e = n + s * mu[i] * t
-            e = e / np.linalg.norm(e)
-            ax.plot([p[0], p[0] + L * e[0]], [p[1], p[1] + L * e[1]], color="#7a7a7a", ls="--", lw=0.9)
-        ax.plot(*p, "o", color="k", ms=5)
-        ax.text(p[0], p[1], f"  {i + 1} ({mode.letters[i]})", fontsize=9, va="bottom", clip_on=True, in_layout=False)
-    handles += [
-        Line2D([], [], color="#2060c0", lw=1.2, label="inward normal"),
-        Line2D([], [], color="#7a7a7a", ls="--", lw=0.9, label="friction-cone edges"),
-    ]
-    force_colours = ["#d62728", "#2ca02c", "#9467bd"]
-    # the contact each active wrench acts at: sliding contacts in order (3S); the rolling one twice, then the sliding one (RS)
-    at = list(mode.sliding) if mode.kind == "3S" else [mode.rolling[0], mode.rolling[0], mode.sliding[0]]
-    for k, line in enumerate(gt.lines):
-        ax.axline(tuple(line.point), tuple(line.point + line.direction), color=force_colours[k], lw=1.0, alpha=0.9)
-        p = pts[at[k]]
-        ax.annotate("", xy=p, xytext=p - 0.8 * L * line.direction,
-                    arrowprops=dict(arrowstyle="-|>", color=force_colours[k], lw=1.4), in_layout=False)  # fmt: skip
-        label = f"line of action, force {k + 1} (contact {at[k] + 1})"
-        handles.append(Line2D([], [], color=force_colours[k], lw=1.0, label=label))
-    if gt.g_line is not None:
-        gl = gt.g_line
-        ax.axline(tuple(gl.point), tuple(gl.point + gl.direction), color="k", lw=1.6)
-        ax.annotate("", xy=gl.point + L * gl.direction, xytext=gl.point,
-                    arrowprops=dict(arrowstyle="-|>", color="k", lw=1.6), in_layout=False)  # fmt: skip
-        handles.append(Line2D([], [], color="k", lw=1.6, label="line of action of $g_{obj}$"))
-    V = gt.vertices
-    if np.all(np.isfinite(V)):
-        ax.add_patch(Polygon(V, closed=True, fc="#ff7f0e", alpha=0.18, ec="#ff7f0e", lw=1.5, ls=":"))
-        for name, v in zip(("p12", "p23", "p31"), V):
-            ax.text(v[0], v[1], name, fontsize=8, color="#ff7f0e", clip_on=True, in_layout=False)
-        handles.append(Line2D([], [], color="#ff7f0e", ls=":", lw=1.5, label="triangle p12 p23 p31"))
-    span = np.vstack([pts, [[0.0, 0.0]], V[np.all(np.isfinite(V), axis=1)]])
-    span = span[np.linalg.norm(span, axis=1) <= 4 * R]
-    lo, hi = span.min(axis=0) - 0.6 * L, span.max(axis=0) + 0.6 * L
-    ax.set_xlim(lo[0], hi[0])
-    ax.set_ylim(lo[1], hi[1])
-    ax.set_aspect("equal", adjustable="box")
-    verdict = "feasible" if gt.feasible else "infeasible"
-    sense = "".join("+" if s else "-" for s in gt.moment_sense)
-    checks = f"negative span {'yes' if gt.negative_span else 'no'}, moment sense {sense}"
-    ax.set_title(title or f"{mode.name} ({mode.letters}): graphical test {verdict}\n{checks}", fontsize=9)
-    ax.legend(handles=handles, loc="upper center", bbox_to_anchor=(0.5, -0.12), ncol=2, fontsize=7, framealpha=0.85)
-    ax.set_xlabel("x (m)")
-    ax.set_ylabel("y (m)")
-    return ax
+    fig, axes = new_axes(1, 1, size=(5.6, 6.4))
+    ax = plot_mu_map(sl, ax=axes[0, 0], legend=False,
+                     title=f"Fig. 8 reproduced: the rod, $l_1$ = {l1:g}, $l_2$ = {l2:g}\n"
+                           "R2S1 above the line $l_1 \\mu_2 = l_2 \\mu_1$, R1S2 below")  # fmt: skip
+    handles = list(ax.mu_legend_handles)
+    if mu_static is not None and mu_kinetic is not None:
+        plot_friction_rectangle(ax, mu_static, mu_kinetic)
+        handles += [h for h in ax.get_legend_handles_labels()[0]]
+    legend_below(ax, handles, ncol=2)
+    ax.set_aspect("equal")
+    return fig

@@ -1,42 +1,48 @@
 """Operator plots of a two-finger plan: bands along the whole plan, the mode timeline, hand snapshots.
 
-Each function takes a :class:`qsplan.planner.Plan`, draws into ``ax`` (or a new
-figure) and returns the axes or the figure; matplotlib is imported inside.
-:func:`plan_figures` gives all three for ``qsplan demo`` / ``qsplan plan``.
+Each function takes a :class:`qsplan.planner.Plan`, draws into ``ax`` (or a new figure) and returns
+the axes or the figure; matplotlib is imported inside.  Only the plan's public fields are read
+(``Plan.phases``, :class:`~qsplan.planner.planning.results.ContactSegmentPlan`; every other phase is
+drawn as a free motion of the fingers), so plans with more phases or fields draw too.
+:func:`plan_figures` gives them all, the plan card (:mod:`qsplan.planner.plotting.card`) included,
+for ``qsplan demo`` / ``qsplan plan``.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["plot_plan_bands", "plot_mode_timeline", "plan_snapshots_figure", "plan_figures"]
+from qsplan.planner.plotting.plan_panels import (
+    draw_band,
+    mark_narrowest,
+    phase_label,
+    plot_mode_timeline,
+    snapshot_keys,
+    torque_limits,
+)
+from qsplan.planner.plotting.style import FONT, finger_colour, legend_below, torque_text
 
-_COLOURS = {"left": "#08519c", "right": "#a63603"}
+__all__ = ["SNAPSHOT_COLUMNS", "plan_figures", "plan_snapshots_figure", "plot_mode_timeline", "plot_plan_bands"]
 
-#: Hand snapshots per row.
+#: Hand snapshots per row, at most.
 SNAPSHOT_COLUMNS = 6
 
 
-def _panel_limits(seg, resolution):
-    """y-limits (N m) showing a segment's command and finite band sides; a far or infinite side is cut off."""
-    vals = np.concatenate([seg.command, seg.lower[np.isfinite(seg.lower)]])
-    lo, hi = float(vals.min()), float(seg.command.max())
-    span = max(hi - lo, resolution)
-    return lo - 0.6 * span, hi + 1.5 * span
+def plot_plan_bands(plan, axes=None, sharey=False):
+    """The guaranteed band and the command of the torque-controlled finger along each in-contact segment.
 
-
-def plot_plan_bands(plan, axes=None):
-    """The guaranteed band and the command of the effort-controlled finger along each in-contact segment.
-
-    One panel per segment (N m vs s from the plan's start), each scaled to its own command and
-    lower band side, since bands differ by orders of magnitude between segments; an upper side
-    beyond the panel (or infinite) is cut off at its top, marked "band continues above".
+    One panel per segment (N m against s from the plan's start), each scaled to its command, lower
+    edge and margin (bands differ by orders of magnitude between segments), or one scale for all
+    with ``sharey``.  Upper edges solid, lower edges dashed; an upper edge above the panel or
+    unbounded is marked with up-triangles; the narrowest point is marked with its width.
 
     Parameters
     ----------
-    plan : qsplan.planner.planning.plan.Plan
+    plan : qsplan.planner.planning.results.Plan
     axes : sequence of matplotlib Axes, optional
         One per segment; default a new figure with one row each.
+    sharey : bool
+        The same torque scale in every panel.
 
     Returns
     -------
@@ -46,81 +52,67 @@ def plot_plan_bands(plan, axes=None):
 
     segs = plan.segments
     if axes is None:
-        _, grid = new_axes(1, len(segs), size=(9.0, 2.3))
+        _, grid = new_axes(1, len(segs), size=(8.0, 2.1))
         axes = [row[0] for row in grid]
     res = plan.task.torque_resolution
-    for ax, seg in zip(axes, segs):
-        c = _COLOURS[seg.effort_joint]
-        y0, y1 = _panel_limits(seg, res)
-        ax.fill_between(seg.t, np.clip(seg.lower, y0, y1), np.clip(seg.upper, y0, y1), color=c, alpha=0.18, lw=0,
-                        label="guaranteed band")  # fmt: skip
-        ax.plot(seg.t, seg.lower, "--", color=c, lw=1.0)
-        ax.plot(seg.t, np.where(np.isfinite(seg.upper), seg.upper, np.nan), "-", color=c, lw=1.0)
-        ax.plot(seg.t, seg.command, ":", color="k", lw=1.4, label="command")
-        if np.any(seg.upper > y1):
-            ax.text(0.99, 0.96, "band continues above", transform=ax.transAxes, ha="right", va="top", fontsize=7)
-        ax.axhline(0.0, color="0.5", lw=0.5)
-        ax.set_ylim(y0, y1)
-        ax.set_ylabel(f"tau_{seg.effort_joint} (N m)")
-        k = int(np.argmin(seg.width))
-        ax.set_title(f"{seg.name}: {seg.mode}, narrowest band {seg.width[k]:.3g} N m at t = {seg.t[k]:.3g} s, "
-                     f"smallest margin {np.min(seg.margin):.3g} N m", fontsize=8)  # fmt: skip
-    axes[-1].set_xlabel("t (s) from the plan's start")
-    axes[0].legend(fontsize=7, loc="upper left")
+    shared = torque_limits(segs, res) if sharey else None
+    for i, (ax, seg) in enumerate(zip(axes, segs)):
+        ylim = shared or torque_limits([seg], res)
+        draw_band(ax, seg.t, seg.lower, seg.upper, seg.command, finger_colour(seg.effort_joint), ylim, label=i == 0)
+        mark_narrowest(ax, seg, ylim, label=i == 0)
+        ax.axhline(0.0, color="0.6", lw=0.5)
+        ax.set_ylim(*ylim)
+        ax.set_xlim(seg.t[0], seg.t[-1])
+        ax.set_ylabel(f"$\\tau_{{{seg.effort_joint}}}$ (N m)", fontsize=FONT["label"])
+        mode, control = phase_label(seg)
+        ax.set_title(f"{seg.name.split(':')[0]}: {mode}, {control}-controlled; smallest margin "
+                     f"{torque_text(np.min(seg.margin))}", fontsize=FONT["note"] + 0.5, loc="left")  # fmt: skip
+    axes[-1].set_xlabel("t (s) from the plan's start", fontsize=FONT["label"])
+    legend_below(axes[-1], handles=axes[0].get_legend_handles_labels()[0], ncol=3)
     lo, hi = plan.task.mu_range
-    axes[0].figure.suptitle(f"{plan.task.name}: torque bands guaranteed for every mu in [{lo:g}, {hi:g}]"
-                            f"{' (shared)' if plan.task.shared_mu else ' per contact'}; resolution {res:g} N m",
-                            fontsize=9)  # fmt: skip
+    model = "one shared coefficient" if plan.task.shared_mu else "each contact's coefficient"
+    axes[0].get_figure(root=False).suptitle(f"{plan.task.name}: torque bands guaranteed for {model} in [{lo:g}, "
+                                            f"{hi:g}];\ncontroller resolution {res:g} N m", fontsize=FONT["title"])  # fmt: skip
     return list(axes)
 
 
-def plot_mode_timeline(plan, ax=None):
-    """Which mode each phase keeps and which finger is torque-controlled, against time."""
-    from qsplan.planner.planning.results import ContactSegmentPlan
-    from qsplan.planner.plotting.style import new_axes
+def plan_snapshots_figure(plan, per_phase=3, columns=SNAPSHOT_COLUMNS):
+    """Hand snapshots: ``per_phase`` along each in-contact segment and the open grasp of each regrasp.
 
-    if ax is None:
-        _, axes = new_axes(1, 1, size=(9.0, 1.6))
-        ax = axes[0][0]
-    for ph in plan.phases:
-        contact = isinstance(ph, ContactSegmentPlan)
-        colour = _COLOURS[ph.effort_joint] if contact else "0.75"
-        ax.barh(0, ph.t[-1] - ph.t[0], left=ph.t[0], color=colour, alpha=0.6, edgecolor="k", lw=0.5)
-        label = f"{ph.mode}\n{ph.effort_joint} torque" if contact else "free\nregrasp"
-        ax.text(0.5 * (ph.t[0] + ph.t[-1]), 0, label, ha="center", va="center", fontsize=7)
-    ax.set_yticks([])
-    ax.set_xlabel("t (s)")
-    ax.set_title("mode timeline", fontsize=8)
-    return ax
+    Rows are filled evenly (no empty panel but the last row's), every panel at one scale (a scale
+    bar in the first), the torque-controlled finger marked, the marks explained in a legend.
+    """
+    from matplotlib.figure import Figure
 
+    from qsplan.planner.plotting.hands import hand_limits, plot_hand, snapshot_legend_handles
+    from qsplan.planner.plotting.style import figure_legend
 
-def plan_snapshots_figure(plan, per_phase=3):
-    """Hand snapshots: ``per_phase`` along each in-contact segment and the open grasp of each regrasp."""
-    from qsplan.planner.plotting.hands import plot_hand
-    from qsplan.planner.planning.results import ContactSegmentPlan
-    from qsplan.planner.plotting.style import new_axes
-
-    shots = []
-    for ph in plan.phases:
-        if isinstance(ph, ContactSegmentPlan):
-            for k in np.unique(np.round(np.linspace(0, ph.t.size - 1, per_phase)).astype(int)):
-                shots.append((ph.t[k], plan.task.pose(ph.x[k]), ph.q[k], True))
-        else:
-            k = int(np.argmax(np.abs(ph.q - ph.q[0]).sum(axis=1)))
-            shots.append((ph.t[k], plan.task.pose(ph.x), ph.q[k], False))
-    ncols = min(len(shots), SNAPSHOT_COLUMNS)
-    fig, axes = new_axes(ncols, -(-len(shots) // ncols), size=(2.4, 2.4))
-    flat = axes.ravel()
-    for ax, (t, pose, q, contact) in zip(flat, shots):
-        plot_hand(plan.task.hand, pose, q, ax=ax, contacts=contact)
-        ax.set_title(f"t = {t:.3g} s" + ("" if contact else " (open)"), fontsize=8)
+    shots = snapshot_keys(plan, per_phase)
+    rows = -(-len(shots) // columns)
+    cols = -(-len(shots) // rows)
+    lim = hand_limits(plan.task.hand, [(pose, q) for _, pose, q, _, _ in shots])
+    w = 2.0
+    h = w * (lim[1][1] - lim[1][0]) / (lim[0][1] - lim[0][0]) + 0.35
+    fig = Figure(figsize=(w * cols, h * rows + 0.9), layout="constrained")
+    flat = fig.subplots(rows, cols, squeeze=False).ravel()
+    for i, (ax, (t, pose, q, effort, opened)) in enumerate(zip(flat, shots)):
+        plot_hand(plan.task.hand, pose, q, ax=ax, contacts=not opened, effort_joint=effort, limits=lim,
+                  scale_bar=i == 0)  # fmt: skip
+        ax.set_title(f"t = {t:.3g} s" + (" (fingers open)" if opened else ""), fontsize=FONT["note"])
     for ax in flat[len(shots):]:
         ax.set_visible(False)
-    fig.suptitle(plan.task.name, fontsize=9)
+    figure_legend(fig, snapshot_legend_handles(), ncol=3)
+    fig.suptitle(f"{plan.task.name}: the hand along the plan", fontsize=FONT["title"])
     return fig
 
 
-def plan_figures(plan) -> dict:
-    """``{"plan_bands", "mode_timeline", "hand_snapshots"}`` -> matplotlib Figure."""
+def plan_figures(plan, certificate=None, replays=()) -> dict:
+    """``{"plan_bands", "mode_timeline", "hand_snapshots", "plan_card"}`` -> matplotlib Figure.
+
+    ``certificate`` and ``replays`` give the plan card its verdict line
+    (:func:`qsplan.planner.plotting.card.plan_card`).
+    """
+    from qsplan.planner.plotting.card import plan_card
+
     return {"plan_bands": plot_plan_bands(plan)[0].figure, "mode_timeline": plot_mode_timeline(plan).figure,
-            "hand_snapshots": plan_snapshots_figure(plan)}  # fmt: skip
+            "hand_snapshots": plan_snapshots_figure(plan), "plan_card": plan_card(plan, certificate, replays)}  # fmt: skip

@@ -1,26 +1,138 @@
-"""Plots for people: mu-space maps.  Compute lives in ``mechanics``; this module only draws.
+"""The one style of every qsplan figure: colours, text sizes, legends off the data, A4 pages, saving.
 
-Every function takes ``ax=None`` (a new figure is made) and returns the axes.
-matplotlib is imported inside the functions so that importing qsplan stays light.
+Every figure module draws with these, so that a reader learns a figure once:
+
+* a finger has one colour everywhere (snapshots, timelines, bands, the plan card): :data:`FINGER`;
+* a set of feasible modes has one colour in every mu-space figure (Figs. 3, 6, 8, ``qsplan muspace``):
+  :func:`mode_set_colour` depends only on the modes' enumeration numbers, never on drawing order;
+* band edges are drawn as in the paper: upper edges solid, lower edges dashed (:data:`UPPER`,
+  :data:`LOWER`), and an infinite edge is said in words (:func:`torque_text`), never as ``inf N m``;
+* legends sit outside the axes (:func:`legend_below`, :func:`legend_right`, :func:`figure_legend`), so
+  they never cover data.
+
+Figures are :class:`matplotlib.figure.Figure` objects (no pyplot, no display needed); matplotlib is
+imported inside the functions so that importing qsplan stays light.
 """
 
 from __future__ import annotations
 
-import numpy as np
+import math
 
-__all__ = ["PALETTE", "axes_or_new", "plot_mu_slice", "new_axes", "save_figure"]
+__all__ = [
+    "A4_LANDSCAPE",
+    "A4_PORTRAIT",
+    "BAND_FILL",
+    "COMMAND",
+    "COMPETITOR",
+    "EDGE",
+    "FINGER",
+    "FONT",
+    "JAM",
+    "LOWER",
+    "NARROWEST",
+    "NO_BAND",
+    "PALETTE",
+    "REGRASP",
+    "SAMPLED",
+    "UPPER",
+    "axes_or_new",
+    "body_style",
+    "figure_legend",
+    "finger_colour",
+    "legend_below",
+    "legend_right",
+    "mode_set_colour",
+    "new_axes",
+    "plot_mu_slice",
+    "save_figure",
+    "torque_text",
+]
 
-#: Colours for mode sets, in order of first appearance; "jam" is always light grey.
+#: Mode colours by enumeration number (mode ``j``, 0-based, gets ``PALETTE[j % 10]``).
 PALETTE = ["#4c72b0", "#dd8452", "#55a868", "#c44e52", "#8172b3", "#937860", "#da8bc3", "#8c8c8c", "#ccb974", "#64b5cd"]
-_JAM = "#e8e8e8"
+#: Cells where no mode is feasible (a jam).
+JAM = "#e8e8e8"
+
+#: One colour per finger (edges; faces are lighter): the same in snapshots, timelines and bands.
+FINGER = {"left": "#2171b5", "right": "#d94801"}
+_BODIES = {"palm": ("#d9d9d9", "#636363"), "left": ("#9ecae1", FINGER["left"]), "right": ("#fdae6b", FINGER["right"]),
+           "workpiece": ("#fff7bc", "#8c6d31")}  # fmt: skip
+_OTHER_BODY = ("#dadaeb", "#54278f")
+#: A phase without a torque-controlled joint (a regrasp).
+REGRASP = "#bdbdbd"
+
+#: Bands: fill, edges, the command, the narrowest point, competitors, samples without a band, the paper's method.
+BAND_FILL = "#9ecae1"
+EDGE = "#1f3b73"
+COMMAND = "#000000"
+NARROWEST = "#d62728"
+COMPETITOR = "#c44e52"
+NO_BAND = "#eeeeee"
+SAMPLED = "#e377c2"
+#: Line styles of band edges, as in the paper: upper solid, lower dashed.
+UPPER = {"ls": "-"}
+LOWER = {"ls": "--"}
+
+#: Text sizes (points): at least 7 pt on paper, so an A4 print stays readable.
+FONT = {"suptitle": 11, "title": 10, "label": 9, "tick": 8, "legend": 8, "note": 7.5}
+
+#: Page sizes (inches).
+A4_PORTRAIT = (8.27, 11.69)
+A4_LANDSCAPE = (11.69, 8.27)
+
+
+def finger_colour(name: str) -> str:
+    """The edge colour of finger ``name`` (:data:`FINGER`); other joints of a chain get purple."""
+    return FINGER.get(str(name), _OTHER_BODY[1])
+
+
+def body_style(name: str) -> tuple:
+    """``(face, edge)`` colours of a drawn body: palm, fingers, workpiece, any other link of a chain."""
+    return _BODIES.get(str(name), _OTHER_BODY)
+
+
+def mode_set_colour(modes) -> str:
+    """The colour of a set of feasible modes, the same in every figure.
+
+    One mode ``j`` (0-based enumeration number) gets ``PALETTE[j % 10]``; several modes (an
+    ambiguous set) the mean of their colours (drawn hatched by the mu-space plots); none is
+    :data:`JAM`.
+
+    Parameters
+    ----------
+    modes : iterable of int
+    """
+    from matplotlib.colors import to_hex, to_rgb
+
+    modes = sorted(int(j) for j in modes)
+    if not modes:
+        return JAM
+    rgb = [to_rgb(PALETTE[j % len(PALETTE)]) for j in modes]
+    return to_hex(tuple(sum(c[k] for c in rgb) / len(rgb) for k in range(3)))
+
+
+def torque_text(value, unit: str = "N m", side: str = "upper") -> str:
+    """An effort for people: ``"0.139 N m"``, ``"unbounded above"`` (``inf``), ``"unbounded below"``, ``"none"`` (NaN)."""
+    v = float(value)
+    if math.isnan(v):
+        return "none"
+    if math.isinf(v):
+        return "unbounded above" if v > 0 else "unbounded below"
+    return f"{v:.3g} {unit}"
 
 
 def new_axes(ncols=1, nrows=1, size=(4.2, 3.8)):
-    """A fresh Figure (no pyplot, no display needed) and its axes array."""
+    """A fresh Figure (no pyplot, no display needed) and its axes array, shape (nrows, ncols).
+
+    ``size`` is the size of one panel (inches); the layout is constrained, so labels and legends
+    placed outside the axes get room.
+    """
     from matplotlib.figure import Figure
 
     fig = Figure(figsize=(size[0] * ncols, size[1] * nrows), layout="constrained")
     axes = fig.subplots(nrows, ncols, squeeze=False)
+    for ax in axes.ravel():
+        ax.tick_params(labelsize=FONT["tick"])
     return fig, axes
 
 
@@ -32,85 +144,95 @@ def axes_or_new(ax, size=(6.4, 3.6)):
     return axes[0, 0]
 
 
-def save_figure(fig, path, option: str = "path", dpi: int = 110, force: bool = True, inputs=()) -> None:
+def legend_below(ax, handles=None, ncol: int = 2, **kw):
+    """The legend under the axes, below its tick labels and x label, so that it never hides data; returns it
+    (or None).  The offset is in points, so it holds for axes of any height."""
+    from matplotlib.transforms import ScaledTranslation
+
+    handles = handles if handles is not None else ax.get_legend_handles_labels()[0]
+    if not handles:
+        return None
+    lines = 1 + ax.get_xlabel().count("\n") if ax.get_xlabel() else 0
+    drop = (1.6 * FONT["tick"] + 1.5 * FONT["label"] * lines + 6.0) / 72.0  # inches: tick labels, x label, a gap
+    below = ax.transAxes + ScaledTranslation(0.0, -drop, ax.get_figure(root=True).dpi_scale_trans)
+    return ax.legend(handles=handles, fontsize=FONT["legend"], loc="upper center", bbox_to_anchor=(0.5, 0.0),
+                     bbox_transform=below, borderaxespad=0.0, ncol=ncol, frameon=False, **kw)  # fmt: skip
+
+
+def legend_right(ax, handles=None, **kw):
+    """The legend right of the axes, top-aligned; returns it (or None)."""
+    handles = handles if handles is not None else ax.get_legend_handles_labels()[0]
+    if not handles:
+        return None
+    return ax.legend(handles=handles, fontsize=FONT["legend"], loc="upper left", bbox_to_anchor=(1.02, 1.0),
+                     borderaxespad=0.0, frameon=False, **kw)  # fmt: skip
+
+
+def figure_legend(fig, handles, ncol: int = 3, where: str = "lower center", **kw):
+    """One legend for all panels of ``fig``, outside them (constrained layout makes room); returns it."""
+    return fig.legend(handles=handles, loc=f"outside {where}", ncol=ncol, fontsize=FONT["legend"], frameon=False, **kw)
+
+
+def save_figure(fig, path, option: str = "path", dpi: int = 110, force: bool = True, inputs=(), tight: bool = True) -> None:
     """Write ``fig`` to ``path`` atomically (parent folders created; the format from the suffix).
 
     Written by :func:`qsplan.planner.export.files.atomic_write`: a temporary file renamed over
     ``path``, never through a symbolic link, never over one of ``inputs``; an existing file is
     replaced only with ``force`` (True by default for callers that checked their outputs first).
-    An unwritable or refused path raises a :class:`~qsplan.mechanics.QsplanError` naming ``option``
-    (the caller's name for the path).
+    PNG files record ``Software: qsplan <version>``.  ``tight`` crops the page to its content (a page
+    meant for print, the plan card, keeps its size with ``tight=False``).  An unwritable or refused path raises a
+    :class:`~qsplan.mechanics.QsplanError` naming ``option`` (the caller's name for the path).
     """
     from pathlib import Path
 
+    from qsplan import __version__
     from qsplan.mechanics import QsplanError
     from qsplan.planner.export.files import atomic_write
 
     fmt = Path(path).suffix.lstrip(".").lower() or "png"
+    meta = {"Software": f"qsplan {__version__}"} if fmt == "png" else None
     try:
-        atomic_write(path, lambda f: fig.savefig(f, format=fmt, dpi=dpi, bbox_inches="tight"), binary=True,
-                     force=force, inputs=inputs, field=option)  # fmt: skip
+        atomic_write(path, lambda f: fig.savefig(f, format=fmt, dpi=dpi, bbox_inches="tight" if tight else None,
+                                                 metadata=meta),
+                     binary=True, force=force, inputs=inputs, field=option)  # fmt: skip
     except OSError as exc:
         raise QsplanError(f"{option}: cannot write {str(path)!r}: {exc.strerror or exc}") from None
 
 
 def plot_mu_slice(mumap, xs, ys, ax=None, xlabel="$\\mu_1$", ylabel="$\\mu_2$", title=None, names=True, colours=None):
-    """Draw a 2-D slice of a :class:`qsplan.mechanics.muspace.maps.MuMap` as labelled regions.
+    """Draw a 2-D slice of a :class:`qsplan.mechanics.muspace.maps.MuMap` cell by cell (no exact boundaries).
 
-    Each cell gets the colour of its *set* of feasible modes; jammed cells (no
-    mode) are light grey and overlaps (ambiguity) are their own sets, so both
-    are explicit.  The legend names each set by the modes' paper names and
-    their enumeration numbers (3S=1, R1S2=2, ... for three contacts).
-
-    Parameters
-    ----------
-    mumap : MuMap
-        Built on ``grid_points(..., xs, ys)`` (row ``j * len(xs) + i`` is ``(xs[i], ys[j])``).
-    xs, ys : array-like, shape (nx,), (ny,)
-    ax : matplotlib Axes, optional
-    colours : dict, optional
-        Mode set (tuple of mode indices) -> colour; pass the same dict to several
-        panels so that a set keeps its colour across them (new sets are added to it).
+    Kept for maps without regions; :func:`qsplan.planner.plotting.muspace.plot_mu_map` draws a
+    :class:`~qsplan.mechanics.muspace.slices.MuSlice` with its exact regions.  Each cell gets the
+    colour of its set of feasible modes (:func:`mode_set_colour`); the legend, right of the axes,
+    names each set present.  ``colours`` is accepted for compatibility and ignored: colours no
+    longer depend on the order of drawing.
 
     Returns
     -------
     matplotlib.axes.Axes
     """
+    import numpy as np
     from matplotlib.colors import ListedColormap
     from matplotlib.patches import Patch
 
-    if ax is None:
-        _, axes = new_axes()
-        ax = axes[0, 0]
+    ax = axes_or_new(ax, size=(5.0, 4.2))
     xs, ys = np.asarray(xs), np.asarray(ys)
     feas = mumap.feasible.reshape(ys.size, xs.size, -1)
-    keys = np.packbits(feas, axis=-1, bitorder="little")
-    flat = keys.reshape(ys.size * xs.size, -1)
-    uniq, inverse = np.unique(flat, axis=0, return_inverse=True)
-    inverse = inverse.reshape(ys.size, xs.size)
+    keys = np.packbits(feas, axis=-1, bitorder="little").reshape(ys.size * xs.size, -1)
+    uniq, inverse = np.unique(keys, axis=0, return_inverse=True)
     sets = [np.flatnonzero(np.unpackbits(u, bitorder="little")[: feas.shape[-1]]) for u in uniq]
-    shared = {} if colours is None else colours
-    colours, labels = [], []
-    for s in sets:
-        if s.size == 0:
-            colours.append(_JAM)
-            labels.append("jam (no mode)")
-        else:
-            key = tuple(int(j) for j in s)
-            if key not in shared:
-                shared[key] = PALETTE[len(shared) % len(PALETTE)]
-            colours.append(shared[key])
-            label = " + ".join(f"{mumap.modes[j].name} ({j + 1})" if names else mumap.modes[j].letters for j in s)
-            labels.append(label + ("  [ambiguous]" if s.size > 1 else ""))
+    cols = [mode_set_colour(s) for s in sets]
+    labels = [" + ".join(f"{mumap.modes[j].name} ({j + 1})" if names else mumap.modes[j].letters for j in s)
+              or "jam (no mode)" for s in sets]  # fmt: skip
     dx = (xs[-1] - xs[0]) / max(xs.size - 1, 1) / 2
     dy = (ys[-1] - ys[0]) / max(ys.size - 1, 1) / 2
-    ax.imshow(
-        inverse, origin="lower", cmap=ListedColormap(colours), vmin=-0.5, vmax=len(colours) - 0.5,
-        extent=(xs[0] - dx, xs[-1] + dx, ys[0] - dy, ys[-1] + dy), aspect="auto", interpolation="nearest",
-    )  # fmt: skip
-    ax.legend(handles=[Patch(color=c, label=l) for c, l in zip(colours, labels)], loc="upper right", fontsize=7, framealpha=0.85)
-    ax.set_xlabel(xlabel)
-    ax.set_ylabel(ylabel)
+    ax.imshow(inverse.reshape(ys.size, xs.size), origin="lower", cmap=ListedColormap(cols), vmin=-0.5,
+              vmax=len(cols) - 0.5, extent=(xs[0] - dx, xs[-1] + dx, ys[0] - dy, ys[-1] + dy), aspect="auto",
+              interpolation="nearest")  # fmt: skip
+    legend_right(ax, [Patch(color=c, label=l) for c, l in zip(cols, labels)])
+    ax.set_xlabel(xlabel, fontsize=FONT["label"])
+    ax.set_ylabel(ylabel, fontsize=FONT["label"])
     if title:
-        ax.set_title(title, fontsize=10)
+        ax.set_title(title, fontsize=FONT["title"])
     return ax

@@ -25,6 +25,10 @@ __all__ = ["reproduce_paper", "PAPER_FILES", "TABLE1"]
 #: The files :func:`reproduce_paper` writes into its folder.
 PAPER_FILES = ("fig3_eq37.png", "fig6_eq42.png", "fig8_rod.png", "table1.txt", "paper_results.json")
 
+#: Fig. 8's friction rectangle: rolling (static) and sliding (kinetic) coefficients of the rod's supports,
+#: those of ``examples/rod_bouncing.py``; it lies inside the R2S1 region as in the paper's figure.
+ROD_FRICTION = ((0.5, 0.5), (0.4, 0.4))
+
 #: The paper's Table 1: contact modes tested for n_c = 3..8 (rows dof = n_c - 1, n_c, n_c + 1).
 TABLE1 = {
     -1: [6, 16, 45, 126, 357, 1016],
@@ -68,8 +72,7 @@ def reproduce_paper(out_dir, n: int = 161, progress=None, force: bool = False) -
     progress : file-like, optional
         Receives one line per step.
     """
-    from qsplan.planner.plotting.muspace import plot_mu_map
-    from qsplan.planner.plotting.style import new_axes
+    from qsplan.planner.plotting.muspace import mu_slices_figure, rod_mu_figure
 
     from qsplan.planner.export.files import atomic_write, check_out_dir, check_outputs
     from qsplan.planner.plotting.style import save_figure
@@ -85,15 +88,14 @@ def reproduce_paper(out_dir, n: int = 161, progress=None, force: bool = False) -
     say("eq. (37): mu-space slices (Fig. 3)")
     scene = scene_from_dict(eq37_scene())
     xs = np.linspace(0.0, 2.0, n)
-    fig, axes = new_axes(2, 2)
-    slices, colours = {}, {}
-    agreement = []
-    for ax, mu3 in zip(axes.ravel(), (0.0, 0.5, 1.0, 2.0)):
+    slices, drawn, agreement = {}, [], []
+    for mu3 in (0.0, 0.5, 1.0, 2.0):
         sl = mu_slice(scene, 0, 1, xs, xs, base_mu=[0, 0, mu3])
         slices[f"mu3={mu3}"] = {**_summary(sl.mumap, n), "boundary_agreement": _agreement(sl)}
         agreement.append(slices[f"mu3={mu3}"]["boundary_agreement"])
-        plot_mu_map(sl, ax=ax, title=f"eq. (37), $\\mu_3$ = {mu3}", colours=colours)
-    fig.suptitle("Fig. 3 reproduced: 3S shrinks as $\\mu_3$ grows, R1S2 unchanged")
+        drawn.append(sl)
+    fig = mu_slices_figure(drawn, [f"$\\mu_3$ = {mu3:g}" for mu3 in (0.0, 0.5, 1.0, 2.0)],
+                           "Fig. 3 reproduced, eq. (37): the 3S region (1) shrinks as $\\mu_3$ grows; R1S2 (2) does not change")
     save_figure(fig, out / "fig3_eq37.png", option="out_dir")
     modes37 = sorted({m for s in slices.values() for m in s["modes_feasible_somewhere"]})
     areas3s = [s["area_fraction"].get("3S", 0.0) for s in slices.values()]
@@ -112,16 +114,15 @@ def reproduce_paper(out_dir, n: int = 161, progress=None, force: bool = False) -
     say("eq. (42): several modes at once (Fig. 6)")
     scene = scene_from_dict(eq42_scene())
     xs = np.linspace(0.0, 1.5, n)
-    fig, axes = new_axes(2, 2)
-    slices, colours = {}, {}
-    agreement = []
-    for ax, mu3 in zip(axes.ravel(), (0.1, 0.3, 0.6, 1.0)):
+    slices, drawn, agreement = {}, [], []
+    for mu3 in (0.1, 0.3, 0.6, 1.0):
         sl = mu_slice(scene, 0, 1, xs, xs, base_mu=[0, 0, mu3])
         slices[f"mu3={mu3}"] = {**_summary(sl.mumap, n), "boundary_agreement": _agreement(sl)}
         agreement.append(slices[f"mu3={mu3}"]["boundary_agreement"])
-        plot_mu_map(sl, ax=ax, title=f"eq. (42), $\\mu_3$ = {mu3}", colours=colours)
+        drawn.append(sl)
     diag = polynomial_map(scene, np.repeat(np.linspace(0, 1.5, n)[:, None], 3, axis=1))
-    fig.suptitle("Fig. 6 reproduced: four modes, up to three feasible at once")
+    fig = mu_slices_figure(drawn, [f"$\\mu_3$ = {mu3:g}" for mu3 in (0.1, 0.3, 0.6, 1.0)],
+                           "Fig. 6 reproduced, eq. (42): four modes, up to three feasible at once (stripes: ambiguous)")
     save_figure(fig, out / "fig6_eq42.png", option="out_dir")
     modes42 = sorted({m for s in slices.values() for m in s["modes_feasible_somewhere"]})
     first = int(np.flatnonzero(~diag.jammed)[0])
@@ -142,8 +143,7 @@ def reproduce_paper(out_dir, n: int = 161, progress=None, force: bool = False) -
     xs = np.linspace(0.0, 1.0, n)
     sl = mu_slice(scene, 0, 1, xs, xs, base_mu=[0, 0])
     mm = sl.mumap
-    fig, axes = new_axes(1, 1, size=(5.0, 4.5))
-    plot_mu_map(sl, ax=axes[0, 0], title=f"rod, $l_1$ = {l1}, $l_2$ = {l2}: boundary $l_1 \\mu_2 = l_2 \\mu_1$")
+    fig = rod_mu_figure(sl, l1, l2, ROD_FRICTION[0], ROD_FRICTION[1])
     save_figure(fig, out / "fig8_rod.png", option="out_dir")
     curve_pts = np.vstack([c.points for c in sl.boundary_curves()])
     names = [m.name for m in mm.modes]

@@ -26,7 +26,10 @@ from qsplan.planner.torque.sweep import (
     segment_bands,
 )
 
-__all__ = ["SEGMENT_FILES", "SEGMENT_PLOTS", "SweepRun", "segment_document", "segment_outputs", "sweep_segment"]
+__all__ = ["DEFAULT_TORQUE_RESOLUTION", "SEGMENT_FILES", "SEGMENT_PLOTS", "SweepRun", "segment_document", "segment_outputs", "sweep_segment"]
+
+#: The torque resolution (N m) ``qsplan sweep`` sizes the command's margin with: the bundled tasks' controller.
+DEFAULT_TORQUE_RESOLUTION = 0.02
 
 #: The schedule files :func:`sweep_segment` writes.
 SEGMENT_FILES = ("segment1.csv", "segment1.json")
@@ -61,7 +64,7 @@ def _narrow(sweep):
     return {"t": float(sweep.t[k]), "width": w, "lower": float(sweep.lower[k]), "upper": float(sweep.upper[k])}
 
 
-def segment_document(sb: SegmentBands, paper_samples: int, files=()) -> dict:
+def segment_document(sb: SegmentBands, paper_samples: int, files=(), resolution=None) -> dict:
     """The summary of Figs. 10-13 for one segment (the ``qsplan sweep --json`` document).
 
     Efforts in N m, times in s; ``paper_method.wider_than_exact_points`` counts the samples where the
@@ -88,7 +91,7 @@ def segment_document(sb: SegmentBands, paper_samples: int, files=()) -> dict:
                        "split_points": int(g.split.sum()), "narrowest": _narrow(band)},
         "paper_method": {"samples": paper_samples, "narrowest": _narrow(sb.sampled),
                          "wider_than_exact_points": int(paper_method_wider(sb).sum())},
-        "safety_margin": sb.safety_margin, "max_margin": sb.max_margin,
+        "safety_margin": sb.safety_margin, "max_margin": sb.max_margin, "torque_resolution": resolution,
         "force_margin": check_force_margin(g.force_margin).to_dict(),
         "command_max": float(np.nanmax(sb.command)) if np.isfinite(sb.command).any() else None,
         "files": [str(f) for f in files],
@@ -98,21 +101,27 @@ def segment_document(sb: SegmentBands, paper_samples: int, files=()) -> dict:
 def sweep_segment(samples, out_dir, mu_range=DEFAULT_MU_RANGE, *, shared: bool = False,
                   paper_samples: int = PAPER_MU_SAMPLES, safety_margin=None, max_margin=None, display_limit=None,
                   force: bool = False, plots: bool = True, workers=None, scheduler=None,
-                  force_margin=None) -> SweepRun:  # fmt: skip
+                  force_margin=None, resolution=DEFAULT_TORQUE_RESOLUTION) -> SweepRun:  # fmt: skip
     """Compute Figs. 10-13 for a sampled segment and write the schedule and figures into ``out_dir``.
 
     Parameters as in :func:`qsplan.planner.torque.sweep.segment_bands` (``force_margin``: the minimum
     normal force and Coulomb slack, N, of the guaranteed and sampled bands, default none);
     ``display_limit`` (N m) truncates the plotted bands (default per figure); ``force`` overwrites
-    existing files (checked before computing).
+    existing files (checked before computing).  The command follows the plans' rule
+    (:func:`qsplan.planner.torque.command.with_segment_command`): one margin along the whole
+    segment, half the narrowest band and at most two torque resolutions (``resolution``, N m),
+    unless ``safety_margin`` / ``max_margin`` (N m) set it.
     """
+    from qsplan.planner.torque.command import with_segment_command
+
     out = check_out_dir(out_dir)
     check_outputs(segment_outputs(out, plots), force)
     sb = segment_bands(samples, tuple(mu_range), shared, paper_samples, safety_margin, max_margin,
                        workers=workers, scheduler=scheduler, force_margin=force_margin)  # fmt: skip
+    sb = with_segment_command(sb, resolution, safety_margin, max_margin)
     from qsplan.planner.export.schedule import export_schedule
 
-    files = [str(p) for p in export_schedule(sb, out, force=True)]
+    files = [str(p) for p in export_schedule(sb, out, force=True, resolution=resolution)]
     if plots:
         from qsplan.planner.plotting.bands import segment_band_figures
         from qsplan.planner.plotting.style import save_figure
@@ -121,4 +130,4 @@ def sweep_segment(samples, out_dir, mu_range=DEFAULT_MU_RANGE, *, shared: bool =
             path = f"{out_dir}/{name}.png"
             save_figure(fig, path, option="out_dir")
             files.append(path)
-    return SweepRun(sb, tuple(files), segment_document(sb, paper_samples, files))
+    return SweepRun(sb, tuple(files), segment_document(sb, paper_samples, files, resolution))

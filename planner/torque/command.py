@@ -1,9 +1,15 @@
-"""The torque command inside a guaranteed band (Section 5.2): the effort with the largest margin.
+"""The torque command inside a guaranteed band (Section 5.2): one margin kept along the whole segment.
 
 The paper notes that "the narrowest portion of the region specifies the resolution
-of the torque controller"; the command exported for a controller sits where a
-torque error is least likely to leave the band.  :data:`PLAN_FORCE_MARGIN` keeps the
-band itself away from the brink of eq. (28) for what the torque does not cover.
+of the torque controller"; the command exported for a controller keeps one margin
+``m`` from both band edges along the whole segment (:func:`segment_command`, the rule of
+plans and of ``qsplan sweep``): ``lower + m`` where the band is wider than ``2 m``, its
+midpoint where it is not, so the command is continuous and close to the torque the mode
+needs.  ``m`` is half the segment's narrowest band (the largest margin that holds
+everywhere), at most :data:`MAX_MARGIN_RESOLUTIONS` torque resolutions
+(:func:`default_safety_margin`): a very wide band buys no more than that.
+:data:`PLAN_FORCE_MARGIN` keeps the band itself away from the brink of eq. (28) for
+what the torque does not cover.
 """
 
 from __future__ import annotations
@@ -13,7 +19,16 @@ import numpy as np
 from qsplan.mechanics.bands.effort import ForceMargin
 from qsplan.mechanics.errors import NoAnswerError, QsplanError
 
-__all__ = ["PLAN_FORCE_MARGIN", "choose_command", "default_safety_margin", "plan_force_margin"]
+__all__ = ["MAX_MARGIN_RESOLUTIONS", "PLAN_FORCE_MARGIN", "choose_command", "command_rule", "default_safety_margin",
+           "plan_force_margin", "segment_command", "with_segment_command"]
+
+#: The largest margin (in torque resolutions) a command keeps from its band's edges.  A plan
+#: accepts a band one resolution wide (the command mid-band, half a resolution from each
+#: edge): that is the torque error the controller is trusted with.  Two resolutions are four
+#: times it; beyond that a wider band would only raise the command (and the contact forces)
+#: far above the torque the mode needs: the demo's third segment, whose narrowest band is
+#: 1.76 N m wide, would command ~0.93 N m where its lower edge asks ~0.05 N m.
+MAX_MARGIN_RESOLUTIONS = 2.0
 
 #: The force margin of plans (task files' ``[controller] min_normal_force`` and
 #: ``min_coulomb_slack``), N.  At a band edge of eq. (28) some normal force or cone slack is
@@ -102,23 +117,105 @@ def choose_command(lower, upper, safety_margin, max_margin=None):
     return command + 0.0, margin
 
 
-def default_safety_margin(band) -> float:
-    """The safety margin (N m) for a band along a segment: half its narrowest bounded width.
+def segment_command(lower, upper, safety_margin, max_margin=None):
+    """The command of a whole segment: one margin kept from both band edges everywhere (the plans' rule).
+
+    :func:`choose_command` with ``max_margin`` defaulting to ``safety_margin``: ``lower + m``
+    where the band is wider than ``2 m``, the midpoint where it is narrower, ``lower + m``
+    (``upper - m``) where it is unbounded above (below).  With ``m`` at most half the
+    segment's narrowest band (:func:`default_safety_margin`) the margin ``m`` holds at every
+    sample and the command is continuous; it never runs up a blown-up upper edge.
+
+    Parameters and returns as :func:`choose_command`.
+    """
+    return choose_command(lower, upper, safety_margin, safety_margin if max_margin is None else max_margin)
+
+
+def command_rule(safety_margin, max_margin=None, resolution=None) -> dict:
+    """The command rule in words and numbers, for export metadata (N m).
+
+    Parameters
+    ----------
+    safety_margin : float
+        The margin kept where the band is unbounded on one side.
+    max_margin : float or None
+        The cap on the margin of bounded bands (None: midpoints).
+    resolution : float, optional
+        The controller's torque resolution the margin was sized with.
+    """
+    if max_margin is None:
+        rule = ("midpoint of a bounded band; lower + safety_margin where unbounded above (upper - safety_margin "
+                "where unbounded below); 0 where unbounded on both sides")
+    else:
+        rule = ("one margin m = max_margin kept from both edges along the whole segment: lower + m where the band "
+                "is wider than 2 m, its midpoint where it is narrower; lower + safety_margin where unbounded above "
+                "(upper - safety_margin where unbounded below); m = min(half the segment's narrowest band, "
+                f"{MAX_MARGIN_RESOLUTIONS:g} torque resolutions) unless given")
+    out = {"rule": rule, "safety_margin_N_m": float(safety_margin),
+           "max_margin_N_m": None if max_margin is None else float(max_margin)}  # fmt: skip
+    if resolution is not None:
+        out.update(torque_resolution_N_m=float(resolution), max_margin_resolutions=MAX_MARGIN_RESOLUTIONS)
+    return out
+
+
+def default_safety_margin(band, resolution=None) -> float:
+    """The margin (N m) a command keeps along a segment: half its narrowest bounded band, at most
+    :data:`MAX_MARGIN_RESOLUTIONS` times ``resolution``.
 
     The narrowest point sets the torque resolution the controller needs anyway (Fig. 13),
     so keeping that margin from a finite edge where the band is unbounded asks nothing
-    more of it.  With no bounded point, the largest finite edge (the size of the
-    torque the mode needs); with none, :class:`qsplan.mechanics.NoAnswerError` (no band to size it from).
+    more of it; with ``resolution`` (the controller's, N m) a very wide band keeps no more
+    than a few resolutions, so the command stays near the torque the mode needs.  With
+    no bounded point, the largest finite edge (the size of the torque the mode needs),
+    capped alike; with none, :class:`qsplan.mechanics.NoAnswerError` (no band to size it from).
 
     Parameters
     ----------
     band : qsplan.planner.torque.pointwise.BandSweep
+    resolution : float, optional
+        Positive (N m or N): the controller's torque resolution.
     """
+    if resolution is not None and not (np.isfinite(resolution) and resolution > 0):
+        raise QsplanError(f"torque resolution: expected a positive finite effort (N m or N); got {resolution!r}")
+    cap = np.inf if resolution is None else MAX_MARGIN_RESOLUTIONS * float(resolution)
     w = band.width
     bounded = band.feasible & np.isfinite(w) & (w > 0)
     if bounded.any():
-        return 0.5 * float(np.min(w[bounded]))
+        return min(0.5 * float(np.min(w[bounded])), cap)
     edges = np.abs(np.concatenate([band.lower[np.isfinite(band.lower)], band.upper[np.isfinite(band.upper)]]))
     if edges.size and edges.max() > 0:
-        return float(edges.max())  # no bounded point: the size of the effort the mode needs
+        return min(float(edges.max()), cap)  # no bounded point: the size of the effort the mode needs
     raise NoAnswerError("safety margin: no bounded band along the segment to size it from; pass one explicitly")
+
+
+def with_segment_command(bands, resolution=None, safety_margin=None, max_margin=None):
+    """``bands`` with the plans' command (:func:`segment_command`) in place of its own.
+
+    Parameters
+    ----------
+    bands : qsplan.planner.torque.sweep.SegmentBands
+    resolution : float, optional
+        The controller's torque resolution (N m): caps the default margin (:func:`default_safety_margin`).
+    safety_margin : float, optional
+        The margin ``m`` (N m); default :func:`default_safety_margin` of the guaranteed band.
+    max_margin : float, optional
+        A larger cap on bounded bands' margin (N m); default ``m``.
+
+    Returns
+    -------
+    qsplan.planner.torque.sweep.SegmentBands
+        With ``command``, ``margin``, ``safety_margin`` and ``max_margin`` replaced.
+    """
+    from dataclasses import replace
+
+    band = bands.guaranteed.band
+    if safety_margin is None:
+        try:
+            safety_margin = default_safety_margin(band, resolution)
+        except NoAnswerError:  # unbounded everywhere: keep the controller's resolution from the finite edge
+            safety_margin = 1.0 if resolution is None else float(resolution)
+    cap = float(safety_margin) if max_margin is None else max(float(max_margin), float(safety_margin))
+    command, margin = segment_command(band.lower, band.upper, float(safety_margin), cap)
+    command.setflags(write=False)
+    margin.setflags(write=False)
+    return replace(bands, command=command, margin=margin, safety_margin=float(safety_margin), max_margin=cap)

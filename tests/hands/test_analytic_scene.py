@@ -60,19 +60,30 @@ def test_demo_hand_along_segment_1(effort_joint, finger_mass):
 
 @pytest.mark.parametrize("name", sorted(task_paths()))
 def test_bundled_tasks_along_their_segments(name):
+    from qsplan.hands.grasp_geometry import candidate_grasps, grasp_configurations
+
     task = load_task(task_paths()[name])
-    stops = np.concatenate([[task.start_x], task.waypoints])
+    end = [task.goal.x] if task.goal is not None else task.waypoints
+    stops = np.concatenate([[task.start_x], end])
     used = total = 0
     for a, b in zip(stops[:-1], stops[1:]):
-        for x in np.linspace(a, b, 60):
-            pose = task.pose(x)
-            try:
-                q = finger_angles(task.hand, pose)[0]
-            except SceneError:
-                continue
-            total += 1
-            used += _compare(task.hand, pose, q)
-    assert total > 100 and used >= 0.9 * total
+        xs = np.linspace(a, b, 60)
+        if task.goal is None:  # the scripted tasks: both inner edges at the vertices of tangency
+            for x in xs:
+                pose = task.pose(x)
+                try:
+                    q = finger_angles(task.hand, pose)[0]
+                except SceneError:
+                    continue
+                total += 1
+                used += _compare(task.hand, pose, q)
+            continue
+        for grasp in candidate_grasps(task.hand):  # the automatic tasks: every grasp the planner may use
+            conf = grasp_configurations(task.hand, grasp, xs)
+            for k in np.flatnonzero(conf.ok):
+                total += 1
+                used += _compare(task.hand, task.pose(xs[k]), conf.q[k])
+    assert total > 50 and used >= 0.9 * total
 
 
 def _random_hand(rng):

@@ -212,7 +212,7 @@ def _flip_velocity(rows):  # the velocity-controlled finger driven backwards: th
 def _torque_far_outside(rows):  # a torque far beyond its band: another mode wins, or the planned one fails
     for k in range(_contact_row(rows, 0), _contact_row(rows, 4)):
         e = rows[k]["effort_joint"]
-        rows[k][f"tau_{e}"] = repr(float(rows[k][f"tau_{e}"]) * 4.0 + 1.0)
+        rows[k][f"tau_{e}"] = repr(float(rows[k][f"tau_{e}"]) * 4.0 + 10.0)  # beyond the bands (upper edges ~2 N m)
 
 
 def _stop_velocity(rows):  # no driving speed: every mode degenerate (zero speeds), all set aside

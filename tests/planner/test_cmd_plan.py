@@ -7,18 +7,7 @@ import pytest
 from qsplan.planner.cli.main import main
 from qsplan.planner.export.plan_files import read_plan_csv
 
-SMALL_TASK = """
-name = "small"
-[hand]
-workpiece = [[0.0, 0.0], [0.080, 0.0], [0.085, 0.080], [0.008, 0.100]]
-[motion]
-start_x = 0.0
-waypoints = [-0.02, 0.0]
-[friction]
-range = [0.0, 0.2]
-[controller]
-torque_resolution = 0.02
-"""
+from tests.planner.conftest import SMALL_TASK
 
 
 def run(args, capsys):
@@ -41,7 +30,8 @@ def test_plan_writes_the_trajectory_and_its_resimulation(tmp_path, capsys):
     replays = json.loads((out / "replay.json").read_text())
     assert [r["mu"] for r in replays] == [[0.0] * 4, [0.2] * 4] and all(r["followed"] for r in replays)
     assert {s["planned_mode"] for r in replays for s in r["segments"]} == {"SSSS"}
-    # a second run refuses to overwrite, in one line, before planning
+    # a second run refuses to overwrite a file qsplan did not write (here: edited), in one line, before planning
+    (out / "plan.csv").write_bytes((out / "plan.csv").read_bytes() + b"\n")
     before = (out / "plan.csv").read_bytes()
     code, stdout, err = run(["plan", str(task), "--out", str(out), "--no-plots", "--quiet"], capsys)
     assert code == 2 and err.count("\n") == 1 and "--force" in err and "exists" in err
@@ -81,8 +71,11 @@ def test_ctrl_c_during_planning_exits_130_and_leaves_nothing(tmp_path):
     import sys
     import time
 
-    out = tmp_path / "demo"
-    proc = subprocess.Popen([sys.executable, "-m", "qsplan.planner.cli", "demo", "--out", str(out)],
+    from qsplan.planner.planning.task import task_paths
+
+    out = tmp_path / "plan"
+    task = str(task_paths()["scripted_regrasp_task"])  # three segments and two regrasps: seconds of planning
+    proc = subprocess.Popen([sys.executable, "-m", "qsplan.planner.cli", "plan", task, "--out", str(out)],
                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)  # fmt: skip
     t0, seen = time.perf_counter(), ""
     while time.perf_counter() - t0 < 60 and "effort-controlled finger" not in seen:  # a segment is being planned

@@ -1,0 +1,196 @@
+"""Band tables: every candidate grasp judged along the palm, batched (the search's input, Section 5.2).
+
+For each candidate grasp (which feature each finger touches, :mod:`qsplan.hands.grasps`) and
+each workpiece ``x`` of a grid, :func:`band_tables` judges the configuration as the plan's
+dense sweep does (:func:`qsplan.planner.planning.contact_state.check_contact_state`): the
+four contacts exist (the grasp's closed form), the joints inside their limits, no two bodies
+overlapping (:mod:`qsplan.planner.planning.collision`), and for each effort-controlled finger
+and each direction of the slide the guaranteed 4S band with every competitor precluded
+(:func:`qsplan.mechanics.bands.batched_robust.robust_bands`, batched over the grid; per-state
+competitors: a mode kinematically impossible at a state cannot occur there).  The tables are
+the search graph of :mod:`qsplan.planner.sequence.widest`; the plan built from the route is
+judged again sample by sample, so the tables only propose.  Units SI (m, rad, N m).
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+
+import numpy as np
+
+from qsplan.planner.sequence.widest import SearchGraph
+
+__all__ = ["BandTables", "band_tables", "table_grid", "GRID_STEP", "SEARCH_MARGIN"]
+
+#: Grid step (m) of the tables: the plan's dense-sweep step, so that the tables judge the states
+#: the plan will judge (:data:`qsplan.planner.planning.plan.SWEEP_STEP`).
+GRID_STEP = 5e-4
+
+#: How far (m) beyond the start and the goal the tables reach: room for the detours a regrasp may
+#: need (a slide away from the goal to where another grasp is valid); 6 cm is most of the span between
+#: the default hand's fingers (0.18 m) minus a workpiece.
+SEARCH_MARGIN = 0.06
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class BandTables:
+    """The judged grid.
+
+    Attributes
+    ----------
+    grasps : tuple
+        The candidate grasps (:class:`qsplan.hands.grasps.Grasp`), indexed as the tables' first axis.
+    x : ndarray, shape (n,)
+        The grid of workpiece x (m).
+    graph : SearchGraph
+        ``valid (G, n)``, ``touched (G, n, 2)``, ``width (G, 2, 2, n)`` (N m; ``-inf`` without a band).
+    q : ndarray, shape (G, n, 2)
+        Joint angles (rad; NaN where the grasp has no configuration).
+    lower, upper : ndarray, shape (G, 2, 2, n)
+        The guaranteed bands (N m; NaN without one).
+    why : ndarray of object, shape (G, n)
+        Why a configuration is invalid, in words (None where valid).
+    states : int
+        Configurations judged (grid points x grasps), and
+    band_states : int
+        of them, band evaluations (valid configurations x effort fingers x directions).
+    seconds : float
+        Wall time (s) of building the tables.
+    """
+
+    grasps: tuple
+    x: np.ndarray
+    graph: SearchGraph
+    q: np.ndarray
+    lower: np.ndarray
+    upper: np.ndarray
+    why: np.ndarray
+    states: int
+    band_states: int
+    seconds: float
+
+    def index(self, x: float) -> int:
+        """The grid index of ``x`` (m): the nearest grid point."""
+        return int(np.argmin(np.abs(self.x - x)))
+
+
+def table_grid(start_x: float, goal_x: float, limit: float, step: float = GRID_STEP, margin: float = SEARCH_MARGIN):
+    """The grid (m), shape (n,): through ``start_x`` and ``goal_x`` exactly, spacing at most ``step``, reaching
+    ``margin`` beyond both and no further than ``|x| <= limit``."""
+    span = goal_x - start_x
+    k = int(np.ceil(abs(span) / step))
+    h = abs(span) / k if k else step
+    lo = max(min(start_x, goal_x) - margin, -limit)
+    hi = min(max(start_x, goal_x) + margin, limit)
+    below = int(np.floor((min(start_x, goal_x) - lo) / h + 1e-9))
+    above = int(np.floor((hi - max(start_x, goal_x)) / h + 1e-9))
+    base = min(start_x, goal_x)
+    grid = base + h * np.arange(-below, k + above + 1)
+    # the start and the goal exactly (no rounding of base + h * k)
+    grid[below] = base
+    grid[below + k] = max(start_x, goal_x)
+    return grid
+
+
+def _no_contact(grasp, finger: int) -> str:
+    """Why ``finger`` (0 left, 1 right) has no contact of ``grasp``'s placement, in words."""
+    side = ("left", "right")[finger]
+    placement = (grasp.left, grasp.right)[finger]
+    if type(placement).__name__ == "TipOnEdge":
+        return (f"the {side} fingertip cannot rest on edge {placement.edge} (out of reach, at an end of the edge, "
+                "or the finger would cross the workpiece)")  # fmt: skip
+    return (f"the {side} finger's inner edge cannot rest on a workpiece vertex (the vertex of tangency lies beyond "
+            "the finger's length, or the finger would cross the workpiece)")  # fmt: skip
+
+
+def _geometry(task, grasp, x):
+    """Configurations of ``grasp`` at ``x`` (n,): ``(conf, valid (n,), why list)``."""
+    from qsplan.hands.grasp_geometry import grasp_configurations
+    from qsplan.planner.planning.collision import find_collisions
+    from qsplan.planner.planning.contact_state import limit_problem
+
+    conf = grasp_configurations(task.hand, grasp, x)
+    valid = np.array(conf.ok, dtype=bool)
+    why = [None] * len(x)
+    for k in np.flatnonzero(~valid):
+        f = int(np.argmin(conf.finger_ok[k]))
+        why[k] = _no_contact(grasp, f)
+    lim = task.joint_limits
+    inside = np.all((conf.q >= lim[:, 0]) & (conf.q <= lim[:, 1]), axis=1)
+    for k in np.flatnonzero(valid & ~inside):
+        why[k] = limit_problem(task, conf.q[k])
+    valid &= inside
+    poses = np.stack([x, np.full_like(x, task.hand.rest_height), np.zeros_like(x)], axis=1)
+    try:
+        from qsplan.planner.planning.collision import find_collisions_batch
+    except ImportError:  # the batched test (issue 13) not there: one state at a time
+        find_collisions_batch = None
+    idx = np.flatnonzero(valid)
+    if find_collisions_batch is not None and idx.size:
+        hit = np.zeros(len(x), bool)
+        hit[idx] = find_collisions_batch(task.hand, poses[idx], conf.q[idx])
+    else:
+        hit = np.zeros(len(x), bool)
+        for k in idx:
+            hit[k] = bool(find_collisions(task.hand, poses[k], conf.q[k], first=True))
+    for k in np.flatnonzero(hit):
+        c = find_collisions(task.hand, poses[k], conf.q[k], first=True)
+        why[k] = c[0].message if c else "two bodies overlap"
+    valid &= ~hit
+    return conf, poses, valid, why
+
+
+def band_tables(task, grasps, x, progress=None) -> BandTables:
+    """Judge every grasp of ``grasps`` at every ``x`` (m, shape (n,)) of the grid (see the module docstring).
+
+    Parameters
+    ----------
+    task : qsplan.planner.planning.task.Task
+    grasps : sequence of qsplan.hands.grasps.Grasp
+    x : ndarray, shape (n,)
+    progress : callable, optional
+
+    Returns
+    -------
+    BandTables
+    """
+    from qsplan.mechanics.bands.batched_robust import robust_bands
+
+    from qsplan.planner.planning.contact_state import MODE
+    from qsplan.planner.planning.grasped import controlled, grasp_scenes
+
+    t0 = time.perf_counter()
+    x = np.asarray(x, dtype=float)
+    G, n = len(grasps), len(x)
+    valid = np.zeros((G, n), bool)
+    touched = np.full((G, n, 2), -1, dtype=int)
+    q = np.full((G, n, 2), np.nan)
+    lower = np.full((G, 2, 2, n), np.nan)
+    upper = np.full((G, 2, 2, n), np.nan)
+    why = np.empty((G, n), dtype=object)
+    jobs, scenes = [], []  # (g, e, d, k) of every band to evaluate, and its scene
+    for g, grasp in enumerate(grasps):
+        conf, poses, ok, reasons = _geometry(task, grasp, x)
+        valid[g], touched[g], q[g] = ok, conf.touched, conf.q
+        why[g] = reasons
+        idx = np.flatnonzero(ok)
+        if progress:
+            progress(f"  grasp {g + 1}/{G} {grasp.label}: {idx.size} of {n} configurations valid")
+        if not idx.size:
+            continue
+        base = grasp_scenes(task.hand, conf, idx, 1, 0.0)  # contacts found once per configuration
+        for e in range(2):
+            for d in range(2):
+                xdot = (1.0 if d else -1.0) * task.workpiece_speed
+                scenes += [controlled(b, e, conf.dq_dx[k, 1 - e] * xdot) for b, k in zip(base, idx)]
+                jobs += [(g, e, d, k) for k in idx]
+    # one call: the states of every grasp and direction with the same effort finger form one batch
+    bands = robust_bands(scenes, MODE, task.mu_range, shared=task.shared_mu, force_margin=task.force_margin) if scenes else []
+    for (g, e, d, k), b in zip(jobs, bands):
+        if b.feasible:
+            lower[g, e, d, k], upper[g, e, d, k] = b.lower, b.upper
+    band_states = len(scenes)
+    width = np.where(np.isnan(lower) | np.isnan(upper), -np.inf, upper - lower)
+    graph = SearchGraph(valid, touched, width, float(task.torque_resolution))
+    return BandTables(tuple(grasps), x, graph, q, lower, upper, why, G * n, band_states, time.perf_counter() - t0)

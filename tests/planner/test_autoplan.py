@@ -1,0 +1,153 @@
+"""Automatic planning (issue 14): the [goal] file contract, plans certified and re-simulated, reports, tables."""
+
+import tomllib
+
+import numpy as np
+import pytest
+
+from qsplan.mechanics.errors import QsplanError
+from qsplan.planner.planning.task import demo_task_path, load_task, make_task, task_paths
+
+pytestmark = pytest.mark.ompl
+
+pytest.importorskip("ompl")
+
+DEMO = tomllib.loads(demo_task_path().read_text())
+HAND = DEMO["hand"]
+
+
+def goal_task(tmp_path, goal, **tables):
+    """A task file with the demo's hand and start and the given [goal] table (TOML text written by hand)."""
+    lines = ["[hand]", f"workpiece = {HAND['workpiece']}", f"finger_length = {HAND['finger_length']}",
+             "[motion]", "start_x = 0.0", "[goal]"] + [f"{k} = {v!r}".replace("'", '"') for k, v in goal.items()]
+    for name, table in tables.items():
+        lines += [f"[{name}]"] + [f"{k} = {v!r}".replace("'", '"') for k, v in table.items()]
+    lines += ["[controller]", "torque_resolution = 0.02"]
+    path = tmp_path / "task.toml"
+    path.write_text("\n".join(lines) + "\n")
+    return path
+
+
+def test_goal_contract_is_read(tmp_path):
+    task = load_task(goal_task(tmp_path, {"x": -0.03, "left": "vertex:3", "right": "edge:1"}))
+    assert task.goal.x == -0.03 and task.goal.left == ("vertex", 3) and task.goal.right == ("edge", 1)
+    assert task.automatic and task.waypoints.size == 0
+    demo = load_task(demo_task_path())
+    assert demo.automatic and demo.goal.x == DEMO["goal"]["x"]
+
+
+@pytest.mark.parametrize("goal, match", [
+    ({"left": "edge:1"}, r"goal\.x: missing"),
+    ({"x": "left"}, r"goal\.x: expected a number"),
+    ({"x": 5.0}, r"goal\.x: expected -1 to 1 m"),
+    ({"x": 0.01, "left": "edge 1"}, r'goal\.left: expected "edge:K" or "vertex:K"'),
+    ({"x": 0.01, "right": "vertex:4"}, r"goal\.right: the workpiece has 4 vertices"),
+    ({"x": 0.01, "middle": "edge:1"}, r"goal\.middle: unknown field"),
+])  # fmt: skip
+def test_bad_goals_name_the_field(tmp_path, goal, match):
+    with pytest.raises(QsplanError, match=match):
+        load_task(goal_task(tmp_path, goal))
+
+
+def test_waypoints_and_goal_together_are_refused():
+    with pytest.raises(QsplanError, match=r"goal: give either motion\.waypoints .* or \[goal\]"):
+        make_task(HAND, 0.0, [0.01], goal={"x": 0.01})
+    with pytest.raises(QsplanError, match=r"motion\.waypoints: missing \(or give a \[goal\]"):
+        make_task(HAND, 0.0)
+    with pytest.raises(QsplanError, match=r"start\.left: expected"):
+        make_task(HAND, 0.0, goal={"x": 0.01}, start={"left": "palm"})
+
+
+@pytest.mark.parametrize("goal_x", [-0.03, 0.03])
+def test_demo_start_to_goals_left_and_right_certified(tmp_path, goal_x):
+    """The acceptance's tasks: the demo's start, goals left and right; a certified plan whose export re-simulates."""
+    from qsplan.planner.planning.pipeline import run_plan
+
+    task = load_task(goal_task(tmp_path, {"x": goal_x}))
+    run = run_plan(task, tmp_path / "out", verify=2, plots=False)
+    assert run.followed and run.certificate.ok
+    plan = run.plan
+    assert plan.phases[0].x[0] == 0.0 and plan.phases[-1].x[-1] == goal_x
+    assert plan.sequence and plan.sequence[-1]["kind"] == "search"
+    assert min(np.min(s.width) for s in plan.segments) >= task.torque_resolution
+
+
+def test_planner_is_deterministic(tmp_path):
+    from qsplan.planner.planning.pipeline import run_plan
+
+    task = load_task(demo_task_path())
+    a = run_plan(task, tmp_path / "a", verify=0, plots=False)
+    b = run_plan(task, tmp_path / "b", verify=0, plots=False)
+    assert (tmp_path / "a" / "plan.csv").read_bytes() == (tmp_path / "b" / "plan.csv").read_bytes()
+    assert a.plan.sequence[:-1] == b.plan.sequence[:-1]
+
+
+@pytest.mark.parametrize("stem", sorted(s for s, p in task_paths().items() if "[goal]" in p.read_text()))
+def test_bundled_goal_tasks(tmp_path, stem):
+    """Each bundled automatic task is planned, certified and re-simulated; the infeasible one says why."""
+    from qsplan.planner.planning.pipeline import run_plan
+    from qsplan.planner.planning.results import PlanFailure
+
+    task = load_task(task_paths()[stem])
+    if stem == "friction_closes_task":
+        with pytest.raises(PlanFailure) as err:
+            run_plan(task, tmp_path / "out", verify=0, plots=False)
+        msg = err.value.report.message
+        assert "no guaranteed band for the whole friction range [0.0, 0.6]" in msg
+        assert "with mu in [0, 0.5" in msg  # the friction from which the band closes, by bisection
+        assert (tmp_path / "out" / "failure.json").exists()
+        return
+    run = run_plan(task, tmp_path / "out", verify=3, plots=False)
+    assert run.followed and run.certificate.ok
+    assert run.plan.phases[-1].x[-1] == task.goal.x
+
+
+def test_goal_on_a_vertex_the_finger_cannot_touch_is_named(tmp_path):
+    from qsplan.planner.planning.plan import plan_task
+    from qsplan.planner.planning.results import PlanFailure
+
+    task = load_task(goal_task(tmp_path, {"x": -0.03, "left": "vertex:0"}))
+    with pytest.raises(PlanFailure, match=r"the goal is unreachable on this palm.*left finger's inner edge on vertex 3"):
+        plan_task(task)
+
+
+def test_tables_agree_with_the_per_state_check():
+    """The batched tables against check_contact_state (the per-state validity checker), state by state."""
+    from qsplan.hands.grasp_geometry import candidate_grasps
+    from qsplan.planner.planning.contact_state import check_contact_state
+    from qsplan.planner.sequence.tables import band_tables, table_grid
+
+    for stem in ("demo_task", "pentagon_roof_task"):
+        task = load_task(task_paths()[stem])
+        tables = band_tables(task, candidate_grasps(task.hand), table_grid(task.start_x, task.goal.x, 0.16, step=0.004,
+                                                                           margin=0.02))  # fmt: skip
+        G, n = tables.graph.shape
+        for g in range(G):
+            for i in range(0, n, 3):
+                for e, d in ((0, 0), (1, 1)):
+                    c = check_contact_state(task, tables.x[i], ("left", "right")[e], (-1.0, 1.0)[d],
+                                            grasp=tables.grasps[g])  # fmt: skip
+                    if not tables.graph.valid[g, i]:
+                        assert not c.ok
+                        continue
+                    lo, hi = tables.lower[g, e, d, i], tables.upper[g, e, d, i]
+                    if np.isnan(lo):
+                        assert not c.ok or c.reason
+                        continue
+                    assert (c.lower, c.upper) == (lo, hi)
+                    assert c.ok == (hi - lo >= task.torque_resolution)
+
+
+def test_cli_sequence_planner_option(tmp_path, capsys):
+    """``qsplan plan --sequence-planner``: the search is recorded in plan.json's metadata."""
+    import json
+
+    from qsplan.planner.cli.main import main
+
+    out = tmp_path / "out"
+    code = main(["plan", str(demo_task_path()), "--out", str(out), "--sequence-planner", "BITstar", "--no-plots",
+                 "--verify", "0", "--quiet"])  # fmt: skip
+    assert code == 0
+    meta = json.loads((out / "plan.json").read_text())["metadata"]
+    assert meta["sequence"][-1]["planner"] == "BITstar" and meta["sequence"][0]["kind"] == "slide"
+    assert "sequence found by the 'BITstar' search" in capsys.readouterr().out
