@@ -14,7 +14,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from qsplan.mechanics.errors import SceneError
+from qsplan.mechanics.errors import QsplanError, SceneError
 
 __all__ = ["controlled", "grasp_samples", "grasp_scenes"]
 
@@ -36,12 +36,14 @@ def controlled(scene, effort_joint: int, velocity: float):
                    joint_effort=_frozen(np.where(e, 0.0, np.nan)))  # fmt: skip
 
 
-def grasp_scenes(hand, conf, idx, effort_joint, xdot) -> list:
+def grasp_scenes(hand, conf, idx, effort_joint, xdot, reasons: dict | None = None) -> list:
     """Scenes of the configurations ``conf`` (:class:`qsplan.hands.grasp_geometry.GraspConfigurations`) at
     indices ``idx`` with the workpiece moving at ``xdot`` (m/s) and ``effort_joint`` (0/1 or "left"/"right")
     effort-controlled; the other joint moves at ``dq_dx * xdot`` (rad/s), keeping both contacts.  Built from the
     grasp's known contacts (:func:`qsplan.hands.batch_scenes.grasp_scenes`, checked to be the polygon search's),
-    else by :func:`qsplan.hands.two_finger_scene.hand_scene`, which says what the polygons give."""
+    else by :func:`qsplan.hands.two_finger_scene.hand_scene`, which says what the polygons give.  Where they
+    give no four-contact scene, the error is raised, or, with ``reasons`` (a dict), the scene is None and
+    ``reasons[k]`` (``k`` the position in ``idx``) says why."""
     from dataclasses import replace
 
     from qsplan.hands.batch_scenes import grasp_scenes as known_contact_scenes
@@ -56,8 +58,17 @@ def grasp_scenes(hand, conf, idx, effort_joint, xdot) -> list:
     sub = replace(conf, **arrays)
     scenes = known_contact_scenes(hand, sub, name, xdot)
     poses = sub.poses(hand.rest_height)
-    return [s if s is not None else hand_scene(hand, poses[k], sub.q[k], name, velocity=float(sub.dq_dx[k, v] * xdot))
-            for k, s in enumerate(scenes)]  # fmt: skip
+    out = []
+    for k, scene in enumerate(scenes):
+        if scene is None:
+            try:
+                scene = hand_scene(hand, poses[k], sub.q[k], name, velocity=float(sub.dq_dx[k, v] * xdot))
+            except QsplanError as exc:  # the polygons give no four-contact scene here (e.g. vertex on vertex)
+                if reasons is None:
+                    raise
+                reasons[k] = f"no four-contact scene: {exc}"
+        out.append(scene)
+    return out
 
 
 def grasp_samples(hand, grasp, xs, effort_joint, speed):

@@ -78,6 +78,8 @@ def unreachable_goal_report(task, tables, i, which, grasps_at) -> ConfigurationR
     lines = [f"{tables.grasps[g].label}: {tables.why[g, i]}" for g in cands[:6] if not tables.graph.valid[g, i]]
     lines += [f"{tables.grasps[g].label} is valid there with {_touching(task, tables, g, i)}"
               for g in range(len(tables.grasps)) if tables.graph.valid[g, i]][:4]  # fmt: skip
+    if not lines:  # nothing meets it, nothing is valid: why each candidate is not
+        lines = [f"{tables.grasps[g].label}: {tables.why[g, i]}" for g in range(len(tables.grasps))][:4]
     feats = task.goal.describe() if which == "goal" else f"start features {list(task.start_features)}"
     reason = (f"the {which} is unreachable on this palm: no grasp meeting it ({feats}) is a valid configuration"
               + (f" ({'; '.join(lines)})" if lines else " (no candidate grasp of this hand has those features anywhere)"))  # fmt: skip

@@ -179,7 +179,13 @@ def band_tables(task, grasps, x, progress=None) -> BandTables:
             progress(f"  grasp {g + 1}/{G} {grasp.label}: {idx.size} of {n} configurations valid")
         if not idx.size:
             continue
-        base = grasp_scenes(task.hand, conf, idx, 1, 0.0)  # contacts found once per configuration
+        failed = {}
+        base = grasp_scenes(task.hand, conf, idx, 1, 0.0, failed)  # contacts found once per configuration
+        for k, why_not in failed.items():  # no four-contact scene there: not a configuration of this grasp
+            valid[g, idx[k]] = False
+            why[g, idx[k]] = why_not
+        keep = [k for k in range(len(idx)) if k not in failed]
+        base, idx = [base[k] for k in keep], idx[keep]
         for e in range(2):
             for d in range(2):
                 xdot = (1.0 if d else -1.0) * task.workpiece_speed

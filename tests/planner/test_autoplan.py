@@ -151,3 +151,23 @@ def test_cli_sequence_planner_option(tmp_path, capsys):
     meta = json.loads((out / "plan.json").read_text())["metadata"]
     assert meta["sequence"][-1]["planner"] == "BITstar" and meta["sequence"][0]["kind"] == "slide"
     assert "sequence found by the 'BITstar' search" in capsys.readouterr().out
+
+
+def test_single_link_fingers_have_one_grasp_at_each_x():
+    """Why the paper's hand never needs a regrasp onto another feature: a single-link finger turning about a fixed
+    axis meets a convex workpiece on the palm in one configuration only, so at each workpiece x at most one
+    candidate grasp is valid (checked on every bundled hand, 1 mm apart over the whole palm)."""
+    from qsplan.hands.grasp_geometry import candidate_grasps
+    from qsplan.planner.sequence.tables import band_tables, table_grid
+
+    seen = set()
+    for path in task_paths().values():
+        task = load_task(path)
+        key = (task.hand.workpiece.tobytes(), task.hand.finger_length, task.hand.finger_base)
+        if key in seen:
+            continue
+        seen.add(key)
+        grasps = candidate_grasps(task.hand)
+        tables = band_tables(task, grasps, table_grid(-0.15, 0.15, 0.16, step=0.001, margin=0.0))
+        assert tables.graph.valid.sum(axis=0).max() <= 1, task.name
+    assert len(seen) >= 3  # the quadrilateral (16 cm fingers), the pentagon (11 cm), the trapezoid (8 cm)
