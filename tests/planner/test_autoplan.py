@@ -171,3 +171,35 @@ def test_single_link_fingers_have_one_grasp_at_each_x():
         tables = band_tables(task, grasps, table_grid(-0.15, 0.15, 0.16, step=0.001, margin=0.0))
         assert tables.graph.valid.sum(axis=0).max() <= 1, task.name
     assert len(seen) >= 3  # the quadrilateral (16 cm fingers), the pentagon (11 cm), the trapezoid (8 cm)
+
+
+@pytest.mark.parametrize("seed", range(3))
+def test_random_goal_tasks_plan_or_say_why(seed):
+    """Seeded random workpieces, fingers, starts (on a grasp valid there) and goals: a plan, or a PlanFailure /
+    QsplanError with a message; never another exception (a scene the polygons cannot give crashed the tables)."""
+    from dataclasses import replace
+
+    from qsplan.hands.grasp_geometry import candidate_grasps, grasp_configurations
+    from qsplan.planner.planning.plan import plan_task
+    from qsplan.planner.planning.results import PlanFailure
+
+    rng = np.random.default_rng(seed)
+    for _ in range(8):
+        w, h = rng.uniform(0.04, 0.09), rng.uniform(0.03, 0.1)
+        top = sorted(rng.uniform(0.0, w, int(rng.integers(1, 4))))[::-1]
+        pts = [[0.0, 0.0], [w, 0.0]] + [[float(x), float(h * rng.uniform(0.6, 1.0))] for x in top]
+        x0 = float(rng.uniform(-0.03, 0.03))
+        try:
+            task = make_task({"workpiece": pts, "finger_length": float(rng.uniform(0.06, 0.17))}, x0,
+                             goal={"x": x0 + float(rng.choice([-1, 1]) * rng.uniform(0.002, 0.04))})  # fmt: skip
+        except QsplanError:
+            continue
+        for g in candidate_grasps(task.hand):
+            if grasp_configurations(task.hand, g, np.array([x0])).ok[0]:
+                side = [("inner", None) if type(p).__name__ == "OnVertex" else ("edge", p.edge) for p in (g.left, g.right)]
+                task = replace(task, start_features=tuple(side))
+                break
+        try:
+            plan_task(task)
+        except (PlanFailure, QsplanError) as exc:
+            assert str(exc).strip() and "\n" not in str(exc)
