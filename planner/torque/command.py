@@ -73,7 +73,11 @@ def choose_command(lower, upper, safety_margin, max_margin=None):
 
     * bounded band: the midpoint, margin = half the width; with ``max_margin``, a band
       wider than twice it gets ``lower + max_margin`` instead (no torque far above the
-      one the mode needs: near a blow-up of the upper edge the midpoint runs away);
+      one the mode needs: near a blow-up of the upper edge the midpoint runs away) or, in
+      a segment whose bands are unbounded below and nowhere unbounded above (a finger
+      squeezing with negative torque, whose lower edge is the one that blows up),
+      ``upper - max_margin``: the edge the mode needs is the same along the segment, so the
+      command stays continuous where an unbounded edge becomes finite;
     * unbounded above (below): ``lower + safety_margin`` (``upper - safety_margin``), margin = ``safety_margin``
       (a midpoint does not exist);
     * unbounded on both sides: 0, margin inf;
@@ -100,13 +104,14 @@ def choose_command(lower, upper, safety_margin, max_margin=None):
         raise QsplanError(f"max margin: expected a finite effort of at least the safety margin {safety_margin:g}; "
                           f"got {max_margin!r}")  # fmt: skip
     lo_f, up_f = np.isfinite(lower), np.isfinite(upper)
+    from_upper = bool(np.any(np.isneginf(lower) & up_f)) and not np.any(np.isposinf(upper))
     with np.errstate(invalid="ignore"):
         half = 0.5 * (upper - lower)
         if max_margin is not None:
             half = np.minimum(half, max_margin)
         command = np.select(
             [lo_f & up_f, lo_f & np.isposinf(upper), np.isneginf(lower) & up_f, np.isneginf(lower) & np.isposinf(upper)],
-            [lower + half, lower + safety_margin, upper - safety_margin, 0.0],
+            [upper - half if from_upper else lower + half, lower + safety_margin, upper - safety_margin, 0.0],
             np.nan,
         )
         margin = np.select(

@@ -100,6 +100,9 @@ def test_bundled_goal_tasks(tmp_path, stem):
     run = run_plan(task, tmp_path / "out", verify=3, plots=False)
     assert run.followed and run.certificate.ok
     assert run.plan.phases[-1].x[-1] == task.goal.x
+    for seg in run.plan.segments:  # commands continuous (a squeezing finger's band unbounded below leapt to -4.5 N m)
+        jump = float(np.max(np.abs(np.diff(seg.command)))) if seg.command.size > 1 else 0.0
+        assert jump <= 0.1 * (float(np.max(np.abs(seg.command))) + task.torque_resolution), (stem, jump)
 
 
 def test_goal_on_a_vertex_the_finger_cannot_touch_is_named(tmp_path):
