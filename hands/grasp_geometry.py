@@ -82,6 +82,14 @@ class GraspConfigurations:
     normals: np.ndarray
     dq_dx: np.ndarray
 
+    def take(self, rows) -> "GraspConfigurations":
+        """The states ``rows`` (array of int) of these configurations, as configurations."""
+        from dataclasses import fields, replace
+
+        rows = np.asarray(rows, dtype=int)
+        per_state = {f.name: getattr(self, f.name)[rows] for f in fields(self) if f.name not in ("grasp", "tip")}
+        return replace(self, **per_state)
+
     def poses(self, rest_height: float) -> np.ndarray:
         """Workpiece poses ``(x, rest_height, 0)`` (m, m, rad), shape (n, 3)."""
         return np.column_stack([self.x, np.full_like(self.x, rest_height), np.zeros_like(self.x)])

@@ -44,18 +44,13 @@ def grasp_scenes(hand, conf, idx, effort_joint, xdot, reasons: dict | None = Non
     else by :func:`qsplan.hands.two_finger_scene.hand_scene`, which says what the polygons give.  Where they
     give no four-contact scene, the error is raised, or, with ``reasons`` (a dict), the scene is None and
     ``reasons[k]`` (``k`` the position in ``idx``) says why."""
-    from dataclasses import replace
-
     from qsplan.hands.batch_scenes import grasp_scenes as known_contact_scenes
     from qsplan.hands.two_finger import JOINT_NAMES
     from qsplan.hands.two_finger_scene import hand_scene
 
     name = JOINT_NAMES[effort_joint] if isinstance(effort_joint, (int, np.integer)) else effort_joint
     v = 1 - JOINT_NAMES.index(name)
-    idx = np.asarray(list(idx), dtype=int)
-    arrays = {f: getattr(conf, f)[idx] for f in ("x", "q", "ok", "finger_ok", "touched", "touched_as_written", "points",
-                                                  "normals", "dq_dx")}  # fmt: skip
-    sub = replace(conf, **arrays)
+    sub = conf.take(np.asarray(list(idx), dtype=int))
     scenes = known_contact_scenes(hand, sub, name, xdot)
     poses = sub.poses(hand.rest_height)
     out = []

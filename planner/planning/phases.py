@@ -135,9 +135,8 @@ def slide_phase(task, name, x0, x1, effort, direction, touching, comps, t0, opti
     from qsplan.planner.planning.ompl_bridge import PlanResult
     from qsplan.planner.torque.command import choose_command, default_safety_margin
 
-    # the configuration is the workpiece's x alone (the fingers follow by tangency): the only path is the
-    # straight line, and its dense sweep is the whole check (where OMPL used to return this line after ~100
-    # checks at 0.8 mm, followed by this sweep)
+    # the configuration is the workpiece's x alone (the fingers follow the grasp's closed form): the only path
+    # is the straight line, and its dense sweep is the whole check
     path = straight_path(x0, x1)
     x = densify(path[:, 0], SWEEP_STEP)
     t_check = time.perf_counter()

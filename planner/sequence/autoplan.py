@@ -25,6 +25,7 @@ The plan then goes through the same export, certification and re-simulation as a
 from __future__ import annotations
 
 import time
+from dataclasses import replace
 
 import numpy as np
 
@@ -44,30 +45,28 @@ _FINGERS = ("left", "right")
 
 
 def _feature_text(feature):
-    return None if feature is None else f"{feature[0]}:{feature[1]}"
+    """A task's feature as :meth:`qsplan.hands.grasps.Grasp.matches` reads it: None (any), ``"vertex"`` (the start's
+    ``"inner"``: the inner edge on whichever vertex), ``"edge:K"``, ``"vertex:K"``."""
+    if feature is None:
+        return None
+    return "vertex" if feature[0] == "inner" else f"{feature[0]}:{feature[1]}"
 
 
 def _start_grasps(tables, task, i):
-    """Indices of the grasps that meet the task's start features at grid index ``i``."""
-    feats = [None if f[0] == "inner" else _feature_text(f) for f in task.start_features]
-    out = []
-    for g, grasp in enumerate(tables.grasps):
-        inner_ok = all(f[0] != "inner" or type(p).__name__ == "OnVertex"
-                       for f, p in zip(task.start_features, (grasp.left, grasp.right)))  # fmt: skip
-        if inner_ok and _meets(tables, task, g, i, feats) and tables.graph.valid[g, i]:
-            out.append(g)
-    return out
+    """Indices of the valid grasps that meet the task's start features at grid index ``i``."""
+    feats = [_feature_text(f) for f in task.start_features]
+    return [g for g in range(len(tables.grasps)) if tables.graph.valid[g, i] and _meets(tables, task, g, i, feats)]
 
 
 def _meets(tables, task, g, i, feats) -> bool:
-    """Whether grasp ``g`` at grid index ``i`` touches the features ``feats`` (left, right: text or None)."""
+    """Whether grasp ``g`` at grid index ``i`` touches the features ``feats`` (left, right: text or None): its
+    placements match, and a ``"vertex:K"`` is the vertex touched there."""
     from qsplan.hands.grasps import user_vertex
 
-    grasp = tables.grasps[g]
-    if not grasp.matches(*[f if f is None or f.startswith("edge") else "vertex" for f in feats]):
+    if not tables.grasps[g].matches(*feats):
         return False
-    for k, f in enumerate(feats):  # "vertex:K": the vertex touched there
-        if f is not None and f.startswith("vertex"):
+    for k, f in enumerate(feats):
+        if f is not None and f.startswith("vertex:"):
             touched = int(tables.graph.touched[g, i, k])
             if touched < 0 or user_vertex(task.hand, touched) != int(f.split(":")[1]):
                 return False
@@ -126,10 +125,9 @@ def _opening(task, grasp, x):
 
 def _realise(task, tables, route, options, progress, counters):
     """The route's phases as plan phases; raises ``_Rejected`` naming the table cell or regrasp to drop."""
-    from qsplan.planner.planning.contact_state import check_contact_state
+    from qsplan.planner.planning.contact_state import check_contact_state, contact_samples
     from qsplan.planner.planning.phases import regrasp_phase, slide_phase
     from qsplan.planner.torque.sweep import competing_modes
-    from qsplan.planner.planning.contact_state import contact_samples
 
     x, q_tab = tables.x, tables.q
     phases, seq, t0 = [], [], 0.0
@@ -236,7 +234,7 @@ def plan_automatic(task, options=None, progress=None, planner: str = "widest", t
     width = tables.graph.width.copy()
     while True:
         rounds += 1
-        graph = type(tables.graph)(tables.graph.valid, tables.graph.touched, width, tables.graph.resolution)
+        graph = replace(tables.graph, width=width)
         results = [search_route(graph, (s, i_start), goals, planner, forbidden) for s in starts]
         search_s += sum(r.seconds for r in results)
         evaluations += sum(r.evaluations for r in results)

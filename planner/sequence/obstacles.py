@@ -60,12 +60,12 @@ class NoRouteReport:
 
 def _touching(task, tables, g, i) -> str:
     """What grasp ``g`` touches at grid index ``i``, in the polygon's numbering as written."""
-    from qsplan.hands.grasps import user_edge, user_vertex
+    from qsplan.hands.grasps import TipOnEdge, user_edge, user_vertex
 
     parts = []
     for k, (side, placement) in enumerate(zip(("left", "right"), (tables.grasps[g].left, tables.grasps[g].right))):
         t = int(tables.graph.touched[g, i, k])
-        if type(placement).__name__ == "TipOnEdge":
+        if isinstance(placement, TipOnEdge):
             parts.append(f"the {side} fingertip on edge {user_edge(task.hand, t)}")
         else:
             parts.append(f"the {side} finger's inner edge on vertex {user_vertex(task.hand, t)}")
@@ -75,24 +75,24 @@ def _touching(task, tables, g, i) -> str:
 def unreachable_goal_report(task, tables, i, which, grasps_at) -> ConfigurationReport:
     """The start or goal (``which``) at grid index ``i`` has no valid grasp with the asked features."""
     cands = grasps_at(tables, task, i)
-    lines = [f"{tables.grasps[g].label}: {tables.why[g, i]}" for g in cands[:6] if not tables.graph.valid[g, i]]
+    lines = [f"{tables.grasps[g].label}: {tables.reason(task, g, i)}" for g in cands[:6] if not tables.graph.valid[g, i]]
     lines += [f"{tables.grasps[g].label} is valid there with {_touching(task, tables, g, i)}"
               for g in range(len(tables.grasps)) if tables.graph.valid[g, i]][:4]  # fmt: skip
     if not lines:  # nothing meets it, nothing is valid: why each candidate is not
-        lines = [f"{tables.grasps[g].label}: {tables.why[g, i]}" for g in range(len(tables.grasps))][:4]
+        lines = [f"{tables.grasps[g].label}: {tables.reason(task, g, i)}" for g in range(len(tables.grasps))][:4]
     feats = task.goal.describe() if which == "goal" else f"start features {list(task.start_features)}"
     reason = (f"the {which} is unreachable on this palm: no grasp meeting it ({feats}) is a valid configuration"
               + (f" ({'; '.join(lines)})" if lines else " (no candidate grasp of this hand has those features anywhere)"))  # fmt: skip
     return ConfigurationReport(f"the {which}", f"the {which}", float(tables.x[i]), None, reason)
 
 
-def _blocking(tables, g, i0, i1) -> str:
+def _blocking(task, tables, g, i0, i1) -> str:
     """Where grasp ``g``'s slides from ``i0`` toward ``i1`` end, and why."""
     step = 1 if i1 >= i0 else -1
     touched0 = tables.graph.touched[g, i0]
     for i in range(i0, i1 + step, step):
         if not tables.graph.valid[g, i]:
-            return f"at x = {tables.x[i]:.4g} m: {tables.why[g, i]}"
+            return f"at x = {tables.x[i]:.4g} m: {tables.reason(task, g, i)}"
         if np.any(tables.graph.touched[g, i] != touched0):
             return f"at x = {tables.x[i]:.4g} m a finger's contact moves to another feature"
     return "nothing blocks its geometry"
@@ -120,7 +120,7 @@ def no_route_report(task, tables, graph, starts, i_start, goals, forbidden) -> N
         return NoRouteReport("band closes", summary, (), band)
     geo = [r for r in (widest_route(geometric, (s, i_start), goals, forbidden) for s in starts) if r is not None]
     details = tuple(f"grasp {tables.grasps[s].label} from x = {tables.x[i_start]:.4g} m toward {tables.x[i_goal]:.4g} m: "
-                    f"{_blocking(tables, s, i_start, i_goal)}" for s in starts)  # fmt: skip
+                    f"{_blocking(task, tables, s, i_start, i_goal)}" for s in starts)  # fmt: skip
     if geo:
         route = geo[0]
         allowed = slide_widths(anyband)

@@ -91,8 +91,8 @@ def _route_from_states(graph, edges, states, forbidden, evaluations):
     return Route(tuple(steps), min(widths, default=np.inf), sum(s.kind == "regrasp" for s in steps), evaluations)
 
 
-def search_route(graph: SearchGraph, start, goals, planner: str = "widest", forbidden=frozenset(), regrasp_ok=None,
-                 seed: int = 1, iterations: int = 3000) -> SearchResult:  # fmt: skip
+def search_route(graph: SearchGraph, start, goals, planner: str = "widest", forbidden=frozenset(), seed: int = 1,
+                 iterations: int = 3000) -> SearchResult:  # fmt: skip
     """Find a route from ``start`` to one of ``goals`` (``(grasp, i)`` nodes) with ``planner`` inside OMPL.
 
     Parameters
@@ -104,7 +104,6 @@ def search_route(graph: SearchGraph, start, goals, planner: str = "widest", forb
         One of :data:`SEQUENCE_PLANNERS`.
     forbidden : set of (int, int, int)
         Regrasps ``(from, to, i)`` not to use.
-    regrasp_ok : ndarray of bool, shape (n,), optional
     seed : int
         OMPL's RNG seed (sampling planners).
     iterations : int
@@ -122,8 +121,7 @@ def search_route(graph: SearchGraph, start, goals, planner: str = "widest", forb
         raise QsplanError(f"planner: expected one of {', '.join(SEQUENCE_PLANNERS)}; got {planner!r}")
     G, n = graph.shape
     goals = [tuple(map(int, g)) for g in goals]
-    regrasp_ok = np.ones(n, bool) if regrasp_ok is None else np.asarray(regrasp_ok, bool)
-    forbidden = frozenset(forbidden) | {(g, h, i) for g in range(G) for h in range(G) for i in np.flatnonzero(~regrasp_ok)}
+    forbidden = frozenset(forbidden)
     edges = slide_widths(graph)
     counter, found = [0], [None]
     ou.setLogLevel(ou.LOG_NONE)
@@ -185,7 +183,7 @@ def search_route(graph: SearchGraph, start, goals, planner: str = "widest", forb
             # pdef.getStartState() is freed twice at teardown (segfault, ompl 2.0.1)
             pdef = self.getProblemDefinition()
             s0 = (int(start[0]), int(start[1]))
-            route = widest_route(graph, s0, goals, forbidden, regrasp_ok)
+            route = widest_route(graph, s0, goals, forbidden)
             found[0] = route
             if route is None:
                 return ob.PlannerStatus(ob.PlannerStatus.TIMEOUT)
@@ -241,4 +239,4 @@ def search_route(graph: SearchGraph, start, goals, planner: str = "widest", forb
             states = [node(s) for s in path.getStates()]
             del path
             route = _route_from_states(graph, edges, states, forbidden, evaluations)
-    return SearchResult(route if exact or route is not None else None, planner, seconds, evaluations, text)
+    return SearchResult(route, planner, seconds, evaluations, text)

@@ -21,11 +21,18 @@ import numpy as np
 
 from qsplan.planner.sequence.widest import SearchGraph
 
-__all__ = ["BandTables", "band_tables", "table_grid", "GRID_STEP", "SEARCH_MARGIN"]
+__all__ = ["BandTables", "band_tables", "table_grid", "GRID_STEP", "OVERLAP", "SEARCH_MARGIN"]
 
 #: Grid step (m) of the tables: the plan's dense-sweep step, so that the tables judge the states
 #: the plan will judge (:data:`qsplan.planner.planning.plan.SWEEP_STEP`).
 GRID_STEP = 5e-4
+
+#: What :attr:`BandTables.why` holds where two bodies overlap (:meth:`BandTables.reason` says which, and by how much).
+OVERLAP = "two bodies overlap"
+
+#: Relative slack of the grid's end counts: ``(end - start) / h`` computes a hair below its integer when the
+#: span is a multiple of the step (floating point), which would drop the last grid point.
+_GRID_ROUNDING = 1e-9
 
 #: How far (m) beyond the start and the goal the tables reach: room for the detours a regrasp may
 #: need (a slide away from the goal to where another grasp is valid); 6 cm is most of the span between
@@ -50,7 +57,8 @@ class BandTables:
     lower, upper : ndarray, shape (G, 2, 2, n)
         The guaranteed bands (N m; NaN without one).
     why : ndarray of object, shape (G, n)
-        Why a configuration is invalid, in words (None where valid).
+        Why a configuration is invalid, in words (None where valid; :data:`OVERLAP` where two bodies overlap,
+        :meth:`reason` says which).
     states : int
         Configurations judged (grid points x grasps), and
     band_states : int
@@ -74,6 +82,17 @@ class BandTables:
         """The grid index of ``x`` (m): the nearest grid point."""
         return int(np.argmin(np.abs(self.x - x)))
 
+    def reason(self, task, g: int, i: int) -> str | None:
+        """Why grasp ``g`` is invalid at grid index ``i``, in words (None where valid): the overlapping bodies
+        and their overlap measured here, for reports, not for every configuration of the tables."""
+        why = self.why[g, i]
+        if why != OVERLAP:
+            return why
+        from qsplan.planner.planning.collision import find_collisions
+
+        hit = find_collisions(task.hand, task.pose(self.x[i]), self.q[g, i], first=True)
+        return hit[0].message if hit else "two bodies overlap"
+
 
 def table_grid(start_x: float, goal_x: float, limit: float, step: float = GRID_STEP, margin: float = SEARCH_MARGIN):
     """The grid (m), shape (n,): through ``start_x`` and ``goal_x`` exactly, spacing at most ``step``, reaching
@@ -83,8 +102,8 @@ def table_grid(start_x: float, goal_x: float, limit: float, step: float = GRID_S
     h = abs(span) / k if k else step
     lo = max(min(start_x, goal_x) - margin, -limit)
     hi = min(max(start_x, goal_x) + margin, limit)
-    below = int(np.floor((min(start_x, goal_x) - lo) / h + 1e-9))
-    above = int(np.floor((hi - max(start_x, goal_x)) / h + 1e-9))
+    below = int(np.floor((min(start_x, goal_x) - lo) / h + _GRID_ROUNDING))
+    above = int(np.floor((hi - max(start_x, goal_x)) / h + _GRID_ROUNDING))
     base = min(start_x, goal_x)
     grid = base + h * np.arange(-below, k + above + 1)
     # the start and the goal exactly (no rounding of base + h * k)
@@ -95,9 +114,11 @@ def table_grid(start_x: float, goal_x: float, limit: float, step: float = GRID_S
 
 def _no_contact(grasp, finger: int) -> str:
     """Why ``finger`` (0 left, 1 right) has no contact of ``grasp``'s placement, in words."""
+    from qsplan.hands.grasps import TipOnEdge
+
     side = ("left", "right")[finger]
     placement = (grasp.left, grasp.right)[finger]
-    if type(placement).__name__ == "TipOnEdge":
+    if isinstance(placement, TipOnEdge):
         return (f"the {side} fingertip cannot rest on edge {placement.edge} (out of reach, at an end of the edge, "
                 "or the finger would cross the workpiece)")  # fmt: skip
     return (f"the {side} finger's inner edge cannot rest on a workpiece vertex (the vertex of tangency lies beyond "
@@ -105,40 +126,29 @@ def _no_contact(grasp, finger: int) -> str:
 
 
 def _geometry(task, grasp, x):
-    """Configurations of ``grasp`` at ``x`` (n,): ``(conf, valid (n,), why list)``."""
+    """Configurations of ``grasp`` at ``x`` (n,): ``(conf, valid (n,), why list)``; overlapping configurations get
+    :data:`OVERLAP` (their message is measured only when a report asks: :meth:`BandTables.reason`)."""
     from qsplan.hands.grasp_geometry import grasp_configurations
-    from qsplan.planner.planning.collision import find_collisions
+    from qsplan.planner.planning.collision import find_collisions_batch
     from qsplan.planner.planning.contact_state import limit_problem
 
     conf = grasp_configurations(task.hand, grasp, x)
     valid = np.array(conf.ok, dtype=bool)
     why = [None] * len(x)
     for k in np.flatnonzero(~valid):
-        f = int(np.argmin(conf.finger_ok[k]))
-        why[k] = _no_contact(grasp, f)
+        why[k] = _no_contact(grasp, int(np.argmin(conf.finger_ok[k])))
     lim = task.joint_limits
     inside = np.all((conf.q >= lim[:, 0]) & (conf.q <= lim[:, 1]), axis=1)
     for k in np.flatnonzero(valid & ~inside):
         why[k] = limit_problem(task, conf.q[k])
     valid &= inside
-    poses = np.stack([x, np.full_like(x, task.hand.rest_height), np.zeros_like(x)], axis=1)
-    try:
-        from qsplan.planner.planning.collision import find_collisions_batch
-    except ImportError:  # the batched test (issue 13) not there: one state at a time
-        find_collisions_batch = None
     idx = np.flatnonzero(valid)
-    if find_collisions_batch is not None and idx.size:
-        hit = np.zeros(len(x), bool)
-        hit[idx] = find_collisions_batch(task.hand, poses[idx], conf.q[idx])
-    else:
-        hit = np.zeros(len(x), bool)
-        for k in idx:
-            hit[k] = bool(find_collisions(task.hand, poses[k], conf.q[k], first=True))
+    hit = np.zeros(len(x), bool)
+    if idx.size:
+        hit[idx] = find_collisions_batch(task.hand, conf.poses(task.hand.rest_height)[idx], conf.q[idx])
     for k in np.flatnonzero(hit):
-        c = find_collisions(task.hand, poses[k], conf.q[k], first=True)
-        why[k] = c[0].message if c else "two bodies overlap"
-    valid &= ~hit
-    return conf, poses, valid, why
+        why[k] = OVERLAP
+    return conf, valid & ~hit, why
 
 
 def band_tables(task, grasps, x, progress=None) -> BandTables:
@@ -171,7 +181,7 @@ def band_tables(task, grasps, x, progress=None) -> BandTables:
     why = np.empty((G, n), dtype=object)
     jobs, scenes = [], []  # (g, e, d, k) of every band to evaluate, and its scene
     for g, grasp in enumerate(grasps):
-        conf, poses, ok, reasons = _geometry(task, grasp, x)
+        conf, ok, reasons = _geometry(task, grasp, x)
         valid[g], touched[g], q[g] = ok, conf.touched, conf.q
         why[g] = reasons
         idx = np.flatnonzero(ok)

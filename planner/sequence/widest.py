@@ -115,7 +115,7 @@ def slide_widths(graph: SearchGraph) -> np.ndarray:
     return np.where(same[:, None, None, :], edge, -np.inf)
 
 
-def _neighbours(graph, edges, g, i, forbidden, regrasp_ok):
+def _neighbours(graph, edges, g, i, forbidden):
     """Edges out of node (g, i): ``(width, to_g, to_i, effort, kind)``."""
     G, n = graph.shape
     out = []
@@ -124,14 +124,13 @@ def _neighbours(graph, edges, g, i, forbidden, regrasp_ok):
             out.append((edges[g, e, 1, i], g, i + 1, e, "slide"))
         if i > 0 and edges[g, e, 0, i - 1] > -np.inf:
             out.append((edges[g, e, 0, i - 1], g, i - 1, e, "slide"))
-    if regrasp_ok[i]:
-        for h in range(G):
-            if h != g and graph.valid[h, i] and (g, h, i) not in forbidden:
-                out.append((np.inf, h, i, -1, "regrasp"))
+    for h in range(G):
+        if h != g and graph.valid[h, i] and (g, h, i) not in forbidden:
+            out.append((np.inf, h, i, -1, "regrasp"))
     return out
 
 
-def widest_route(graph: SearchGraph, start: tuple, goals, forbidden=frozenset(), regrasp_ok=None) -> Route | None:
+def widest_route(graph: SearchGraph, start: tuple, goals, forbidden=frozenset()) -> Route | None:
     """The widest route from ``start`` to any node of ``goals``, fewest regrasps, steps and segments among them.
 
     Parameters
@@ -142,8 +141,6 @@ def widest_route(graph: SearchGraph, start: tuple, goals, forbidden=frozenset(),
     goals : iterable of (int, int)
     forbidden : set of (int, int, int)
         Regrasps ``(from grasp, to grasp, i)`` not to use.
-    regrasp_ok : ndarray of bool, shape (n,), optional
-        Grid points where the workpiece may be released (default all).
 
     Returns
     -------
@@ -152,7 +149,6 @@ def widest_route(graph: SearchGraph, start: tuple, goals, forbidden=frozenset(),
     """
     G, n = graph.shape
     goals = {tuple(map(int, g)) for g in goals}
-    regrasp_ok = np.ones(n, bool) if regrasp_ok is None else np.asarray(regrasp_ok, bool)
     edges = slide_widths(graph)
     start = (int(start[0]), int(start[1]))
     if not graph.valid[start] or not goals:
@@ -168,7 +164,7 @@ def widest_route(graph: SearchGraph, start: tuple, goals, forbidden=frozenset(),
         if w < best[g, i]:
             continue
         expanded += 1
-        for ew, h, j, _, _ in _neighbours(graph, edges, g, i, forbidden, regrasp_ok):
+        for ew, h, j, _, _ in _neighbours(graph, edges, g, i, forbidden):
             nw = min(w, ew)
             if nw > best[h, j]:
                 best[h, j] = nw
@@ -193,7 +189,7 @@ def widest_route(graph: SearchGraph, start: tuple, goals, forbidden=frozenset(),
         if (g, i) in goals:
             done = node
             break
-        for ew, h, j, e, kind in _neighbours(graph, edges, g, i, forbidden, regrasp_ok):
+        for ew, h, j, e, kind in _neighbours(graph, edges, g, i, forbidden):
             if ew < width:
                 continue
             if kind == "regrasp":

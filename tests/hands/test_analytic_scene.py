@@ -15,20 +15,8 @@ from qsplan.hands.two_finger_scene import hand_scene
 from qsplan.mechanics import SceneError
 from qsplan.planner.planning.task import load_task, task_paths
 
-FIELDS = ("Wn", "Wt", "Jn", "Jt", "mu", "g_obj", "g_man", "joint_velocity", "joint_effort")
-RTOL = 1e-12  # round-off: the two paths compute the same products in a different order at most
+from tests.hands.scenes import assert_same_scene
 
-
-def _assert_same_scene(a, g):
-    assert a.contact_names == g.contact_names and a.joint_names == g.joint_names
-    assert a.virtual_joints == g.virtual_joints
-    np.testing.assert_array_equal(a.effort_controlled, g.effort_controlled)
-    for f in FIELDS:
-        A, G = getattr(a, f), getattr(g, f)
-        assert A.shape == G.shape, f
-        np.testing.assert_array_equal(np.isnan(A), np.isnan(G), err_msg=f)
-        scale = max(float(np.nanmax(np.abs(G), initial=0.0)), 1e-300)
-        np.testing.assert_allclose(A, G, rtol=RTOL, atol=RTOL * scale, err_msg=f)
 
 
 def _compare(hand, pose, q, effort_joint="right", velocity=0.1, effort=0.0, mu=None) -> bool:
@@ -41,7 +29,7 @@ def _compare(hand, pose, q, effort_joint="right", velocity=0.1, effort=0.0, mu=N
             hand_scene(hand, pose, q, **kw)
         assert grasp_contacts(hand, pose, q) is None
         return False
-    _assert_same_scene(hand_scene(hand, pose, q, **kw), g)
+    assert_same_scene(hand_scene(hand, pose, q, **kw), g)
     return grasp_contacts(hand, pose, q) is not None
 
 

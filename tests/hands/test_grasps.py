@@ -18,8 +18,8 @@ from qsplan.hands.two_finger_scene import hand_scene
 from qsplan.mechanics import SceneError
 from qsplan.planner.planning.collision import find_collisions
 
-FIELDS = ("Wn", "Wt", "Jn", "Jt", "mu", "g_obj", "g_man", "joint_velocity", "joint_effort")
-RTOL = 1e-12  # round-off: the two paths compute the same products in a different order at most
+from tests.hands.scenes import assert_same_scene
+
 
 #: A house: its two roof edges (2 and 3) are the top edges a fingertip reaches from each side.
 HOUSE = ((0.0, 0.0), (0.06, 0.0), (0.06, 0.03), (0.03, 0.065), (0.0, 0.03))
@@ -56,18 +56,6 @@ HANDS = _hands()
 
 def _tip_grasps(hand):
     return [g for g in candidate_grasps(hand) if isinstance(g.left, TipOnEdge) or isinstance(g.right, TipOnEdge)]
-
-
-def _assert_same_scene(a, g):
-    """As tests/hands/test_analytic_scene.py compares an analytic scene with the generic one."""
-    assert a.contact_names == g.contact_names and a.joint_names == g.joint_names
-    np.testing.assert_array_equal(a.effort_controlled, g.effort_controlled)
-    for f in FIELDS:
-        A, G = getattr(a, f), getattr(g, f)
-        assert A.shape == G.shape, f
-        np.testing.assert_array_equal(np.isnan(A), np.isnan(G), err_msg=f)
-        scale = max(float(np.nanmax(np.abs(G), initial=0.0)), 1e-300)
-        np.testing.assert_allclose(A, G, rtol=RTOL, atol=RTOL * scale, err_msg=f)
 
 
 # -- numbering as written -------------------------------------------------------------------------------------------
@@ -275,12 +263,12 @@ def test_tip_scenes_analytic_equal_generic():
             velocity = c.dq_dx[i, 1] * -0.02
             g_scene = hand_scene(hand, pose, q, "left", velocity=velocity, method="generic")
             auto = hand_scene(hand, pose, q, "left", velocity=velocity)
-            _assert_same_scene(auto, g_scene)
+            assert_same_scene(auto, g_scene)
             found = grasp_contacts(hand, pose, q)
             if found is not None:
                 used += 1
                 np.testing.assert_array_equal(found.features[2:], c.touched[i])
-                _assert_same_scene(scenes[i], g_scene)
+                assert_same_scene(scenes[i], g_scene)
             # off the grasp: the finger turned a little into or away from the edge
             dq = np.zeros(2)
             dq[int(rng.integers(2))] = rng.choice([-1.0, 1.0]) * rng.choice([1e-9, 1e-6, 1e-4])
@@ -290,7 +278,7 @@ def test_tip_scenes_analytic_equal_generic():
                 with pytest.raises(SceneError):
                     hand_scene(hand, pose, q + dq)
                 continue
-            _assert_same_scene(hand_scene(hand, pose, q + dq), off)
+            assert_same_scene(hand_scene(hand, pose, q + dq), off)
     assert used >= 300
 
 

@@ -183,6 +183,7 @@ def test_random_goal_tasks_plan_or_say_why(seed):
     from dataclasses import replace
 
     from qsplan.hands.grasp_geometry import candidate_grasps, grasp_configurations
+    from qsplan.hands.grasps import OnVertex
     from qsplan.planner.planning.plan import plan_task
     from qsplan.planner.planning.results import PlanFailure
 
@@ -199,7 +200,7 @@ def test_random_goal_tasks_plan_or_say_why(seed):
             continue
         for g in candidate_grasps(task.hand):
             if grasp_configurations(task.hand, g, np.array([x0])).ok[0]:
-                side = [("inner", None) if type(p).__name__ == "OnVertex" else ("edge", p.edge) for p in (g.left, g.right)]
+                side = [("inner", None) if isinstance(p, OnVertex) else ("edge", p.edge) for p in (g.left, g.right)]
                 task = replace(task, start_features=tuple(side))
                 break
         try:
