@@ -8,7 +8,9 @@ sampling planners with the minimax objective (``RRTstar``, ``BITstar``; iteratio
 The table: time, states evaluated (table look-ups or nodes expanded), the route's narrowest band (N m),
 its regrasps; and the same on seeded synthetic tables of six grasps (what a hand with a choice of contacts
 gives).  Then each task planned end to end by :func:`qsplan.planner.plan_task` (tables, search, dense
-sweeps, OMPL regrasps; wall time).  ``qsplan demo``'s whole-command time is in ``bench_plan.py``.
+sweeps, OMPL regrasps; wall time), the described hands' (issue 15: the two-link hand, the parallel-jaw
+gripper) on their contact manifolds: time, states evaluated (the planner's validity checks and dense
+samples), phases and the narrowest guaranteed band.  ``qsplan demo``'s whole-command time is in ``bench_plan.py``.
 
 Run: ``python3 benchmarks/bench_autoplan.py [--iterations N]``.
 """
@@ -72,9 +74,10 @@ def main(argv=None):
     args = ap.parse_args(argv)
     tasks = {stem: load_task(p) for stem, p in task_paths().items()}
     tasks = {k: t for k, t in tasks.items() if t.goal is not None}
+    paper = {k: t for k, t in tasks.items() if hasattr(t.hand, "finger_length")}  # the band tables: the paper's hand
     print(f"{'task':<22} {'planner':<9} {'search s':>9} {'evaluated':>10} {'narrowest N m':>14} {'regrasps':>9}")
     planned = {}
-    for stem, task in tasks.items():
+    for stem, task in paper.items():
         tables, t_tables, rows = search_rows(task, args.iterations)
         print(f"{stem:<22} {'tables':<9} {t_tables:9.3f} {tables.states + tables.band_states:10d} {'':>14} {'':>9}")
         for name, secs, evals, width, regrasps in rows:
@@ -87,16 +90,19 @@ def main(argv=None):
         print(f"{label:<22} {name:<9} {secs:9.3f} {evals:10d} {w:>14} {'-' if regrasps is None else regrasps:>9}")
         label = ""
     print()
-    print(f"{'task':<22} {'plan s':>8} {'segments':>9} {'regrasps':>9} {'narrowest N m':>14}")
+    print(f"{'task':<30} {'hand':<22} {'plan s':>7} {'states':>7} {'segments':>9} {'regrasps':>9} {'narrowest':>12}")
     for stem, task in tasks.items():
+        hand = getattr(getattr(task.hand, "description", None), "name", "paper's hand")
         t0 = time.perf_counter()
         try:
-            plan = plan_automatic(task) if task.goal is not None else plan_task(task)
+            plan = plan_task(task)
             w = plan.narrowest()[2]
-            print(f"{stem:<22} {time.perf_counter() - t0:8.2f} {len(plan.segments):9d} "
-                  f"{len(plan.phases) - len(plan.segments):9d} {w:14.4g}")  # fmt: skip
+            unit = "N" if all(k == "prismatic" for k in getattr(getattr(task.hand, "description", None),
+                                                                  "joint_kinds", ("revolute",))) else "N m"
+            print(f"{stem:<30} {hand:<22} {time.perf_counter() - t0:7.2f} {plan.validity_checks:7d} "
+                  f"{len(plan.segments):9d} {len(plan.phases) - len(plan.segments):9d} {w:8.4g} {unit}")  # fmt: skip
         except Exception as exc:  # an infeasible task: its report
-            print(f"{stem:<22} {time.perf_counter() - t0:8.2f} no plan: {str(exc)[:90]}")
+            print(f"{stem:<30} {hand:<22} {time.perf_counter() - t0:7.2f} no plan: {str(exc)[:80]}")
 
 
 if __name__ == "__main__":

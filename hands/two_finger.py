@@ -26,6 +26,7 @@ import numpy as np
 
 from qsplan.mechanics.errors import SceneError
 from qsplan.mechanics.model.friction import check_friction
+from qsplan.hands.workpiece import prepare_workpiece, workpiece_world
 
 __all__ = [
     "CONTACT_ROLES",
@@ -47,12 +48,6 @@ JOINT_NAMES = ("left", "right")
 #: What each of the four contacts is, in the order the scene lists them.
 CONTACT_ROLES = ("palm, left end of the bottom edge", "palm, right end of the bottom edge",
                  "left finger's inner edge on a workpiece vertex", "right finger's inner edge on a workpiece vertex")  # fmt: skip
-
-#: Relative tolerance (of the workpiece's size) within which the two lowest
-#: vertices count as one horizontal bottom edge; polygon coordinates are
-#: decimal inputs, so 1e-9 of the size is rounding, not a tilt.
-_FLAT_TOL = 1e-9
-
 
 @dataclass(frozen=True, slots=True, eq=False)
 class TwoFingerHand:
@@ -171,35 +166,9 @@ def make_two_finger_hand(
         Naming the field: non-convex or degenerate workpiece, no level bottom edge, non-positive
         sizes, a ``palm_edge`` out of range or that the workpiece cannot rest on.
     """
-    from shapely.geometry import Polygon
-
-    from qsplan.mechanics.model.geometry import check_polygon
-
-    V = check_polygon(workpiece, "workpiece")
-    poly = Polygon(V)
-    if abs(poly.convex_hull.area - poly.area) > 1e-12 * poly.area or len(np.asarray(poly.convex_hull.exterior.coords)) - 1 != len(V):
-        raise SceneError("workpiece: expected a convex polygon with no straight vertices (the fingers touch its corners)")
-    raw = np.asarray(workpiece, dtype=float).reshape(-1, 2)  # the validated vertex of each row (repeats are dropped):
-    of_user = np.argmin(np.linalg.norm(raw[:, None] - V[None], axis=2), axis=1)
-    perm = np.arange(len(V))
-    if not poly.exterior.is_ccw:
-        V, perm = V[::-1], perm[::-1]
-    if palm_edge is not None:
-        V, poly = _lay_on_edge(V, perm, of_user, palm_edge)
-    size = float(np.ptp(V, axis=0).max())
-    order = np.argsort(V[:, 1], kind="stable")
-    low = V[order[:2]]
-    if abs(low[0, 1] - low[1, 1]) > _FLAT_TOL * size or abs(V[order[2], 1] - low[0, 1]) <= _FLAT_TOL * size:
-        raise SceneError("workpiece: expected exactly two lowest vertices at the same height (the edge resting on the palm)")
-    start = int(order[0] if V[order[0], 0] < V[order[1], 0] else order[1])
-    V, perm = np.roll(V, -start, axis=0), np.roll(perm, -start)
-    if V[1, 0] <= V[0, 0] or abs(V[1, 1] - V[0, 1]) > _FLAT_TOL * size:
-        raise SceneError("workpiece: the bottom edge must run left to right from vertex 0 (counter-clockwise order)")
-    c = np.asarray(poly.centroid.coords[0])
-    V = V - c
-    V.setflags(write=False)
+    prepared = prepare_workpiece(workpiece, palm_edge)
     hand = TwoFingerHand(
-        workpiece=V,
+        workpiece=prepared.vertices,
         workpiece_mass=_positive(workpiece_mass, "workpiece_mass", "kg"),
         finger_base=_positive(finger_base, "finger_base", "m"),
         finger_length=_positive(finger_length, "finger_length", "m"),
@@ -209,36 +178,12 @@ def make_two_finger_hand(
         palm_thickness=_positive(palm_thickness, "palm_thickness", "m"),
         gravity=_positive(gravity, "gravity", "m/s^2", allow_zero=True),
         mu=float(check_friction(mu, "mu")),
-        vertex_order=tuple(int(np.flatnonzero(of_user == j)[0]) for j in perm),
-        vertex_of_user=tuple(int(i) for i in np.argsort(perm)[of_user]),
+        vertex_order=prepared.vertex_order,
+        vertex_of_user=prepared.vertex_of_user,
     )
     if hand.finger_width >= hand.finger_length:
         raise SceneError(f"finger_width: expected less than finger_length ({hand.finger_length} m); got {hand.finger_width}")
     return hand
-
-
-def _lay_on_edge(V, perm, of_user, palm_edge):
-    """``V`` (k, 2, counter-clockwise; ``perm`` its validated vertex order) turned so that the edge
-    ``palm_edge`` as written is level at the bottom, and its shapely Polygon."""
-    from shapely.geometry import Polygon
-
-    n_user = len(of_user)
-    if isinstance(palm_edge, (bool, np.bool_)) or not isinstance(palm_edge, (int, np.integer)) or not 0 <= palm_edge < n_user:
-        raise SceneError(f"palm_edge: expected an edge index in [0, {n_user}) of the workpiece as written; got {palm_edge!r}")
-    pos = np.argsort(perm)  # validated vertex -> position in V
-    a, b = pos[of_user[palm_edge]], pos[of_user[(palm_edge + 1) % n_user]]
-    if a == b:  # a row repeating its predecessor
-        raise SceneError(f"palm_edge: edge {palm_edge} of the workpiece as written has zero length")
-    a, b = (a, b) if (b - a) % len(V) == 1 else (b, a)  # counter-clockwise: the palm below the edge
-    d = V[b] - V[a]
-    V = V @ _rot(-np.arctan2(d[1], d[0])).T
-    level = 0.5 * (V[a, 1] + V[b, 1])  # the turn leaves ~1e-17 m of tilt: lay the edge exactly level
-    V[a, 1] = V[b, 1] = level
-    poly = Polygon(V)
-    if not V[a, 0] < poly.centroid.x < V[b, 0]:
-        raise SceneError(f"palm_edge: the workpiece cannot rest on edge {palm_edge}: its centroid (x = {poly.centroid.x:.6g} m "
-                         f"along the edge) is not over the edge [{V[a, 0]:.6g}, {V[b, 0]:.6g}] m")  # fmt: skip
-    return V, poly
 
 
 #: The workpiece of the default hand (m, before centring): an irregular quadrilateral 8 cm wide
@@ -256,17 +201,6 @@ def default_hand(**overrides) -> TwoFingerHand:
     """
     args = {"workpiece": DEFAULT_WORKPIECE, "finger_base": 0.09, "finger_length": 0.16, **overrides}
     return make_two_finger_hand(**args)
-
-
-def _rot(theta):
-    c, s = np.cos(theta), np.sin(theta)
-    return np.array([[c, -s], [s, c]])
-
-
-def workpiece_world(hand: TwoFingerHand, pose) -> np.ndarray:
-    """Workpiece vertices in the world (m), shape (k, 2), at ``pose = (x, y, theta)`` of its centre of mass."""
-    pose = np.asarray(pose, dtype=float)
-    return hand.workpiece @ _rot(pose[2]).T + pose[:2]
 
 
 def tangency_angles(hand: TwoFingerHand, V: np.ndarray):

@@ -30,7 +30,8 @@ from qsplan.mechanics.model.contact import wrench_matrices
 from qsplan.mechanics.model.geometry import CONTACT_TOL
 from qsplan.mechanics.model.scene import Scene
 
-__all__ = ["GraspContacts", "analytic_hand_scene", "finger_jacobians", "grasp_contacts", "gravity_efforts", "scene_from_contacts"]
+__all__ = ["GraspContacts", "analytic_constants", "analytic_hand_scene", "finger_jacobians", "grasp_contacts", "gravity_efforts",
+           "scene_from_arrays", "scene_from_contacts"]  # fmt: skip
 
 #: Margins (in contact tolerances) of the closed-form check: a feature the polygon search must
 #: find lies within NEAR tolerances, one it must not find beyond FAR; values between fall back
@@ -68,7 +69,7 @@ class GraspContacts:
 
 
 @lru_cache(maxsize=16)
-def _constants(hand: TwoFingerHand):
+def analytic_constants(hand: TwoFingerHand):
     """Per-hand constants (cached: hands are immutable): whether the analytic path applies, each finger's inner
     edge in its link frame (its two ends in the link ring's order, m) and the joint axes (m), as plain floats."""
     V = hand.workpiece
@@ -120,7 +121,7 @@ def grasp_contacts(hand: TwoFingerHand, pose, q, tol: float = CONTACT_TOL) -> Gr
         along one of them (an edge-edge contact) but the bottom edge on the palm.
     """
     # plain floats: a handful of numbers per state, where numpy's per-call overhead would dominate
-    corners_only, inner, pivots, shape = _constants(hand)
+    corners_only, inner, pivots, shape = analytic_constants(hand)
     if not corners_only:
         return None
     near, far = NEAR * tol, FAR * tol
@@ -340,11 +341,28 @@ def scene_from_contacts(hand: TwoFingerHand, pose, q, points, normals, effort_co
     Jn[2:], Jt[2:] = J[:, 0], J[:, 1]
     weight = -hand.workpiece_mass * hand.gravity
     g_obj = np.array([0.0, weight, pose[0] * weight - pose[1] * 0.0])  # qsplan.mechanics.model.contact.point_wrench
+    return scene_from_arrays(hand, Wn, Wt, Jn, Jt, g_obj, gravity_efforts(hand, q), effort_controlled, velocity, effort, mu)
+
+
+def scene_from_arrays(hand: TwoFingerHand, Wn, Wt, Jn, Jt, g_obj, g_man, effort_controlled, velocity=0.0, effort=0.0,
+                      mu=None) -> Scene:  # fmt: skip
+    """The hand's :class:`qsplan.mechanics.Scene` from its model arrays (:func:`scene_from_contacts` computes them; the
+    band tables stack them over states, :func:`qsplan.hands.batch_scenes.checked_scene_arrays`).
+
+    Parameters
+    ----------
+    Wn, Wt : ndarray, shape (3, 4)
+    Jn, Jt : ndarray, shape (4, 2)
+    g_obj : ndarray, shape (3,)
+    g_man : ndarray, shape (2,)
+    effort_controlled, velocity, effort, mu
+        As :func:`analytic_hand_scene` takes them (validated by the caller).
+    """
     e = np.array(effort_controlled, dtype=bool)
     return Scene(
         Wn=_frozen(Wn), Wt=_frozen(Wt), Jn=_frozen(Jn), Jt=_frozen(Jt),
         mu=_frozen(np.full(4, hand.mu if mu is None else float(mu))), g_obj=_frozen(g_obj),
-        g_man=_frozen(gravity_efforts(hand, q)), effort_controlled=_frozen(e),
+        g_man=_frozen(g_man), effort_controlled=_frozen(e),
         joint_velocity=_frozen(np.where(e, np.nan, float(velocity))),
         joint_effort=_frozen(np.where(e, float(effort), np.nan)),
         joint_names=JOINT_NAMES, contact_names=_CONTACT_NAMES,

@@ -126,6 +126,7 @@ _LAZY = {
     "plot_speed_accuracy": "qsplan.planner.plotting.bands",
     "auto_display_limit": "qsplan.planner.plotting.bands",
     "plot_hand": "qsplan.planner.plotting.hands",
+    "plot_hand_description": "qsplan.planner.plotting.hand_files",
     "hand_strip_figure": "qsplan.planner.plotting.hands",
     "plot_mu_map": "qsplan.planner.plotting.muspace",
     "mu_slices_figure": "qsplan.planner.plotting.muspace",

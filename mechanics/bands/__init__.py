@@ -4,5 +4,7 @@
 * :mod:`.guaranteed` - over uncertain friction: guaranteed (box vertices, shared-mu roots), possible, sampled
 * :mod:`.preclusion` - competing modes precluded over uncertain friction (Figs. 12-13)
 * :mod:`.robust` - the guaranteed band of one scene with every competitor precluded (Fig. 13)
-* :mod:`.batched`, :mod:`.batched_robust` - the same for a batch of states at once (bit-identical, fast)
+* :mod:`.batched`, :mod:`.batched_modes`, :mod:`.batched_preclusion`, :mod:`.batched_robust` - the same for a
+  batch of states (and many modes) at once, bit-identical and fast; :func:`.batched_robust.robust_band_arrays`
+  gives the numbers alone (the band tables)
 """

@@ -7,7 +7,7 @@ kinematic stage (eqs. 23-25, 16), the equilibrium matrices ``Q_AI`` at many fric
 stacked arrays, instead of a few hundred per state.  Results are bit-identical to the
 per-state reference (:mod:`qsplan.mechanics.bands.effort`, :mod:`.guaranteed`): the same
 floating-point operations on the same numbers, the same LAPACK calls per matrix (one ``det``
-and one ``solve``), and the rows assembled by the same function
+and one ``solve`` per distinct ``Q_AI``), and the rows assembled by the same function
 (:func:`qsplan.mechanics.bands.effort.coulomb_rows`); ``tests/mechanics/test_bands_batched.py``
 compares them on hundreds of states.
 
@@ -15,28 +15,35 @@ Nothing of eqs. (23)-(26) is restated here: a :class:`StateBatch` holds the rows
 :class:`qsplan.mechanics.modes.kinematics.ScenePool` with a leading state axis, and the
 kinematic stage (:func:`qsplan.mechanics.modes.kinematics.kinematic_tests`) and ``Q_AI``
 (:func:`qsplan.mechanics.modes.equilibrium.equilibrium_columns`) are the solver's own
-functions, which serve modes of one scene and states of a batch alike.
+functions, which serve modes of one scene and states of a batch alike
+(:mod:`qsplan.mechanics.bands.batched_modes` calls them on many modes at once).  A batch is
+built from scenes (:func:`state_batch`) or from their stacked arrays
+(:func:`batch_from_arrays`: the band tables, whose scenes are built only where a per-state
+search needs one, :class:`LazyScenes`).
 """
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
 
-from qsplan.mechanics.bands.effort import Band, check_force_margin, check_one_effort_joint, coulomb_rows, intersect_rows, row_margins
+from qsplan.mechanics.bands.batched_modes import BatchKinematics, batch_kinematics, batch_rows_many
+from qsplan.mechanics.bands.effort import Band, check_force_margin, check_one_effort_joint, intersect_rows
 from qsplan.mechanics.bands.guaranteed import shared_band_from_rows, shared_nodes
 from qsplan.mechanics.errors import SceneError
 from qsplan.mechanics.model.friction import check_mu_range
-from qsplan.mechanics.modes.contact_mode import ContactMode, letters_to_codes
-from qsplan.mechanics.modes.equilibrium import equilibrium_columns
-from qsplan.mechanics.modes.kinematics import applicable_rows, check_mode_fits, kinematic_tests, kinematics_rows, sliding_directions
-from qsplan.mechanics.numerics import DEFAULT_TOLERANCES, Status, StatusCode, Tolerances
+from qsplan.mechanics.modes.contact_mode import ContactMode
+from qsplan.mechanics.modes.kinematics import kinematics_rows
+from qsplan.mechanics.numerics import DEFAULT_TOLERANCES, Tolerances
 
 __all__ = [
     "StateBatch",
     "BatchKinematics",
+    "LazyScenes",
     "state_batch",
+    "batch_from_arrays",
     "take_states",
     "batch_signature",
     "map_batches",
@@ -44,6 +51,9 @@ __all__ = [
     "batch_kinematics",
     "batch_rows",
     "point_bands_batch",
+    "BOX_REASONS",
+    "box_band_arrays",
+    "box_bands",
     "guaranteed_bands_box",
     "guaranteed_bands_shared",
 ]
@@ -74,7 +84,8 @@ class StateBatch:
 
     Attributes
     ----------
-    scenes : tuple of Scene
+    scenes : sequence of Scene
+        A tuple, or a :class:`LazyScenes` (built from arrays).
     joint : int
         The effort-controlled joint.
     E, V : ndarray of int
@@ -118,6 +129,36 @@ class StateBatch:
         return self.Wrows.shape[1] // 2
 
 
+class LazyScenes(Sequence):
+    """The scenes of a batch built from arrays, each made on first use (:func:`batch_from_arrays`).
+
+    ``build(s)`` returns the :class:`qsplan.mechanics.Scene` of state ``s``; only the per-state searches the
+    batched root cell leaves open need one, so most are never built.
+    """
+
+    def __init__(self, size: int, build, rows=None):
+        self._build = build
+        self._rows = np.arange(size) if rows is None else np.asarray(rows)
+        self._made = {}
+
+    def __len__(self) -> int:
+        return self._rows.size
+
+    def __getitem__(self, s):
+        if isinstance(s, slice):
+            return self.take(np.arange(len(self))[s])
+        s = int(self._rows[s])
+        if s not in self._made:
+            self._made[s] = self._build(s)
+        return self._made[s]
+
+    def take(self, rows) -> "LazyScenes":
+        """The scenes ``rows`` (array of int), still built on first use."""
+        out = LazyScenes(0, self._build, self._rows[np.asarray(rows, dtype=int)])
+        out._made = self._made
+        return out
+
+
 def state_batch(scenes, tol: Tolerances = DEFAULT_TOLERANCES) -> StateBatch:
     """Stack ``scenes`` (a non-empty sequence of one :func:`batch_signature`, one effort-controlled joint)."""
     scenes = tuple(scenes)
@@ -128,17 +169,34 @@ def state_batch(scenes, tol: Tolerances = DEFAULT_TOLERANCES) -> StateBatch:
         if batch_signature(s) != sig:
             raise SceneError(f"states: scene {k} has {s.n_contacts} contacts and effort-controlled joints "
                              f"{s.effort_joints.tolist()}; expected those of scene 0")  # fmt: skip
+    stack = lambda name: np.stack([getattr(s, name) for s in scenes])  # noqa: E731
+    return batch_from_arrays(scenes, stack("Wn"), stack("Wt"), stack("Jn"), stack("Jt"), stack("g_obj"), stack("g_man"),
+                             stack("joint_velocity"), tol)  # fmt: skip
+
+
+def batch_from_arrays(scenes, Wn, Wt, Jn, Jt, g_obj, g_man, joint_velocity, tol: Tolerances = DEFAULT_TOLERANCES) -> StateBatch:
+    """A :class:`StateBatch` from the stacked arrays of its scenes (what :func:`state_batch` stacks).
+
+    Parameters
+    ----------
+    scenes : sequence of Scene
+        The states' scenes (a :class:`LazyScenes` builds them on use), one :func:`batch_signature`; the
+        first one gives the control partition (exactly one effort-controlled joint).
+    Wn, Wt : ndarray, shape (S, 3, n_c)
+    Jn, Jt : ndarray, shape (S, n_c, n_j)
+    g_obj : ndarray, shape (S, 3)
+    g_man, joint_velocity : ndarray, shape (S, n_j)
+        The scenes' attributes stacked (:class:`qsplan.mechanics.Scene`), equal to ``scenes``' own.
+    """
     joint = check_one_effort_joint(scenes[0])
     E, V = scenes[0].effort_joints, scenes[0].velocity_joints
-    stack = lambda name: np.stack([getattr(s, name) for s in scenes])  # noqa: E731
-    Wrows = np.concatenate([stack("Wn"), stack("Wt")], axis=2).transpose(0, 2, 1)
-    Jrows = np.concatenate([stack("Jn"), stack("Jt")], axis=1)
-    velocity = stack("joint_velocity")
-    M, log_row_norm, drive = kinematics_rows(Wrows, Jrows, velocity, E, V)
+    Wrows = np.concatenate([Wn, Wt], axis=2).transpose(0, 2, 1)
+    Jrows = np.concatenate([Jn, Jt], axis=1)
+    M, log_row_norm, drive = kinematics_rows(Wrows, Jrows, joint_velocity, E, V)
     speed = np.max(np.abs(drive), axis=1) if drive.shape[1] else np.zeros(len(scenes))
     vtol = tol.velocity * np.where(speed > 0, speed, 1.0)
-    r0 = np.concatenate([-stack("g_obj"), -stack("g_man")[:, E]], axis=1)
-    return StateBatch(scenes, joint, E, V, Wrows, Jrows, M, log_row_norm, drive, vtol, r0, velocity)
+    r0 = np.concatenate([-g_obj, -g_man[:, E]], axis=1)
+    return StateBatch(scenes, joint, E, V, Wrows, Jrows, M, log_row_norm, drive, vtol, r0, joint_velocity)
 
 
 def take_states(batch: StateBatch, rows) -> StateBatch:
@@ -146,51 +204,9 @@ def take_states(batch: StateBatch, rows) -> StateBatch:
     rows = np.asarray(rows)
     if rows.size == batch.size and np.array_equal(rows, np.arange(batch.size)):
         return batch
-    return StateBatch(tuple(batch.scenes[s] for s in rows), batch.joint, batch.E, batch.V, batch.Wrows[rows], batch.Jrows[rows],
-                      batch.M[rows], batch.log_row_norm[rows], batch.drive[rows], batch.vtol[rows], batch.r0[rows],
-                      batch.velocity[rows])  # fmt: skip
-
-
-@dataclass(frozen=True, slots=True, eq=False)
-class BatchKinematics:
-    """One mode's kinematic stage (eqs. 24-25, 16) at every state of a batch.
-
-    Attributes
-    ----------
-    mode : ContactMode
-    idx, contact : ndarray of int, shape (k,)
-        Applicable rows and their contacts (the same at every state).
-    slide : ndarray of bool, shape (k,)
-    status : ndarray of int8, shape (S,)
-        ``Status.ORDER`` codes; 0 where the mode passed.
-    xi : ndarray, shape (S, n_c)
-        Sliding directions (eq. 16), 0 at rolling and breaking contacts.
-    """
-
-    mode: ContactMode
-    idx: np.ndarray
-    contact: np.ndarray
-    slide: np.ndarray
-    status: np.ndarray
-    xi: np.ndarray
-
-    @property
-    def ok(self) -> np.ndarray:
-        """(S,) of bool: the mode passed the kinematic stage."""
-        return self.status == StatusCode.FEASIBLE
-
-    def status_name(self, s: int) -> str:
-        return Status.ORDER[int(self.status[s])]
-
-
-def batch_kinematics(batch: StateBatch, mode, tol: Tolerances = DEFAULT_TOLERANCES) -> BatchKinematics:
-    """:func:`qsplan.mechanics.modes.kinematics.kinematics_stage` of one mode at every state."""
-    mode = check_mode_fits(batch.scenes[0], mode)
-    codes = letters_to_codes(mode.letters)
-    idx, contact, slide = (a[0] for a in applicable_rows(batch.scenes[0], codes[None, :]))
-    status, _, _, v_t = kinematic_tests(batch, idx, codes, tol, batch.vtol[:, None])
-    xi = sliding_directions(codes, v_t, status == StatusCode.FEASIBLE)
-    return BatchKinematics(mode, idx, contact, slide, status, xi)
+    scenes = batch.scenes.take(rows) if isinstance(batch.scenes, LazyScenes) else tuple(batch.scenes[s] for s in rows)
+    return StateBatch(scenes, batch.joint, batch.E, batch.V, batch.Wrows[rows], batch.Jrows[rows], batch.M[rows],
+                      batch.log_row_norm[rows], batch.drive[rows], batch.vtol[rows], batch.r0[rows], batch.velocity[rows])  # fmt: skip
 
 
 def batch_rows(batch: StateBatch, bk: BatchKinematics, mu_rows, force_margin=None):
@@ -208,29 +224,7 @@ def batch_rows(batch: StateBatch, bk: BatchKinematics, mu_rows, force_margin=Non
         NaN where ``Q_AI`` is singular; meaningless at states where ``bk.ok`` is False.
     det, scale : ndarray, shape (S, N)
     """
-    S = batch.size
-    mu = np.asarray(mu_rows, dtype=float)
-    mu = np.broadcast_to(mu, (S,) + mu.shape[-2:]) if mu.ndim == 2 else mu
-    N = mu.shape[1]
-    # Q_AI of eq. (26), (S, N, k, k): the solver's function with the rows of each state
-    Q = equilibrium_columns(batch.Wrows[:, None], batch.Jrows[:, None], batch.E, bk.idx, bk.contact, bk.slide,
-                            mu, bk.xi[:, None, :])  # fmt: skip
-    det = np.linalg.det(Q)
-    k = Q.shape[-1]
-    e = np.zeros(k)
-    e[3] = 1.0
-    bad = ~np.isfinite(det) | (det == 0)
-    Qs = Q.copy()
-    Qs[bad] = np.eye(k)
-    rhs = np.broadcast_to(np.stack([batch.r0, np.broadcast_to(e, batch.r0.shape)], axis=2)[:, None], (S, N, k, 2))
-    sol = np.linalg.solve(Qs, rhs)
-    s0, s1 = coulomb_rows(bk.mode, bk.idx, bk.contact, mu, sol)
-    scale = np.maximum(np.max(np.abs(sol[..., 0]), axis=2), np.max(np.abs(batch.r0), axis=1)[:, None])
-    if force_margin is not None:
-        s0 = s0 - row_margins(bk.mode, force_margin)
-    s0[bad] = np.nan
-    s1[bad] = np.nan
-    return s0, s1, det, scale
+    return batch_rows_many([(batch, bk, mu_rows)], force_margin)[0]
 
 
 def _intersect(s0, s1, scale, tol):
@@ -254,10 +248,10 @@ def effort_bands_batch(batch: StateBatch, mode, mu_rows, tol: Tolerances = DEFAU
 
 
 def point_bands_batch(batch: StateBatch, mode, mu, tol: Tolerances = DEFAULT_TOLERANCES, *, force_margin=None,
-                      method: str = "point") -> list:  # fmt: skip
+                      method: str = "point", bk: BatchKinematics | None = None) -> list:  # fmt: skip
     """:func:`qsplan.mechanics.bands.effort.effort_band` at every state, friction ``mu`` (n_c,) or (S, n_c)."""
     force_margin = None if force_margin is None else check_force_margin(force_margin)
-    bk = batch_kinematics(batch, mode, tol)
+    bk = batch_kinematics(batch, mode, tol) if bk is None else bk
     mu = np.broadcast_to(np.asarray(mu, dtype=float), (batch.size, batch.n_c))
     s0, s1, _, scale = batch_rows(batch, bk, mu[:, None, :], force_margin)
     lower, upper, ok = _intersect(s0, s1, scale, tol)
@@ -285,34 +279,46 @@ def box_vertices(mode: ContactMode, lo, hi) -> np.ndarray:
     return verts
 
 
-def guaranteed_bands_box(batch: StateBatch, mode, lo, hi, tol: Tolerances = DEFAULT_TOLERANCES, *,
-                         force_margin=None) -> list:  # fmt: skip
-    """:func:`qsplan.mechanics.bands.guaranteed.guaranteed_band_box` at every state (vertex method, exact)."""
-    force_margin = None if force_margin is None else check_force_margin(force_margin)
-    lo, hi = check_mu_range(lo, hi, n=batch.n_c)
-    bk = batch_kinematics(batch, mode, tol)
+#: Why :func:`box_band_arrays` found no band, by its code (0: a band): the reasons of
+#: :func:`qsplan.mechanics.bands.guaranteed.guaranteed_band_box` (code 1, the kinematics, names its status).
+BOX_REASONS = (None, "kinematics", "equilibrium_singular: det Q_AI changes sign inside the mu box (the mode is degenerate there)",
+               "coulomb: no effort works at some vertex of the mu box", "coulomb: vertex bands do not overlap")  # fmt: skip
+
+
+def box_band_arrays(batch: StateBatch, bk: BatchKinematics, lo, hi, tol: Tolerances = DEFAULT_TOLERANCES, force_margin=None):
+    """:func:`guaranteed_bands_box`'s numbers: ``lower, upper`` (S,) (meaningful where ``why`` is 0) and ``why`` (S,)
+    of int, the index of the reason in :data:`BOX_REASONS` (``lo, hi`` checked, ``force_margin`` a ForceMargin)."""
     s0, s1, det, scale = batch_rows(batch, bk, box_vertices(bk.mode, lo, hi), force_margin)
     steady = np.all(det > 0, axis=1) | np.all(det < 0, axis=1)
     lower, upper, ok = _intersect(s0, s1, scale, tol)
     lo_, up_ = lower.max(axis=1), upper.min(axis=1)
-    letters, joint, out, m, kin_ok = bk.mode.letters, batch.joint, [], "box-vertices", bk.ok
-    for s in range(batch.size):
-        if not kin_ok[s]:
-            out.append(Band(letters, joint, np.nan, np.nan, False, f"kinematics: {bk.status_name(s)}", m))
-        elif not steady[s]:
-            out.append(Band(letters, joint, np.nan, np.nan, False,
-                            "equilibrium_singular: det Q_AI changes sign inside the mu box (the mode is degenerate there)", m))  # fmt: skip
-        elif not ok[s].all():
-            out.append(Band(letters, joint, np.nan, np.nan, False, "coulomb: no effort works at some vertex of the mu box", m))
-        elif lo_[s] > up_[s]:
-            out.append(Band(letters, joint, np.nan, np.nan, False, "coulomb: vertex bands do not overlap", m))
+    why = np.select([~bk.ok, ~steady, ~ok.all(axis=1), lo_ > up_], [1, 2, 3, 4], 0)
+    return lo_, up_, why
+
+
+def box_bands(bk: BatchKinematics, joint: int, lower, upper, why) -> list:
+    """The :class:`qsplan.mechanics.bands.effort.Band` of every state from :func:`box_band_arrays`."""
+    letters, m, out = bk.mode.letters, "box-vertices", []
+    for s, w in enumerate(why.tolist()):
+        if w == 0:
+            out.append(Band(letters, joint, float(lower[s]), float(upper[s]), True, None, m))
         else:
-            out.append(Band(letters, joint, float(lo_[s]), float(up_[s]), True, None, m))
+            out.append(Band(letters, joint, np.nan, np.nan, False, f"kinematics: {bk.status_name(s)}" if w == 1 else BOX_REASONS[w], m))
     return out
 
 
+def guaranteed_bands_box(batch: StateBatch, mode, lo, hi, tol: Tolerances = DEFAULT_TOLERANCES, *,
+                         force_margin=None, bk: BatchKinematics | None = None) -> list:  # fmt: skip
+    """:func:`qsplan.mechanics.bands.guaranteed.guaranteed_band_box` at every state (vertex method, exact).
+    ``bk``: ``mode``'s kinematic stage on ``batch`` if already computed."""
+    force_margin = None if force_margin is None else check_force_margin(force_margin)
+    lo, hi = check_mu_range(lo, hi, n=batch.n_c)
+    bk = batch_kinematics(batch, mode, tol) if bk is None else bk
+    return box_bands(bk, batch.joint, *box_band_arrays(batch, bk, lo, hi, tol, force_margin))
+
+
 def guaranteed_bands_shared(batch: StateBatch, mode, lo: float, hi: float, tol: Tolerances = DEFAULT_TOLERANCES, *,
-                            force_margin=None) -> list:  # fmt: skip
+                            force_margin=None, bk: BatchKinematics | None = None) -> list:  # fmt: skip
     """:func:`qsplan.mechanics.bands.guaranteed.guaranteed_band_shared` at every state (polynomial roots, exact).
 
     The rows at the Chebyshev nodes are batched; the roots of each state's polynomials are found
@@ -321,8 +327,8 @@ def guaranteed_bands_shared(batch: StateBatch, mode, lo: float, hi: float, tol: 
     force_margin = None if force_margin is None else check_force_margin(force_margin)
     lo, hi = check_mu_range(lo, hi)
     if hi == lo:
-        return point_bands_batch(batch, mode, np.full(batch.n_c, lo), tol, force_margin=force_margin, method="shared-roots")
-    bk = batch_kinematics(batch, mode, tol)
+        return point_bands_batch(batch, mode, np.full(batch.n_c, lo), tol, force_margin=force_margin, method="shared-roots", bk=bk)
+    bk = batch_kinematics(batch, mode, tol) if bk is None else bk
     nodes = shared_nodes(bk.mode, lo, hi)
     s0, s1, det, scale = batch_rows(batch, bk, np.repeat(nodes[:, None], batch.n_c, axis=1), force_margin)
     letters, joint, out, kin_ok = bk.mode.letters, batch.joint, [], bk.ok

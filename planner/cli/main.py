@@ -10,6 +10,7 @@ Subcommands, one module each in :mod:`qsplan.planner.cli` (``add_parser(subparse
     qsplan partition SCENE [--mode LETTERS] [--json]  control-mode partitioner (eq. 32)
     qsplan paper [--out DIR]                        reproduce the paper's examples into DIR
     qsplan muspace | band | simulate | sweep | plan | demo | verify   (see each module)
+    qsplan hands [REF] [--out DIR [--force]]        list the bundled hand files, or check and show one
     qsplan --version                                the version (qsplan.__version__)
 
 Bad input prints one line on stderr naming the field and the problem and
@@ -26,7 +27,8 @@ from __future__ import annotations
 import argparse
 import sys
 
-from qsplan.planner.cli import band, count, demo, modes, muspace, paper, partition, plan, simulate, sweep, verify
+from qsplan.planner.cli import (band, count, demo, hands, modes, muspace, paper, partition, plan, simulate, sweep,
+                                verify)  # fmt: skip
 from qsplan.planner.cli.options import (
     EXIT_INTERRUPTED,
     EXIT_USAGE,
@@ -43,7 +45,8 @@ __all__ = ["COMMANDS", "EXIT_USAGE", "main", "build_parser", "add_parallel_optio
 
 #: The subcommands, in the order of ``qsplan --help``.
 COMMANDS = {"modes": modes, "count": count, "partition": partition, "paper": paper, "muspace": muspace,
-            "band": band, "simulate": simulate, "sweep": sweep, "plan": plan, "demo": demo, "verify": verify}  # fmt: skip
+            "band": band, "simulate": simulate, "sweep": sweep, "plan": plan, "demo": demo, "verify": verify,
+            "hands": hands}  # fmt: skip
 
 
 class _VersionShown(Exception):

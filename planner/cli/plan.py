@@ -2,10 +2,11 @@
 
 ::
 
-    qsplan plan TASK.toml [--out DIR] [--seed S] [--planner NAME] [--sequence-planner NAME] [--time-limit SECONDS]
+    qsplan plan TASK.toml|BUNDLED_TASK [--out DIR] [--seed S] [--planner NAME] [--sequence-planner NAME] [--time-limit SECONDS]
                           [--force] [--quiet] [--no-plots] [--verify N]
 
-Reads the task (:mod:`qsplan.planner.planning.task`) and runs the pipeline
+Reads the task (:mod:`qsplan.planner.planning.task`; a bundled task by its name, e.g. ``two_link_task``)
+and runs the pipeline
 (:func:`qsplan.planner.planning.pipeline.run_plan`): plans it (a task with a ``[goal]``
 automatically: band tables of every grasp and the widest route through them, searched in OMPL,
 :mod:`qsplan.planner.sequence`; a task with ``waypoints`` as scripted; in-contact segments
@@ -36,7 +37,8 @@ FLAGS = {"verify": "--verify", "time_limit": "--time-limit"}
 
 def add_parser(subparsers):
     p = subparsers.add_parser("plan", help="plan a two-finger task (TOML) through OMPL with guaranteed torque bands")
-    p.add_argument("task", help="task file (.toml; see qsplan.planner.planning.task)")
+    p.add_argument("task", help="task file (.toml; see qsplan.planner.planning.task), or a bundled task's name "
+                                "(demo_task, two_link_task, ...: qsplan.planner.task_paths())")
     add_plan_options(p, "out/plan")
     return p
 
@@ -57,18 +59,25 @@ def run_task(task, args, out) -> int:
                       verify=args.verify, force=args.force, plots=not args.no_plots, progress=progress,
                       sequence_planner=args.sequence_planner)  # fmt: skip
     plan = result.plan
-    _, t, w = plan.narrowest()
+    name, t, w = plan.narrowest()
     out.write(f"{task.name}: planned {len(plan.segments)} in-contact segments and {len(plan.phases) - len(plan.segments)} "
               f"regrasps, {plan.duration:.4g} s of motion\n")  # fmt: skip
     out.write(f"planning: {plan.seconds:.3g} s, {plan.validity_checks} states judged "
               f"({plan.checks_per_second:.4g} per second: band tables, dense sweeps and the regrasps' OMPL checks)\n")  # fmt: skip
-    if plan.sequence:
-        search = plan.sequence[-1]
+    search = plan.sequence[-1] if plan.sequence else {}
+    if search.get("kind") == "manifold search":  # a described hand: grasps and slides on the contact manifold
+        out.write(f"sequence found on the contact manifold: {search['start_grasps']} start and {search['goal_grasps']} "
+                  f"goal grasps, slides planned by OMPL {search['planner']} and judged densely\n")  # fmt: skip
+    elif search:
         out.write(f"sequence found by the {search['planner']!r} search on band tables of {search['grasps']} grasps x "
                   f"{search['grid_points']} positions ({search['table_states']} configurations, {search['band_states']} "
                   f"guaranteed bands in {search['table_seconds']:.3g} s; search {search['search_seconds']:.3g} s)\n")  # fmt: skip
-    width = torque_text(w, side="upper").replace("unbounded above", "unbounded")
-    out.write(f"narrowest guaranteed band: {width} at t = {t:.4g} s (resolution {task.torque_resolution:g} N m)\n")
+    from qsplan.hands.interface import joint_names, joint_units
+
+    seg = next((s for s in plan.segments if s.name == name), None)
+    unit = "N m" if seg is None else joint_units(task.hand, "tau")[joint_names(task.hand).index(seg.effort_joint)]
+    width = torque_text(w, unit, side="upper").replace("unbounded above", "unbounded")
+    out.write(f"narrowest guaranteed band: {width} at t = {t:.4g} s (resolution {task.torque_resolution:g} {unit})\n")
     out.write(f"{result.certificate.summary()}\n")
     for r in result.replays:
         out.write(f"re-simulated at {r.summary()}\n")
@@ -81,6 +90,10 @@ def run_task(task, args, out) -> int:
 
 
 def run(args, out) -> int:
-    from qsplan.planner.planning.task import load_task
+    from pathlib import Path
 
-    return run_task(load_task(args.task), args, out)
+    from qsplan.planner.planning.task import load_task, task_paths
+
+    bundled = task_paths()
+    path = bundled[args.task] if args.task in bundled and not Path(args.task).exists() else args.task
+    return run_task(load_task(path), args, out)

@@ -1,8 +1,12 @@
-"""Export a whole two-finger plan: one torque schedule (CSV and JSON) for every phase, in time order.
+"""Export a whole plan of any two-finger hand: one torque schedule (CSV and JSON) for every phase, in time order.
 
 Format ``qsplan.torque_schedule.plan``, version 1: the columns of :mod:`qsplan.planner.export.schedule`
-(the band issue's format) for both joints, since the torque-controlled finger may change between
-segments, then extra columns (extended, never renamed).  One row per sample, in this order:
+(the band issue's format) for every joint of the plan's hand, in the hand's joint order (the paper's
+hand: ``left``, ``right``; a described hand: its joints, e.g. ``left_proximal``, ``left_distal``, ...),
+since the torque-controlled joint may change between segments, then extra columns (extended, never
+renamed).  Units per joint kind (:data:`qsplan.hands.interface.JOINT_UNITS`): a revolute joint's
+in rad, rad/s and N m as in the table; a prismatic joint's in m, m/s and N.  One row per sample, in
+this order:
 
 =====================  =======  ==============================================================================
 column                 unit     meaning
@@ -23,7 +27,8 @@ column                 unit     meaning
 ``theta_workpiece``    rad      workpiece pose: orientation
 ``phase``              -        index of the phase, an integer (0, 1, 2, ...: in-contact segments and regrasps
                                 in time order); ``metadata.phases[phase]`` names and describes it
-``effort_joint``       -        the torque-controlled finger (``left``, ``right``); ``none`` on regrasp rows
+``effort_joint``       -        the torque-controlled joint (``left``, ``right``; a described hand's joint
+                                name); ``none`` on regrasp rows
 =====================  =======  ==============================================================================
 
 Times are continuous over the plan; a phase's last row and the next phase's first row share a
@@ -32,8 +37,10 @@ time (the switch).  CSV numbers are full precision (``repr``), ``phase`` an inte
 non-finite numbers ``null`` (``tau_<joint>_min``: unbounded below, ``tau_<joint>_max``: unbounded
 above, elsewhere not applicable); the schema is ``torque_schedule.schema.json`` beside this module
 (:func:`qsplan.planner.export.schema.check_schedule_document`).  ``metadata`` records the task, the
-friction model, limits, force margin, the command rule and each phase, and the planned ``sequence``
-when the plan has one.  Files are never overwritten without ``force``.
+friction model, limits, force margin, the command rule and each phase, the hand
+(:func:`qsplan.hands.interface.hand_metadata`: a described hand's description and workpiece, enough to
+rebuild it) and the planned ``sequence`` when the plan has one.  Files are never overwritten without
+``force``.
 """
 
 from __future__ import annotations
@@ -46,8 +53,8 @@ import numpy as np
 from qsplan.planner.export.files import atomic_write, check_out_dir, check_outputs, csv_cell, json_value
 from qsplan.planner.export.schedule import FORMAT, VERSION
 
-__all__ = ["PLAN_COLUMNS", "PLAN_FORMAT", "column_meanings", "export_plan", "plan_columns", "plan_metadata",
-           "plain_json", "read_plan_csv"]
+__all__ = ["PLAN_COLUMNS", "PLAN_FORMAT", "column_meanings", "export_plan", "plan_columns", "plan_joints",
+           "plan_metadata", "plain_json", "read_plan_csv"]
 
 PLAN_FORMAT = FORMAT + ".plan"
 
@@ -73,28 +80,58 @@ PLAN_COLUMNS = (
     ("effort_joint", None, "the torque-controlled finger (left, right); none on regrasp rows"),
 )  # fmt: skip
 
-_JOINTS = ("left", "right")
+#: Characters a joint's name may hold to name columns (the schema's column pattern).
+_NAME_CHARS = frozenset("abcdefghijklmnopqrstuvwxyz0123456789_")
 
 
-def _family(name: str) -> tuple:
-    """The :data:`PLAN_COLUMNS` entry of column ``name``."""
-    for joint in _JOINTS:
-        if f"_{joint}" in name:
-            name = name.replace(f"_{joint}", "_<joint>", 1)
-            break
-    return next(c for c in PLAN_COLUMNS if c[0] == name)
+def plan_joints(hand) -> tuple:
+    """The joints a plan of ``hand`` has columns for, in the hand's order (:func:`qsplan.hands.interface.joint_names`).
+
+    Raises
+    ------
+    QsplanError
+        A joint whose name cannot name a column (lowercase letters, digits and underscores; not ``none``), or two
+        joints whose columns would share a name.
+    """
+    from qsplan.hands.interface import joint_names
+    from qsplan.mechanics.errors import QsplanError
+
+    names = joint_names(hand)
+    for n in names:
+        if not n or set(n) - _NAME_CHARS or n == "none":
+            raise QsplanError(f"hand.joint_names: {n!r} cannot name a plan column; expected lowercase letters, digits "
+                              "and underscores (and not 'none')")  # fmt: skip
+    columns = [f"{c}_{n}{s}" for n in names for c, s in (("q", ""), ("qd", ""), ("tau", ""), ("tau", "_min"),
+                                                         ("tau", "_max"))]  # fmt: skip
+    if len(set(columns)) != len(columns):
+        raise QsplanError(f"hand.joint_names: {list(names)} give two columns of one name; rename a joint")
+    return names
+
+
+def _match(name: str, joints=None) -> tuple:
+    """``(the PLAN_COLUMNS entry of column name, its joint or None)``; ``joints``: the plan's joint names (default
+    the paper's ``left`` and ``right``)."""
+    for joint in sorted(joints or ("left", "right"), key=len, reverse=True):
+        for head, tail in (("q", ""), ("qd", ""), ("tau", ""), ("tau", "_min"), ("tau", "_max")):
+            if name == f"{head}_{joint}{tail}":
+                return next(c for c in PLAN_COLUMNS if c[0] == f"{head}_<joint>{tail}"), joint
+    return next(c for c in PLAN_COLUMNS if c[0] == name), None
 
 
 def plan_columns(plan) -> tuple:
     """The plan as ordered columns ``{name: list}`` and units ``{name: str or None}`` (:data:`PLAN_COLUMNS`).
 
     Reads the plan's public fields only (``phases``; a phase that is not a
-    :class:`~qsplan.planner.planning.results.ContactSegmentPlan` is a free motion of both fingers).
+    :class:`~qsplan.planner.planning.results.ContactSegmentPlan` is a free motion of every joint); one group of
+    columns per joint of ``plan.task.hand``, in its order, with its kind's units.
     """
+    from qsplan.hands.interface import JOINT_UNITS, joint_kinds
     from qsplan.planner.planning.results import ContactSegmentPlan
 
-    order = ["t", *(f"q_{n}" for n in _JOINTS), *(f"qd_{n}" for n in _JOINTS)]
-    for n in _JOINTS:
+    joints = plan_joints(plan.task.hand)
+    kinds = dict(zip(joints, joint_kinds(plan.task.hand)))
+    order = ["t", *(f"q_{n}" for n in joints), *(f"qd_{n}" for n in joints)]
+    for n in joints:
         order += [f"tau_{n}", f"tau_{n}_min", f"tau_{n}_max"]
     order += ["mode", "margin", "x_workpiece", "y_workpiece", "theta_workpiece", "phase", "effort_joint"]
     cols = {k: [] for k in order}
@@ -103,11 +140,11 @@ def plan_columns(plan) -> tuple:
         n = ph.t.size
         nan = [math.nan] * n
         cols["t"] += ph.t.tolist()
-        for j, name in enumerate(_JOINTS):
+        for j, name in enumerate(joints):
             cols[f"q_{name}"] += ph.q[:, j].tolist()
             cols[f"qd_{name}"] += ph.qd[:, j].tolist()
         contact = isinstance(ph, ContactSegmentPlan)
-        for name in _JOINTS:
+        for name in joints:
             mine = contact and ph.effort_joint == name
             cols[f"tau_{name}"] += ph.command.tolist() if mine else nan
             cols[f"tau_{name}_min"] += ph.lower.tolist() if mine else nan
@@ -119,12 +156,25 @@ def plan_columns(plan) -> tuple:
         cols["theta_workpiece"] += [0.0] * n
         cols["phase"] += [i] * n
         cols["effort_joint"] += [ph.effort_joint if contact else "none"] * n
-    return cols, {k: _family(k)[1] for k in order}
+    units = {}
+    for k in order:
+        (family, unit, _), joint = _match(k, joints)
+        units[k] = unit if joint is None else JOINT_UNITS[kinds[joint]][family.split("_")[0]]
+    return cols, units
 
 
-def column_meanings(names) -> dict:
-    """``{column: meaning}`` of a plan file's columns (:data:`PLAN_COLUMNS`)."""
-    return {k: _family(k)[2] for k in names}
+def column_meanings(names, kinds=None) -> dict:
+    """``{column: meaning}`` of a plan file's columns (:data:`PLAN_COLUMNS`; the joints read from the ``q_<joint>``
+    columns); ``kinds``: ``{joint: "revolute" or "prismatic"}`` (default revolute), a prismatic joint's meanings
+    speak of its position and force."""
+    joints = [k[2:] for k in names if k.startswith("q_")]
+    out = {}
+    for k in names:
+        (_, _, meaning), joint = _match(k, joints)
+        if joint is not None and (kinds or {}).get(joint) == "prismatic":
+            meaning = meaning.replace("joint angle", "joint position").replace("torque", "force")
+        out[k] = meaning
+    return out
 
 
 def plan_metadata(plan) -> dict:
@@ -136,8 +186,10 @@ def plan_metadata(plan) -> dict:
     from qsplan.planner.planning.results import ContactSegmentPlan
     from qsplan.planner.torque.command import MAX_MARGIN_RESOLUTIONS
 
+    from qsplan.hands.interface import hand_metadata, is_chain_hand
+
     task = plan.task
-    h = task.hand
+    chain = is_chain_hand(task.hand)
     name, t, w = plan.narrowest()
     phases = []
     for i, ph in enumerate(plan.phases):
@@ -149,6 +201,8 @@ def plan_metadata(plan) -> dict:
                      narrowest_band={"t_s": float(ph.t[k]), "width_N_m": _num(ph.width[k])},
                      command={"margin_N_m": _num(np.min(ph.margin)), "half_narrowest_band_N_m": _num(0.5 * ph.width[k]),
                               "max_N_m": _num(np.max(ph.command)), "lower_edge_max_N_m": _num(np.max(ph.lower))})  # fmt: skip
+            if chain:  # a prismatic joint's effort is a force: its numbers under *_N_m are in N
+                d["effort_unit"] = _joint_units(task.hand)[ph.effort_joint]["tau"]
         else:
             d.update(kind="regrasp", x_workpiece_m=float(np.ravel(ph.x)[0]))
         phases.append(d)
@@ -168,20 +222,37 @@ def plan_metadata(plan) -> dict:
                             "records its m (command.margin_N_m)",
                     "max_margin_resolutions": MAX_MARGIN_RESOLUTIONS, "torque_resolution_N_m": task.torque_resolution,
                     "velocity_controlled_torque_cells": "nan in CSV, null in JSON"},
-        "limits": {"joints_rad": task.joint_limits.tolist(), "joint_speed_rad_s": task.joint_speed,
-                   "workpiece_speed_m_s": task.workpiece_speed},
+        "limits": _limits(task, chain),
         "narrowest_band": {"phase": name, "t_s": _num(t), "width_N_m": _num(w)},
         "planner": {"name": plan.options.planner, "seed": plan.options.seed, "seconds": plan.seconds,
                     "validity_checks": plan.validity_checks, "checks_per_second": _num(plan.checks_per_second)},
         "phases": phases,
-        "hand": {"workpiece_vertices_m": h.workpiece.tolist(), "workpiece_mass_kg": h.workpiece_mass,
-                 "finger_base_m": h.finger_base, "finger_length_m": h.finger_length, "finger_width_m": h.finger_width,
-                 "finger_mass_kg": h.finger_mass, "palm_halfwidth_m": h.palm_halfwidth, "gravity_m_s2": h.gravity},
+        "hand": hand_metadata(task.hand),
     }  # fmt: skip
     sequence = getattr(plan, "sequence", None)
     if sequence is not None:
         doc["sequence"] = plain_json(list(sequence))
     return doc
+
+
+def _joint_units(hand) -> dict:
+    """``{joint: {"q", "qd", "tau"} -> unit}`` (:data:`qsplan.hands.interface.JOINT_UNITS`)."""
+    from qsplan.hands.interface import JOINT_UNITS, joint_kinds, joint_names
+
+    return {n: JOINT_UNITS[k] for n, k in zip(joint_names(hand), joint_kinds(hand))}
+
+
+def _limits(task, chain: bool) -> dict:
+    """The task's limits: the paper's hand as always (``joints_rad``, one ``joint_speed_rad_s``); a described hand
+    per joint by name (``joints``: range, speed and their units)."""
+    if not chain:
+        return {"joints_rad": task.joint_limits.tolist(), "joint_speed_rad_s": task.joint_speed,
+                "workpiece_speed_m_s": task.workpiece_speed}  # fmt: skip
+    units = _joint_units(task.hand)
+    speeds = np.asarray(task.joint_speeds, dtype=float)
+    joints = {n: {"range": [float(v) for v in task.joint_limits[j]], "unit": units[n]["q"], "speed": float(speeds[j]),
+                  "speed_unit": units[n]["qd"]} for j, n in enumerate(units)}  # fmt: skip
+    return {"joints": joints, "workpiece_speed_m_s": task.workpiece_speed}
 
 
 def plain_json(value):
@@ -213,10 +284,13 @@ def export_plan(plan, out_dir, stem: str = "plan", force: bool = False) -> list:
     out = check_out_dir(out_dir)
     paths = [out / f"{stem}.csv", out / f"{stem}.json"]
     check_outputs(paths, force)
+    from qsplan.hands.interface import joint_kinds, joint_names
+
     cols, units = plan_columns(plan)
     names = list(cols)
+    kinds = dict(zip(joint_names(plan.task.hand), joint_kinds(plan.task.hand)))
     doc = {"format": PLAN_FORMAT, "version": VERSION, "columns": names, "units": units,
-           "descriptions": column_meanings(names),
+           "descriptions": column_meanings(names, kinds),
            "data": {k: [json_value(v) for v in vals] for k, vals in cols.items()}, "metadata": plan_metadata(plan),
            "null": "tau_<joint>_min: unbounded below; tau_<joint>_max: unbounded above; elsewhere: not applicable "
                    "(the joint is velocity-controlled, or a regrasp row)"}  # fmt: skip

@@ -111,6 +111,7 @@ def schedule_columns(bands) -> tuple:
 def schedule_metadata(bands, resolution=None) -> dict:
     """What a controller engineer needs to trust the schedule (all SI); ``resolution``: the controller's torque
     resolution (N m) the command's margin was sized with, if any."""
+    from qsplan.hands.interface import hand_metadata
     from qsplan.mechanics.bands.effort import check_force_margin
     from qsplan.mechanics.modes.contact_mode import ContactMode
 
@@ -154,12 +155,7 @@ def schedule_metadata(bands, resolution=None) -> dict:
                                                  "upper_N_m": float(band.upper[k])},
         },
         "command": command_rule(bands.safety_margin, bands.max_margin, resolution),
-        "hand": {
-            "workpiece_vertices_m": hand.workpiece.tolist(), "workpiece_mass_kg": hand.workpiece_mass,
-            "finger_base_m": hand.finger_base, "finger_length_m": hand.finger_length,
-            "finger_width_m": hand.finger_width, "finger_mass_kg": hand.finger_mass,
-            "palm_halfwidth_m": hand.palm_halfwidth, "gravity_m_s2": hand.gravity,
-        },
+        "hand": hand_metadata(hand),
     }  # fmt: skip
 
 

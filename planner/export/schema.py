@@ -6,7 +6,8 @@
 that file uses (``type``, ``enum``, ``const``, ``required``, ``properties``, ``patternProperties``,
 ``additionalProperties``, ``items``, ``minItems``, ``maxItems``, ``minimum``, ``pattern``, ``oneOf``,
 local ``$ref``), so no dependency is needed; :func:`check_schedule_document` adds what a schema cannot
-say (every column present once, all of one length), and :func:`check_schedule_files` compares the CSV
+say (every column present once, all of one length; in a plan, every joint of the recorded hand with its
+kind's units and ``effort_joint`` naming one of them), and :func:`check_schedule_files` compares the CSV
 beside the JSON with it cell by cell.
 """
 
@@ -135,6 +136,35 @@ def check_schedule_document(doc) -> list:
     lengths = {name: len(values) for name, values in doc["data"].items()}
     if len(set(lengths.values())) > 1:
         errors.append(f"$.data: columns of different lengths {lengths}")
+    if doc["format"].endswith(".plan"):
+        errors += _plan_joint_problems(doc)
+    return errors
+
+
+def _plan_joint_problems(doc) -> list:
+    """A plan file's joints against its hand (``metadata.hand``): every joint's five columns present with its kind's
+    units (the paper's hand: ``left`` and ``right``, revolute; a described hand: its description's joints), and
+    ``effort_joint`` one of them or ``none``."""
+    from qsplan.hands.interface import JOINT_UNITS
+
+    hand = doc["metadata"]["hand"]
+    if "description" in hand:
+        joints = [(j.get("name"), j.get("type")) for f in hand["description"]["fingers"] for j in f.get("joints", ())]
+    else:
+        joints = [("left", "revolute"), ("right", "revolute")]
+    errors = []
+    for name, kind in joints:
+        units = JOINT_UNITS["prismatic" if kind == "prismatic" else "revolute"]
+        for column, quantity in ((f"q_{name}", "q"), (f"qd_{name}", "qd"), (f"tau_{name}", "tau"),
+                                 (f"tau_{name}_min", "tau"), (f"tau_{name}_max", "tau")):  # fmt: skip
+            if column not in doc["data"]:
+                errors.append(f"$.data: missing {column!r} (joint {name!r} of the hand)")
+            elif doc["units"].get(column) != units[quantity]:
+                errors.append(f"$.units.{column}: expected {units[quantity]!r} ({kind} joint); got {doc['units'].get(column)!r}")
+    known = {name for name, _ in joints} | {"none"}
+    bad = sorted({e for e in doc["data"].get("effort_joint", ()) if e not in known})
+    if bad:
+        errors.append(f"$.data.effort_joint: {bad[0]!r} is no joint of the hand; expected one of {sorted(known)}")
     return errors
 
 

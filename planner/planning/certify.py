@@ -1,38 +1,38 @@
-"""Certify an exported two-finger plan from the task alone (issue 12, "a plan certifier").
+"""Certify an exported plan of any two-finger hand from the task alone (issue 12, "a plan certifier").
 
 A plan that exits 0 promises that it is physically possible.  :func:`certify_plan`
 checks the promise on the exported file (``plan.csv`` or ``plan.json``, written by
 :func:`qsplan.planner.export.plan_files.export_plan`), independently of the
 planner's bookkeeping: every row is rebuilt from the task (the hand's polygons,
-the row's joint angles and workpiece pose) and checked
-(:mod:`qsplan.planner.planning.certify_rows`):
+the row's joint positions and workpiece pose; the paper's hand or a described chain
+hand, :mod:`qsplan.hands.interface`) and checked (:mod:`qsplan.planner.planning.certify_rows`):
 
-1. ``overlap``: no two of left finger, right finger, palm and workpiece overlap
-   deeper than the contact tolerance (the fingers' roots turn inside the palm);
+1. ``overlap``: no two of the links, the palm and the workpiece overlap deeper than
+   the contact tolerance (a revolute joint's link turns inside its carrier at its root);
 2. ``joint limit``, ``speed``, ``continuity``, ``time``: the task's joint limits, its
    joint and workpiece speed limits over every step between rows, and no jump where
    two rows share a time; the exported velocity commands within the speed limit;
 3. ``contact``: on in-contact rows, every contact of the planned mode is present;
 4. ``mode``, ``undecided``, ``torque``, ``force margin``, ``motion``: with the row's commands
-   (the velocity-controlled finger's ``qd``, the torque-controlled finger's ``tau``)
+   (the velocity-controlled joints' ``qd``, the torque-controlled joint's ``tau``)
    the all-modes solver (:func:`qsplan.mechanics.solve`, eqs. 13-28) finds the planned
    mode and no other feasible at every vertex of the friction set and at seeded random
    points in it (the kinematics once per row, the friction vectors in one batch:
    :mod:`qsplan.planner.planning.certify_modes`); no mode's feasibility is left undecided (a mode degenerate only to
    machine precision is outside the model and is counted, not failed); the torque
    lies inside its exported band; the planned mode's normal forces are at least
-   ``force_margin``; it moves the workpiece as the rows do.
+   ``force_margin``; it moves the workpiece as the rows do; no sliding contact's direction
+   reverses between two rows of a segment (it would stop sliding in between: a mode change,
+   eq. 16, that the rows' letters do not show).
 
 Units SI (m, rad, s, N, N m).  Rows are numbered from 0 (the first data row).
 """
 
 from __future__ import annotations
 
-import json
 import math
 import time
 from dataclasses import dataclass, field
-from pathlib import Path
 
 import numpy as np
 
@@ -52,16 +52,15 @@ from qsplan.planner.planning.certify_rows import (
     row_bodies,
     step_checks,
 )
-from qsplan.planner.planning.certify_modes import mode_checks
+from qsplan.planner.planning.certify_inputs import plan_columns_required, plan_file, read_plan, task_from_metadata
+from qsplan.planner.planning.certify_modes import mode_checks, row_scene, slip_reversals, slip_velocities
 
-__all__ = ["Violation", "RowVerdict", "Certificate", "certify_plan", "read_plan", "task_from_metadata", "KINDS"]
+__all__ = ["Violation", "RowVerdict", "Certificate", "certify_plan", "plan_columns_required", "read_plan",
+           "task_from_metadata", "KINDS"]
 
 #: Every kind of violation, in the order of the checks.
 KINDS = ("input", "overlap", "joint limit", "speed", "continuity", "time", "contact", "torque", "mode", "undecided",
          "force margin", "motion")  # fmt: skip
-
-_COLUMNS = ("t", "q_left", "q_right", "qd_left", "qd_right", "tau_left", "tau_left_min", "tau_left_max", "tau_right",
-            "tau_right_min", "tau_right_max", "mode", "x_workpiece", "y_workpiece", "theta_workpiece", "effort_joint")  # fmt: skip
 
 
 @dataclass(frozen=True, slots=True)
@@ -182,109 +181,6 @@ def _num(v):
     return float(v) if v is not None and math.isfinite(v) else None
 
 
-def _plan_file(path) -> Path:
-    p = Path(path)
-    if p.is_dir():
-        for name in ("plan.csv", "plan.json"):
-            if (p / name).is_file():
-                return p / name
-        raise QsplanError(f"plan: {str(p)!r} holds neither plan.csv nor plan.json")
-    if not p.is_file():
-        raise QsplanError(f"plan: no such file or directory: {str(p)!r}")
-    if p.suffix not in (".csv", ".json"):
-        raise QsplanError(f"plan: expected a plan directory, a .csv or a .json file; got {str(p)!r}")
-    return p
-
-
-def _read_json(p: Path) -> tuple:
-    try:
-        doc = json.loads(p.read_text(encoding="utf-8"))
-        data = doc["data"]
-        n = len(data["t"])
-    except (OSError, UnicodeDecodeError, ValueError, KeyError, TypeError, RecursionError) as exc:
-        raise QsplanError(f"plan: {str(p)!r} is not a plan JSON file ({type(exc).__name__}: {exc})") from None
-    cols = {}
-    for name, vals in data.items():
-        if name in ("mode", "effort_joint"):
-            cols[name] = np.array([str(v) for v in vals])
-            continue
-        fill = -math.inf if name.endswith("_min") else (math.inf if name.endswith("_max") else math.nan)
-        try:
-            cols[name] = np.array([fill if v is None else float(v) for v in vals], dtype=float)
-        except (TypeError, ValueError):
-            raise QsplanError(f"plan: column {name!r} of {str(p)!r} holds a value that is not a number") from None
-        if cols[name].size != n:
-            raise QsplanError(f"plan: column {name!r} has {cols[name].size} rows; expected {n}")
-    return cols, doc.get("metadata") if isinstance(doc, dict) else None
-
-
-def read_plan(path) -> tuple:
-    """Columns ``{name: ndarray}`` and the metadata (dict or None) of a plan directory, ``.csv`` or ``.json``.
-
-    A directory is read from its ``plan.csv`` (else ``plan.json``); the metadata comes from
-    ``plan.json`` beside it when there is one.
-
-    Raises
-    ------
-    QsplanError
-        Missing or unreadable file, a missing column, columns of different lengths.
-    """
-    p = _plan_file(path)
-    if p.suffix == ".json":
-        cols, meta = _read_json(p)
-    else:
-        from qsplan.planner.export.plan_files import read_plan_csv
-
-        try:
-            cols = read_plan_csv(p)
-        except (OSError, UnicodeDecodeError, ValueError, IndexError) as exc:
-            raise QsplanError(f"plan: {str(p)!r} is not a plan CSV file ({type(exc).__name__}: {exc})") from None
-        side = p.with_suffix(".json")
-        meta = _read_json(side)[1] if side.is_file() else None
-    missing = [c for c in _COLUMNS if c not in cols]
-    if missing:
-        raise QsplanError(f"plan: {str(p)!r} lacks the column(s) {', '.join(missing)}")
-    if cols["t"].size == 0:
-        raise QsplanError(f"plan: {str(p)!r} has no rows")
-    return cols, meta
-
-
-def task_from_metadata(meta, cols=None):
-    """The :class:`~qsplan.planner.planning.task.Task` a plan's ``plan.json`` metadata records.
-
-    The metadata records the hand (but not its palm thickness: the default is used), the
-    friction set, the limits and the torque resolution; the start and the waypoints are
-    read from the rows (``cols``) when given.
-
-    Raises
-    ------
-    QsplanError
-        Naming ``task`` when the metadata does not record the task.
-    """
-    from qsplan.planner.planning.task import make_task
-
-    try:
-        h, lim = meta["hand"], meta["limits"]
-        hand = {"workpiece": h["workpiece_vertices_m"], "workpiece_mass": h["workpiece_mass_kg"],
-                "finger_base": h["finger_base_m"], "finger_length": h["finger_length_m"],
-                "finger_width": h["finger_width_m"], "finger_mass": h["finger_mass_kg"],
-                "palm_halfwidth": h["palm_halfwidth_m"], "gravity": h["gravity_m_s2"]}  # fmt: skip
-        friction = meta["friction"]
-        shared = "shared" in friction["model"]
-        start, waypoints = 0.0, [1.0]
-        if cols is not None:
-            x, contact = cols["x_workpiece"], cols["mode"] != "free"
-            ends = [i for i in range(x.size) if contact[i] and (i + 1 == x.size or not contact[i + 1])]
-            start, waypoints = float(x[0]), [float(x[i]) for i in ends]
-        fm = meta.get("force_margin")  # recorded since force margins exist; older plans: the default
-        margin = None if fm is None else (fm["min_normal_force_N"], fm["min_coulomb_slack_N"])
-        return make_task(hand, start, waypoints, friction["range"], meta["torque_resolution_N_m"], shared,
-                         lim["joints_rad"], lim["joint_speed_rad_s"], lim["workpiece_speed_m_s"],
-                         name=meta.get("task", "task"), force_margin=margin)  # fmt: skip
-    except (KeyError, TypeError) as exc:
-        raise QsplanError(f"task: the plan's metadata does not record the task ({exc}); name the task file") from None
-
-
 def _xdot_rows(cols, k) -> float:
     """The workpiece's x velocity (m/s) at in-contact row ``k`` by a finite difference inside its phase."""
     t, x, ph = cols["t"], cols["x_workpiece"], cols.get("phase")
@@ -331,12 +227,15 @@ def certify_plan(plan, task, *, n_random: int = 8, seed: int = 0, force_margin: 
     if not (isinstance(force_margin, (int, float)) and math.isfinite(force_margin) and force_margin >= 0):
         raise QsplanError(f"force_margin: expected a nonnegative finite number (N); got {force_margin!r}")
     start = time.perf_counter()
-    source = _plan_file(plan)
-    cols, _ = read_plan(source)
+    from qsplan.hands.interface import joint_names
+
+    source = plan_file(plan)
+    cols, _ = read_plan(source, joint_names(task.hand))
     rng = np.random.default_rng(seed)
     n = cols["t"].size
     roots = joint_housings(task.hand)
-    verdicts, every = [], []
+    phase = cols.get("phase", np.full(n, np.nan))  # without phases (nan != nan) no two rows are compared
+    verdicts, every, slip = [], [], None  # slip: (row, phase, sliding velocities) of the last in-contact row
     for k in range(n):
         t, mode = float(cols["t"][k]), str(cols["mode"][k])
         found = limit_checks(task, cols, k)
@@ -352,8 +251,17 @@ def certify_plan(plan, task, *, n_random: int = 8, seed: int = 0, force_margin: 
             found += contact
             if not contact:
                 mus = friction_points(task, int(n_random), rng)
-                more, excluded = mode_checks(task, cols, k, mus, force_margin, _xdot_rows(cols, k), batched)
-                found += more
+                try:
+                    scene = row_scene(task, cols, k)
+                except QsplanError as exc:
+                    found.append(("contact", f"the row's scene cannot be built: {exc}"))
+                else:
+                    more, excluded = mode_checks(task, cols, k, mus, force_margin, _xdot_rows(cols, k), batched, scene)
+                    found += more
+                    slips = slip_velocities(task, cols, k, scene)
+                    if slips is not None and slip is not None and slip[:2] == (k - 1, phase[k]):
+                        found += slip_reversals(mode, scene.contact_names, slip[2], slips)
+                    slip = None if slips is None else (k, phase[k], slips)
                 pts = len(mus)
         vs = tuple(Violation(k, t, kind, msg) for kind, msg in found)
         every += vs

@@ -1,6 +1,7 @@
 """The mode check of the plan certifier (:mod:`qsplan.planner.planning.certify`): the planned mode, alone.
 
-:func:`mode_checks` rebuilds a row's scene from the task (:func:`qsplan.hands.hand_scene`)
+:func:`mode_checks` rebuilds a row's scene from the task (:func:`qsplan.hands.interface.scene_at`:
+the effort-controlled joints those with a torque command, the others driven at their ``qd``)
 and asks which modes its commands make feasible at every friction vector to test.  Two
 paths give the same statuses, bit for bit:
 
@@ -25,7 +26,8 @@ import numpy as np
 
 from qsplan.mechanics import DEFAULT_TOLERANCES, Tolerances
 
-__all__ = ["MOTION_RTOL", "EXACT_TOLERANCES", "VectorStatuses", "solve_per_vector", "solve_all_vectors", "mode_checks"]
+__all__ = ["MOTION_RTOL", "EXACT_TOLERANCES", "SLIP_SIGN_TOL", "VectorStatuses", "solve_per_vector", "solve_all_vectors",
+           "mode_checks", "row_scene", "slip_velocities", "slip_reversals"]
 
 #: Relative difference tolerated between the workpiece speed the solver computes from
 #: the exported velocity command and the one the rows' poses show (finite differences of
@@ -40,6 +42,11 @@ MOTION_RTOL = 1e-2
 #: default tolerances, and the row is not certified.  1e-15 is the lowest singularity
 #: threshold at which the stability study (``benchmarks/bench_stability.py``) saw no LU failure.
 EXACT_TOLERANCES = Tolerances(singular=1e-15, velocity=1e-13)
+
+#: Sliding speed (m/s) within which a contact's sliding direction is not compared between rows: the rows'
+#: positions are written to full precision, so a finite difference over a 0.05 s step is exact to ~1e-15 m/s;
+#: a sliding direction that reverses between two rows shows speeds of 1e-4 m/s on either side.
+SLIP_SIGN_TOL = 1e-12
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -152,13 +159,78 @@ def _fmt_mu(mu) -> str:
     return "[" + ", ".join(f"{m:.4g}" for m in mu) + "]"
 
 
-def mode_checks(task, cols, k, mus, force_margin=0.0, xdot_rows=np.nan, batched=True) -> tuple:
+def row_scene(task, cols, k):
+    """The scene of in-contact row ``k`` rebuilt from the task (:func:`qsplan.hands.interface.scene_at`): the joints
+    with a torque command (and the row's ``effort_joint``) effort-controlled at it, the others at their ``qd``.
+
+    Raises
+    ------
+    QsplanError
+        When the row's polygons give no four-contact grasp.
+    """
+    from qsplan.hands.interface import joint_names, scene_at
+
+    from qsplan.planner.planning.certify_rows import row_pose, row_q
+
+    names = joint_names(task.hand)
+    tau = np.array([cols[f"tau_{n}"][k] for n in names], dtype=float)
+    effort = np.isfinite(tau) | (np.array(names) == str(cols["effort_joint"][k]))
+    qd = np.array([cols[f"qd_{n}"][k] for n in names], dtype=float)
+    # method="generic": contacts found by polygon contact finding, the reference path, not the
+    # closed-form grasp the planner uses (qsplan.hands.two_finger_analytic): a certifier shares no
+    # shortcut with what it certifies (~2 ms per row); a chain hand's contacts are always found so
+    return scene_at(task.hand, row_pose(cols, k), row_q(cols, k, names), effort, qd, effort=tau, method="generic")
+
+
+def slip_velocities(task, cols, k, scene):
+    """Each contact's tangential velocity (m/s, shape (n_c,); eq. 6: ``W_t^T nu - J_t thetadot``) at row ``k`` from the
+    rows' own motion: finite differences of the workpiece pose and every joint to the next row of the phase (the
+    previous one at its end); None when the phase has one row."""
+    from qsplan.hands.interface import joint_names
+
+    from qsplan.planner.planning.certify_rows import row_pose, row_q
+
+    t, ph = cols["t"], cols.get("phase")
+    same = (lambda i: ph[i] == ph[k]) if ph is not None else (lambda i: cols["mode"][i] != "free")
+    names = joint_names(task.hand)
+    for a, b in ((k, k + 1), (k - 1, k)):
+        if 0 <= a and b < t.size and same(a) and same(b) and t[b] > t[a]:
+            dt = float(t[b] - t[a])
+            (x, y, _), rate = row_pose(cols, k), (row_pose(cols, b) - row_pose(cols, a)) / dt
+            nu = np.array([rate[0] + rate[2] * y, rate[1] - rate[2] * x, rate[2]])  # the point at the world origin
+            qdot = (row_q(cols, b, names) - row_q(cols, a, names)) / dt
+            return scene.Wt.T @ nu - scene.Jt @ qdot
+    return None
+
+
+def slip_reversals(mode: str, contacts, before, after) -> list:
+    """A sliding contact whose direction reverses between two rows of a phase: it stops sliding in between, a change
+    of mode (eq. 16: a sliding speed keeps its sign) the rows' letters do not show.
+
+    Parameters
+    ----------
+    mode : str
+        The planned mode's letters.
+    contacts : sequence of str
+        The contacts' names, in the mode's order.
+    before, after : ndarray, shape (n_c,)
+        :func:`slip_velocities` at the two rows (m/s).
+    """
+    for i, letter in enumerate(mode):
+        if letter == "S" and min(abs(before[i]), abs(after[i])) > SLIP_SIGN_TOL and before[i] * after[i] < 0:
+            return [("mode", f"contact {contacts[i]} slides at {before[i] * 1e3:.4g} mm/s at the previous row and "
+                             f"{after[i] * 1e3:.4g} mm/s here: its sliding direction reverses in between, where it "
+                             f"stops sliding (eq. 16), outside the planned mode {mode}")]  # fmt: skip
+    return []
+
+
+def mode_checks(task, cols, k, mus, force_margin=0.0, xdot_rows=np.nan, batched=True, scene=None) -> tuple:
     """Check 4: with the row's commands the planned mode is the only feasible one at every friction vector.
 
     Parameters
     ----------
     mus : ndarray, shape (m, 4)
-        Friction vectors (palm:0, palm:1, left, right).
+        Friction vectors (palm:0, palm:1, left finger, right finger).
     force_margin : float
         N: the planned mode's normal forces must be at least this at every contact.
     xdot_rows : float
@@ -166,6 +238,8 @@ def mode_checks(task, cols, k, mus, force_margin=0.0, xdot_rows=np.nan, batched=
     batched : bool
         Every friction vector in one batch (:func:`solve_all_vectors`); False: the
         reference, one solve per vector (:func:`solve_per_vector`).  Same verdicts.
+    scene : Scene, optional
+        The row's scene when already built (:func:`row_scene`).
 
     Returns
     -------
@@ -173,21 +247,14 @@ def mode_checks(task, cols, k, mus, force_margin=0.0, xdot_rows=np.nan, batched=
         The failures (at most one per kind: the first friction vector that shows it) and
         the modes set aside as degenerate to machine precision (outside the model).
     """
-    from qsplan.hands import hand_scene
     from qsplan.mechanics import QsplanError, Status
 
-    from qsplan.planner.planning.certify_rows import row_pose, row_q
-
-    mode, e = str(cols["mode"][k]), str(cols["effort_joint"][k])
-    v = "right" if e == "left" else "left"
-    try:
-        # method="generic": contacts found by polygon contact finding, the reference path, not the
-        # closed-form grasp the planner uses (qsplan.hands.two_finger_analytic): a certifier shares no
-        # shortcut with what it certifies (~2 ms per row)
-        scene = hand_scene(task.hand, row_pose(cols, k), row_q(cols, k), e, velocity=float(cols[f"qd_{v}"][k]),
-                           effort=float(cols[f"tau_{e}"][k]), method="generic")  # fmt: skip
-    except QsplanError as exc:
-        return [("contact", f"the row's scene cannot be built: {exc}")], ()
+    mode = str(cols["mode"][k])
+    if scene is None:
+        try:
+            scene = row_scene(task, cols, k)
+        except QsplanError as exc:
+            return [("contact", f"the row's scene cannot be built: {exc}")], ()
     solve_at = solve_all_vectors if batched else solve_per_vector
     names = Status.ORDER
     degenerate_codes = [names.index(s) for s in sorted(Status.DEGENERATE)]

@@ -16,7 +16,7 @@ import numpy as np
 
 from qsplan.mechanics.errors import QsplanError, SceneError
 
-__all__ = ["controlled", "grasp_samples", "grasp_scenes"]
+__all__ = ["controlled", "grasp_samples", "grasp_scene_arrays", "grasp_scenes"]
 
 
 def _frozen(a):
@@ -64,6 +64,41 @@ def grasp_scenes(hand, conf, idx, effort_joint, xdot, reasons: dict | None = Non
                 reasons[k] = f"no four-contact scene: {exc}"
         out.append(scene)
     return out
+
+
+def grasp_scene_arrays(hand, conf, idx, reasons: dict | None = None):
+    """The model arrays of the scenes :func:`grasp_scenes` builds at the indices ``idx`` of ``conf``, with no object per
+    state (the band tables): the closed form's contacts for all states at once
+    (:func:`qsplan.hands.batch_scenes.checked_scene_arrays`), :func:`qsplan.hands.two_finger_scene.hand_scene` where it
+    refuses.  Where the polygons give no four-contact scene, the error is raised, or, with ``reasons`` (a dict), the
+    state's arrays are NaN and ``reasons[k]`` (``k`` the position in ``idx``) says why.
+
+    Returns
+    -------
+    arrays : qsplan.hands.batch_scenes.SceneArrays
+        ``len(idx)`` states; the scenes' ``Wn, Wt, Jn, Jt, g_obj, g_man`` bit for bit.
+    generic : dict of int to Scene
+        The scenes the generic path built (``k`` to scene; :func:`controlled` gives their control variants).
+    """
+    from qsplan.hands.batch_scenes import checked_scene_arrays
+    from qsplan.hands.two_finger_scene import hand_scene
+
+    sub = conf.take(np.asarray(list(idx), dtype=int))
+    arrays, ok = checked_scene_arrays(hand, sub)
+    poses = sub.poses(hand.rest_height)
+    generic = {}
+    for k in np.flatnonzero(~ok):
+        try:
+            scene = hand_scene(hand, poses[k], sub.q[k], "right", velocity=float(sub.dq_dx[k, 0] * 0.0))
+        except QsplanError as exc:  # the polygons give no four-contact scene here (e.g. vertex on vertex)
+            if reasons is None:
+                raise
+            reasons[int(k)] = f"no four-contact scene: {exc}"
+            continue
+        generic[int(k)] = scene
+        for name in ("Wn", "Wt", "Jn", "Jt", "g_obj", "g_man"):
+            getattr(arrays, name)[k] = getattr(scene, name)
+    return arrays, generic
 
 
 def grasp_samples(hand, grasp, xs, effort_joint, speed):

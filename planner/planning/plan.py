@@ -217,6 +217,12 @@ def plan_task(task: Task, options: PlannerOptions | None = None, progress=None, 
     """
     if options is None:
         options = DEFAULT_OPTIONS
+    from qsplan.hands.chain_hand import ChainHand
+
+    if isinstance(task.hand, ChainHand):  # a described hand: slides planned on the contact manifold
+        from qsplan.planner.manifold.plan import plan_chain_task
+
+        return plan_chain_task(task, options, progress)
     if task.goal is not None:  # the planner finds the sequence
         from qsplan.planner.sequence.autoplan import plan_automatic
 

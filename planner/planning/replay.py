@@ -1,4 +1,4 @@
-"""Re-simulate an exported two-finger plan with the finite-motion simulator (Section 5.1).
+"""Re-simulate an exported plan of any two-finger hand with the finite-motion simulator (Section 5.1).
 
 A plan promises that, for every friction coefficient in the task's interval, the
 commands of its torque file make the workpiece slide in the planned mode (4S) along
@@ -12,13 +12,15 @@ at every instant from the full model (every mode checked, eqs. 13-28), locates
 mode changes as events and stops when the mode becomes ambiguous or jams.
 
 The simulated system (:class:`ReplaySystem`) has the state
-``[x, y, theta, q_left, q_right, t]`` (m, m, rad, rad, rad, s): the workpiece pose,
-the finger angles and the plan's clock, which indexes the commands.  The
-velocity-controlled finger follows the plan's joint-velocity column and the
-effort-controlled finger's torque column, both interpolated linearly in time
-between rows.  Between segments the plan's regrasp puts both fingers back on the
-workpiece where it is (tangency, :func:`qsplan.hands.two_finger.finger_angles`), so each
-segment starts from the simulated end of the previous one: errors carry over.
+``[x, y, theta, q_0, ..., q_{n_j - 1}, t]`` (m, m, rad, the joints in the hand's order in
+rad or m, s): the workpiece pose, the joint positions and the plan's clock, which indexes
+the commands.  Every velocity-controlled joint follows its joint-velocity column and the
+effort-controlled joint its torque column, both interpolated linearly in time between rows;
+scenes come from :func:`qsplan.hands.interface.scene_at`.  Between segments the plan's regrasp
+puts both fingers back on the workpiece where it is, so each segment starts from the simulated
+end of the previous one (errors carry over): the paper's fingers by tangency with the planned
+grasp (:func:`grasp_angles`), a described chain hand's by closing each finger's last joint onto
+the workpiece from the plan's free joints (:func:`qsplan.hands.chain_hand.close_grasp`).
 """
 
 from __future__ import annotations
@@ -28,8 +30,10 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from qsplan.mechanics.errors import QsplanError
+from qsplan.planner.planning.replay_grasp import chain_grasp, grasp_angles
 
-__all__ = ["ReplaySystem", "SegmentReplay", "Replay", "replay_plan", "replay_segments", "friction_samples", "REPLAY_STEP"]
+__all__ = ["ReplaySystem", "SegmentReplay", "Replay", "chain_grasp", "grasp_angles", "replay_plan", "replay_segments",
+           "friction_samples", "CHAIN_REPLAY_TRAVEL", "REPLAY_STEP"]
 
 #: Step of the replay (s).  Mode changes are located by root finding, not by the step; 0.05 s is
 #: 0.5 mm of workpiece travel at the default 1 cm/s, the spacing of the plan's rows (its band sweep),
@@ -41,12 +45,29 @@ REPLAY_STEP = 0.05
 MAX_CACHED_SCENES = 10_000
 
 
-def _default_options():
+#: Largest workpiece travel (m) per step when replaying a described chain hand.  Its scenes find the contacts in
+#: the polygons at every stage of the RK4 step, and refuse a penetration beyond the contact tolerance (1e-6 m); a
+#: stage is an Euler-like prediction, off the contact constraint by about travel^2 / (2 R) for a contact path of
+#: radius R.  The two-link hand's fingertip contacts (R ~ 0.1 m) penetrate 1.3e-6 m at REPLAY_STEP's 0.5 mm; at
+#: 0.1 mm, 25 times less (5e-8 m), and still within the tolerance for radii down to 5 mm.  The paper's hand builds
+#: its scenes from the grasp's closed form and keeps REPLAY_STEP.
+CHAIN_REPLAY_TRAVEL = 1e-4
+
+
+def _default_options(max_step=REPLAY_STEP):
     from qsplan.mechanics.motion.simulator import MotionOptions
 
     # max_switches = 0: the first mode change already leaves the plan, so the run stops there
     # (all four contacts are still touching at that instant; nothing beyond it is modelled).
-    return MotionOptions(max_step=REPLAY_STEP, max_switches=0)
+    return MotionOptions(max_step=max_step, max_switches=0)
+
+
+def _chain_step(t, x) -> float:
+    """A chain hand's replay step (s) for a segment's rows (times ``t`` s, workpiece ``x`` m): at most
+    :data:`CHAIN_REPLAY_TRAVEL` of workpiece travel, at most :data:`REPLAY_STEP`."""
+    dt, dx = np.diff(t), np.abs(np.diff(x))
+    speed = float(np.max(dx[dt > 0] / dt[dt > 0], initial=0.0))
+    return min(REPLAY_STEP, CHAIN_REPLAY_TRAVEL / speed) if speed > 0 else REPLAY_STEP
 
 
 def _stop_message(motion, planned) -> str | None:
@@ -60,15 +81,18 @@ def _stop_message(motion, planned) -> str | None:
 
 @dataclass(frozen=True, slots=True, eq=False)
 class ReplaySystem:
-    """The two-finger hand driven by one in-contact segment's commands (a :class:`qsplan.mechanics.motion.system.MotionSystem`).
+    """A hand driven by one in-contact segment's commands (a :class:`qsplan.mechanics.motion.system.MotionSystem`).
 
     Attributes
     ----------
-    hand : qsplan.hands.two_finger.TwoFingerHand
-    effort_joint : str
-        ``"left"`` or ``"right"``: torque-controlled; the other finger is velocity-controlled.
-    t, velocity, effort : ndarray, shape (n,)
-        Command rows: time (s), the velocity-controlled joint's speed (rad/s), the effort (N m).
+    hand : qsplan.hands.two_finger.TwoFingerHand or qsplan.hands.chain_hand.ChainHand
+    effort_controlled : ndarray of bool, shape (n_j,)
+        The torque-controlled joint(s); every other joint is velocity-controlled.
+    t : ndarray, shape (n,)
+        Command rows' times (s).
+    velocity, effort : ndarray, shape (n, n_j)
+        Each velocity-controlled joint's speed (rad/s or m/s), each effort-controlled joint's effort (N m or N);
+        the other entries are not read.
     friction : qsplan.mechanics.motion.system.Friction
         Of the four potential contacts (palm, palm, left finger, right finger).
     scenes : dict
@@ -80,30 +104,38 @@ class ReplaySystem:
     """
 
     hand: object
-    effort_joint: str
+    effort_controlled: np.ndarray
     t: np.ndarray
     velocity: np.ndarray
     effort: np.ndarray
     friction: object
     scenes: dict = field(default_factory=dict, repr=False)
 
-    state_names = ("x (m)", "y (m)", "theta (rad)", "q_left (rad)", "q_right (rad)", "t (s)")
     contact_names = ("palm:0", "palm:1", "left", "right")
 
+    @property
+    def state_names(self) -> tuple:
+        from qsplan.hands.interface import joint_names, joint_units
+
+        joints = tuple(f"q_{n} ({u})" for n, u in zip(joint_names(self.hand), joint_units(self.hand)))
+        return ("x (m)", "y (m)", "theta (rad)") + joints + ("t (s)",)
+
     def commands(self, t) -> tuple:
-        """``(velocity, effort)`` at plan time ``t`` (s), linear between rows, held beyond the ends."""
-        return float(np.interp(t, self.t, self.velocity)), float(np.interp(t, self.t, self.effort))
+        """``(velocity (n_j,), effort (n_j,))`` at plan time ``t`` (s), linear between rows, held beyond the ends."""
+        velocity = np.array([np.interp(t, self.t, self.velocity[:, j]) for j in range(self.velocity.shape[1])])
+        effort = np.array([np.interp(t, self.t, self.effort[:, j]) for j in range(self.effort.shape[1])])
+        return velocity, effort
 
     def scene(self, x, contacts):
-        from qsplan.hands.two_finger_scene import hand_scene
+        from qsplan.hands.interface import scene_at
 
         if tuple(contacts) != (0, 1, 2, 3):
             raise QsplanError(f"contacts: the replay keeps all four contacts; got {tuple(contacts)}")
         key = np.asarray(x, dtype=float).tobytes()
         scene = self.scenes.get(key)
         if scene is None:
-            velocity, effort = self.commands(x[5])
-            scene = hand_scene(self.hand, x[:3], x[3:5], self.effort_joint, velocity=velocity, effort=effort)
+            velocity, effort = self.commands(x[-1])
+            scene = scene_at(self.hand, x[:3], x[3:-1], self.effort_controlled, velocity, effort=effort)
             if len(self.scenes) >= MAX_CACHED_SCENES:
                 self.scenes.clear()
             self.scenes[key] = scene
@@ -223,9 +255,11 @@ def replay_segments(columns) -> list:
     list of dict
         Per segment: ``phase``, ``rows`` (indices), ``mode``, ``effort_joint``.
     """
-    for key in ("t", "phase", "mode", "effort_joint", "x_workpiece", "q_left", "q_right"):
+    for key in ("t", "phase", "mode", "effort_joint", "x_workpiece"):
         if key not in columns:
             raise QsplanError(f"plan: column {key!r} missing; expected the columns of qsplan.planner.export.plan_files")
+    if not any(str(key).startswith("q_") for key in columns):
+        raise QsplanError("plan: no column 'q_<joint>'; expected the columns of qsplan.planner.export.plan_files")
     try:
         values = np.asarray(columns["phase"], float)
     except (TypeError, ValueError):
@@ -248,36 +282,6 @@ def rows_pose(columns, k) -> np.ndarray:
     return np.array([columns["x_workpiece"][k], columns["y_workpiece"][k], columns["theta_workpiece"][k]], float)
 
 
-#: Joint angles (rad) within which an exported row's fingers are taken to realise a grasp's closed form:
-#: the export writes angles to 1e-12 or better (repr of floats), tangency round-off is ~1e-15.
-GRASP_MATCH_TOL = 1e-9
-
-
-def grasp_angles(hand, pose, q_planned, planned_pose) -> np.ndarray:
-    """Joint angles (rad, shape (2,)) that put both fingers on the workpiece at ``pose`` with the grasp the plan
-    uses at ``planned_pose`` (its exported angles ``q_planned``): both inner edges on their vertices of
-    tangency (:func:`qsplan.hands.two_finger.finger_angles`) when those are the planned angles, else the
-    candidate grasp (:func:`qsplan.hands.grasp_geometry.candidate_grasps`) whose closed form gives them.
-    At the planned pose these are the planned angles; after a re-simulated segment the workpiece may stand a
-    little elsewhere and the fingers close on it there, with the same grasp."""
-    from qsplan.hands.two_finger import finger_angles
-
-    try:
-        q_inner = finger_angles(hand, planned_pose)[0]
-    except QsplanError:
-        q_inner = None
-    if q_inner is not None and np.allclose(q_inner, q_planned, rtol=0.0, atol=GRASP_MATCH_TOL):
-        return finger_angles(hand, pose)[0]
-    from qsplan.hands.grasp_geometry import candidate_grasps, grasp_configurations
-
-    for grasp in candidate_grasps(hand):
-        at = grasp_configurations(hand, grasp, np.array([planned_pose[0], pose[0]]))
-        if at.ok[0] and np.allclose(at.q[0], q_planned, rtol=0.0, atol=GRASP_MATCH_TOL) and at.ok[1]:
-            return at.q[1]
-    raise QsplanError(f"q: the planned angles {np.round(q_planned, 6).tolist()} rad at x = {planned_pose[0]:.6g} m "
-                      "are no grasp of this hand")  # fmt: skip
-
-
 def replay_plan(columns, hand, mu, options=None, scenes=None) -> Replay:
     """Re-simulate every in-contact segment of an exported plan at the friction vector ``mu``.
 
@@ -285,12 +289,13 @@ def replay_plan(columns, hand, mu, options=None, scenes=None) -> Replay:
     ----------
     columns : dict
         The plan's columns as read by :func:`qsplan.planner.export.plan_files.read_plan_csv`.
-    hand : qsplan.hands.two_finger.TwoFingerHand
+    hand : qsplan.hands.two_finger.TwoFingerHand or qsplan.hands.chain_hand.ChainHand
         The task's hand.
     mu : float or array-like, shape (4,)
         Friction of the contacts palm:0, palm:1, left, right (static = kinetic).
     options : qsplan.mechanics.motion.simulator.MotionOptions, optional
-        Default ``max_step`` :data:`REPLAY_STEP` and ``max_switches = 0`` (stop at the first mode change).
+        Default ``max_step`` :data:`REPLAY_STEP` (a chain hand's: at most :data:`CHAIN_REPLAY_TRAVEL` of workpiece
+        travel per step) and ``max_switches = 0`` (stop at the first mode change).
     scenes : dict, optional
         A cache of the scenes built, to pass again to the replays of the same ``columns`` and
         ``hand`` at other friction vectors (the scenes do not depend on friction); same results.
@@ -299,9 +304,16 @@ def replay_plan(columns, hand, mu, options=None, scenes=None) -> Replay:
     -------
     Replay
     """
+    from qsplan.hands.interface import is_chain_hand, joint_names
     from qsplan.mechanics.motion.simulator import simulate
     from qsplan.mechanics.motion.system import make_friction
 
+    names = joint_names(hand)
+    chain = is_chain_hand(hand)
+    missing = [f"{c}_{n}" for n in names for c in ("q", "qd", "tau") if f"{c}_{n}" not in columns]
+    if missing:
+        raise QsplanError(f"plan: column {missing[0]!r} missing; expected the columns of every joint of the hand")
+    given = options
     options = options or _default_options()
     mu = np.broadcast_to(np.asarray(mu, float), (4,)).copy()
     if np.any(~np.isfinite(mu)) or np.any(mu < 0):
@@ -311,17 +323,23 @@ def replay_plan(columns, hand, mu, options=None, scenes=None) -> Replay:
     out, x_prev = [], None
     for seg in replay_segments(columns):
         rows, e = seg["rows"], seg["effort_joint"]
-        v = "left" if e == "right" else "right"
+        if e not in names:
+            raise QsplanError(f"plan: effort_joint {e!r} in phase {seg['phase']} is no joint of the hand {names}")
         t = np.asarray(columns["t"], float)[rows]
-        system = ReplaySystem(hand, e, t, np.asarray(columns[f"qd_{v}"], float)[rows],
-                              np.asarray(columns[f"tau_{e}"], float)[rows], friction,
-                              scenes.setdefault(seg["phase"], {}))  # fmt: skip
+        tau = np.column_stack([np.asarray(columns[f"tau_{n}"], float)[rows] for n in names])
+        effort = np.isfinite(tau).any(axis=0) | (np.array(names) == e)  # effort joints: those with a torque command
+        velocity = np.column_stack([np.asarray(columns[f"qd_{n}"], float)[rows] for n in names])
+        system = ReplaySystem(hand, effort, t, velocity, tau, friction, scenes.setdefault(seg["phase"], {}))
         k = rows[0]
         pose = rows_pose(columns, k)
         if x_prev is not None:
             pose = x_prev[:3]  # the regrasp leaves the workpiece where the simulation put it
-        q = grasp_angles(hand, pose, np.array([columns["q_left"][k], columns["q_right"][k]], float), rows_pose(columns, k))
+        q_planned = np.array([columns[f"q_{n}"][k] for n in names], float)
+        close = chain_grasp if chain else grasp_angles
+        q = close(hand, pose, q_planned, rows_pose(columns, k))
         x0 = np.concatenate([pose, q, [t[0]]])
+        if chain and given is None:
+            options = _default_options(_chain_step(t, np.asarray(columns["x_workpiece"], float)[rows]))
         start = _start_modes(system, x0, mu)
         if start != (seg["mode"],):
             why = f"at t = {t[0]:.6g} s the feasible modes are {', '.join(start) or 'none (jam)'}"
@@ -336,8 +354,8 @@ def replay_plan(columns, hand, mu, options=None, scenes=None) -> Replay:
         states = motion.states
         planned = np.asarray(columns["x_workpiece"], float)[rows]
         if states.shape[0]:
-            reached = t <= states[-1, 5]
-            err = float(np.max(np.abs(np.interp(t[reached], states[:, 5], states[:, 0]) - planned[reached])))
+            reached = t <= states[-1, -1]
+            err = float(np.max(np.abs(np.interp(t[reached], states[:, -1], states[:, 0]) - planned[reached])))
             end = states[-1]
         else:  # stopped at the segment's start
             err, end = np.nan, np.concatenate([pose, q, [t[0]]])

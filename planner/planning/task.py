@@ -51,40 +51,12 @@ from qsplan.mechanics.bands.effort import ForceMargin, check_force_margin
 from qsplan.mechanics.errors import QsplanError
 from qsplan.mechanics.model.friction import check_mu_range
 from qsplan.planner.planning.goal import Goal, make_goal, make_start_features
+from qsplan.planner.planning.task_fields import (TASK_RANGES, check_hand, hand_from_task_table, in_task_range,
+                                                 short_repr, task_number)  # fmt: skip
 from qsplan.planner.torque.command import PLAN_FORCE_MARGIN, plan_force_margin
 
 __all__ = ["Task", "load_task", "make_task", "demo_task_path", "task_paths", "TASK_RANGES", "MAX_WAYPOINTS",
            "MIN_SEGMENT_LENGTH"]
-
-#: Plausible physical range ``(lo, hi)`` of every number of a task, with its unit; outside it a value is
-#: a mistake (a unit slip, a typo), not a hand.  Reasons:
-#:
-#: * ``size`` (m): finger and palm dimensions and workpiece coordinates of a hand-scale gripper lie
-#:   between a millimetre and a metre; the contact tolerance (1e-6 m) and the planner's steps
-#:   assume that scale (finger sizes of 1e21 m overflowed the geometry).
-#: * ``position`` (m): workpiece ``x`` on a palm at most a metre wide.
-#: * ``mass`` (kg) and ``gravity`` (m/s^2): a workpiece two fingers can hold; Earth is 9.81, 100 is 10 g.
-#: * ``friction``: no dry material pair exceeds a coefficient of about 2; 5 leaves room.
-#: * ``torque_resolution`` (N m): finger motors resolve between 1e-6 and 10 N m; the loads of a hand
-#:   this size are below 1 N m, so a resolution of 10 already leaves nothing plannable.
-#: * ``joint_limit`` (rad): finger angles are measured from the palm's +x axis; above the palm is
-#:   (0, pi), and a limit beyond a half turn either way (e.g. +-100 rad) describes no finger.
-#: * ``joint_speed`` (rad/s): from 1e-3 (slower is holding still) to 10 (a fast servo).
-#: * ``workpiece_speed`` (m/s): from 1e-4 (a 4 cm segment then takes 7 minutes; 1e-300 m/s gave joint
-#:   velocities of 1e11 rad/s) to 0.5 (beyond, the inertial forces of a workpiece turning over a 5 cm
-#:   corner, v^2/r, exceed gravity and the quasistatic model no longer holds).
-TASK_RANGES = {
-    "size": (1e-3, 1.0, "m"),
-    "position": (-1.0, 1.0, "m"),
-    "mass": (1e-3, 100.0, "kg"),
-    "finger_mass": (0.0, 100.0, "kg"),
-    "gravity": (0.0, 100.0, "m/s^2"),
-    "friction": (0.0, 5.0, "friction coefficient"),
-    "torque_resolution": (1e-6, 10.0, "N m"),
-    "joint_limit": (-np.pi, np.pi, "rad"),
-    "joint_speed": (1e-3, 10.0, "rad/s"),
-    "workpiece_speed": (1e-4, 0.5, "m/s"),
-}
 
 #: Most in-contact segments a task may have: each is one OMPL query of up to its time limit, so
 #: 50 segments already mean an hour of planning in the worst case (a long zig-zag hung the planner).
@@ -112,7 +84,7 @@ class Task:
     Attributes
     ----------
     name : str
-    hand : qsplan.hands.two_finger.TwoFingerHand
+    hand : qsplan.hands.two_finger.TwoFingerHand or qsplan.hands.chain_hand.ChainHand
     start_x : float
         Workpiece centre-of-mass ``x`` at the start (m).
     waypoints : ndarray, shape (k,)
@@ -123,8 +95,9 @@ class Task:
         One coefficient for all contacts (else each contact's independently in the range).
     torque_resolution : float
         N m, positive: every guaranteed band along the plan must be at least this wide.
-    joint_limits : ndarray, shape (2, 2)
-        ``[[lo, hi], [lo, hi]]`` (rad) of the left and right finger.
+    joint_limits : ndarray, shape (n_j, 2)
+        ``[[lo, hi], ...]`` (rad, m for a prismatic joint) of each joint: the left and right finger of the paper's
+        hand, a described hand's joints in its order.
     joint_speed : float
         rad/s, positive: limit on each joint's speed.
     workpiece_speed : float
@@ -136,6 +109,11 @@ class Task:
         Where an automatically planned task ends (then ``waypoints`` is empty).
     start_features : ((str, int or None), (str, int or None))
         Where each finger touches at the start: ``("inner", None)`` or ``(kind, K)`` (polygon as written).
+    speeds : ndarray, shape (n_j,), or None
+        A described hand's joint speed limits (rad/s or m/s); None: ``joint_speed`` (see :attr:`joint_speeds`).
+    start_joints : ndarray, shape (n_j,), or None
+        A described hand's free joints at the start (``[start]`` by joint name; the closing joints' entries 0);
+        None: the planner chooses.
     """
 
     name: str
@@ -151,6 +129,14 @@ class Task:
     force_margin: ForceMargin = PLAN_FORCE_MARGIN
     goal: Goal | None = None
     start_features: tuple = (("inner", None), ("inner", None))
+    speeds: np.ndarray | None = None
+    start_joints: np.ndarray | None = None
+
+    @property
+    def joint_speeds(self) -> np.ndarray:
+        """Speed limit of each joint (rad/s, m/s for a prismatic joint), shape (n_j,): a described hand's own, else
+        ``joint_speed`` for both fingers."""
+        return self.speeds if self.speeds is not None else np.full(len(self.joint_limits), self.joint_speed)
 
     @property
     def automatic(self) -> bool:
@@ -162,122 +148,73 @@ class Task:
         return np.array([float(x), self.hand.rest_height, 0.0])
 
 
-def _number(value, field, unit, positive=False, nonnegative=False) -> float:
-    if isinstance(value, (bool, str)):
-        raise QsplanError(f"{field}: expected a number ({unit}); got {_short(value)}")
-    try:
-        x = float(value)
-    except OverflowError:
-        x = float("inf")
-    except (TypeError, ValueError):
-        raise QsplanError(f"{field}: expected a number ({unit}); got {_short(value)}") from None
-    if not np.isfinite(x) or (positive and x <= 0) or (nonnegative and x < 0):
-        kind = "positive finite" if positive else ("nonnegative finite" if nonnegative else "finite")
-        raise QsplanError(f"{field}: expected a {kind} number ({unit}); got {_short(value)}")
-    return x
-
-
-def _in_range(x: float, field: str, kind: str) -> float:
-    lo, hi, unit = TASK_RANGES[kind]
-    if not lo <= x <= hi:
-        raise QsplanError(f"{field}: expected {lo:g} to {hi:g} {unit} (qsplan.planner.planning.task.TASK_RANGES[{kind!r}]); "
-                          f"got {x:g}")  # fmt: skip
-    return x
-
-
-def _check_hand(hand) -> None:
-    """Every size, mass and coefficient of a TwoFingerHand inside :data:`TASK_RANGES`."""
-    for name in ("finger_base", "finger_length", "finger_width", "palm_halfwidth", "palm_thickness"):
-        _in_range(float(getattr(hand, name)), f"hand.{name}", "size")
-    span = float(np.max(np.ptp(hand.workpiece, axis=0)))
-    _in_range(span, "hand.workpiece (its width or height)", "size")
-    _in_range(float(hand.workpiece_mass), "hand.workpiece_mass", "mass")
-    _in_range(float(hand.finger_mass), "hand.finger_mass", "finger_mass")
-    _in_range(float(hand.gravity), "hand.gravity", "gravity")
-    _in_range(float(hand.mu), "hand.mu", "friction")
-
-
-def _hand_from_table(table: dict):
-    """A TwoFingerHand from a ``[hand]`` table: keys checked, numbers checked before the geometry."""
-    import inspect
-
-    from qsplan.hands.two_finger import make_two_finger_hand
-
-    allowed = set(inspect.signature(make_two_finger_hand).parameters)
-    unknown = sorted(set(table) - allowed)
-    if unknown:
-        raise QsplanError(f"hand.{unknown[0]}: unknown field; expected some of {', '.join(sorted(allowed))}")
-    if "workpiece" not in table:
-        raise QsplanError("hand.workpiece: expected the workpiece polygon [[x, y], ...] (m); it is missing")
-    wp = table["workpiece"]
-    if not isinstance(wp, (list, tuple, np.ndarray)) or not 3 <= len(wp) <= 64:
-        raise QsplanError(f"hand.workpiece: expected a polygon of 3 to 64 vertices [[x, y], ...] (m); got {_short(wp)}")
-    for i, v in enumerate(wp):
-        if not isinstance(v, (list, tuple, np.ndarray)) or len(v) != 2:
-            raise QsplanError(f"hand.workpiece[{i}]: expected a vertex [x, y] (m); got {_short(v)}")
-        for c in v:
-            _in_range(_number(c, f"hand.workpiece[{i}]", "m"), f"hand.workpiece[{i}]", "position")
-    for key, value in table.items():
-        if key != "workpiece":
-            _number(value, f"hand.{key}", "SI units")
-    try:
-        return make_two_finger_hand(**table)
-    except QsplanError as exc:
-        raise QsplanError(f"hand.{exc}") from None
-
-
-def _short(value) -> str:
-    text = repr(value)
-    return text if len(text) <= 40 else text[:20] + "..." + text[-10:]
-
-
 def _pair(value, field, unit) -> tuple:
     if not isinstance(value, (list, tuple, np.ndarray)) or len(value) != 2:
         raise QsplanError(f"{field}: expected two numbers [lo, hi] ({unit}); got {value!r}")
-    lo, hi = (_number(v, field, unit) for v in value)
+    lo, hi = (task_number(v, field, unit) for v in value)
     if lo > hi:
         raise QsplanError(f"{field}: expected lo <= hi; got [{lo}, {hi}]")
     return lo, hi
 
 
 def make_task(hand, start_x, waypoints=None, mu_range=(0.0, 0.2), torque_resolution=0.02, shared_mu=False,
-              joint_limits=((0.05, 3.09), (0.05, 3.09)), joint_speed=0.5, workpiece_speed=0.01,
-              name="task", force_margin=None, goal=None, start=None) -> Task:  # fmt: skip
+              joint_limits=None, joint_speed=None, workpiece_speed=0.01,
+              name="task", force_margin=None, goal=None, start=None, base_dir=None) -> Task:  # fmt: skip
     """Validate and build a :class:`Task` (parameters as its attributes; ``hand`` a TwoFingerHand or a dict of
     :func:`qsplan.hands.two_finger.make_two_finger_hand` arguments).  Either ``waypoints`` (a scripted
     sequence) or ``goal`` (the ``[goal]`` table as a dict, or a :class:`Goal`: the planner finds the sequence);
-    ``start`` the ``[start]`` table as a dict (default both fingers ``"inner"``).
+    ``start`` the ``[start]`` table as a dict (default both fingers ``"inner"``; a described hand: its free joints
+    by name).  ``hand`` may also be a :class:`qsplan.hands.chain_hand.ChainHand` or a ``[hand]`` table naming a
+    hand description (:mod:`qsplan.planner.planning.task_fields`; ``base_dir`` resolves its relative ``file``).
+    ``joint_limits`` default: the description's, else ``[0.05, 3.09]`` rad for each finger; ``joint_speed``
+    (rad/s, the paper's hand) default: the description's, else 0.5.
 
     Raises
     ------
     QsplanError
         Naming the field, what was expected and what was received.
     """
+    from qsplan.hands.chain_hand import ChainHand
     from qsplan.hands.two_finger import TwoFingerHand
 
+    lim_default = speeds = None
     if isinstance(hand, dict):
-        hand = _hand_from_table(hand)
-    if not isinstance(hand, TwoFingerHand):
-        raise QsplanError(f"hand: expected a TwoFingerHand or a table of its parameters; got {type(hand).__name__}")
-    _check_hand(hand)
+        hand, lim_default, speeds = hand_from_task_table(hand, base_dir)
+    elif isinstance(hand, ChainHand):
+        lim_default, speeds = hand.description.joint_limits, hand.description.joint_speeds
+    if not isinstance(hand, (TwoFingerHand, ChainHand)):
+        raise QsplanError(f"hand: expected a TwoFingerHand, a ChainHand or a [hand] table; got {type(hand).__name__}")
+    check_hand(hand)
+    chain = isinstance(hand, ChainHand)
+    if not chain and speeds is not None:  # a described paper hand: one speed for both fingers
+        joint_speed = float(np.min(speeds)) if joint_speed is None else joint_speed
+        speeds = None
+    joint_speed = 0.5 if joint_speed is None else joint_speed
+    if joint_limits is None:
+        joint_limits = ((0.05, 3.09), (0.05, 3.09)) if lim_default is None else np.asarray(lim_default).tolist()
     if not isinstance(name, str) or len(name) > 200:
-        raise QsplanError(f"name: expected a string of at most 200 characters; got {_short(name)}")
-    start_x = _in_range(_number(start_x, "motion.start_x", "m"), "motion.start_x", "position")
+        raise QsplanError(f"name: expected a string of at most 200 characters; got {short_repr(name)}")
+    start_x = in_task_range(task_number(start_x, "motion.start_x", "m"), "motion.start_x", "position")
     n_v = len(hand.workpiece)
-    start_features = make_start_features({} if start is None else start, n_v)
+    start_joints = None
+    if chain:
+        start_joints = _start_joints(hand, {} if start is None else start)
+        start_features = (("inner", None), ("inner", None))
+    else:
+        start_features = make_start_features({} if start is None else start, n_v)
     if goal is not None and waypoints is not None:
         raise QsplanError("goal: give either motion.waypoints (a scripted sequence) or [goal] (the planner finds the "
                           "sequence), not both")  # fmt: skip
     if goal is not None:
-        number = lambda v, field, unit: _in_range(_number(v, field, unit), field, "position")  # noqa: E731
+        number = lambda v, field, unit: in_task_range(task_number(v, field, unit), field, "position")  # noqa: E731
         goal = goal if isinstance(goal, Goal) else make_goal(goal, n_v, number)
         waypoints = ()
     elif waypoints is None:
         raise QsplanError("motion.waypoints: missing (or give a [goal] table: the planner then finds the sequence)")
     elif not isinstance(waypoints, (list, tuple, np.ndarray)) or not 1 <= len(waypoints) <= MAX_WAYPOINTS:
         raise QsplanError(f"motion.waypoints: expected a list of 1 to {MAX_WAYPOINTS} workpiece x (m); "
-                          f"got {_short(waypoints)}")  # fmt: skip
-    wp = np.array([_in_range(_number(v, f"motion.waypoints[{i}]", "m"), f"motion.waypoints[{i}]", "position")
+                          f"got {short_repr(waypoints)}")  # fmt: skip
+    wp = np.array([in_task_range(task_number(v, f"motion.waypoints[{i}]", "m"), f"motion.waypoints[{i}]", "position")
                    for i, v in enumerate(waypoints)], dtype=float)  # fmt: skip
     prev = np.concatenate([[start_x], wp[:-1]])
     short = np.abs(wp - prev) < MIN_SEGMENT_LENGTH
@@ -286,18 +223,19 @@ def make_task(hand, start_x, waypoints=None, mu_range=(0.0, 0.2), torque_resolut
         raise QsplanError(f"motion.waypoints[{k}]: segment {k + 1} moves the workpiece {abs(wp[k] - prev[k]):g} m "
                           f"(x {prev[k]:g} to {wp[k]:g}); expected at least {MIN_SEGMENT_LENGTH:g} m")  # fmt: skip
     lo, hi = check_mu_range(*_pair(mu_range, "friction.range", "friction coefficients"), "friction.range")
-    _in_range(hi, "friction.range", "friction")
+    in_task_range(hi, "friction.range", "friction")
     if not lo < hi:
         raise QsplanError(f"friction.range: expected lo < hi (plans are guaranteed over an interval of friction; for "
                           f"one known coefficient give a small interval around it); got [{lo:g}, {hi:g}]")  # fmt: skip
-    if not isinstance(joint_limits, (list, tuple, np.ndarray)) or len(joint_limits) != 2:
-        raise QsplanError(f"limits: expected the ranges of the left and right finger; got {_short(joint_limits)}")
-    limits = np.array([_pair(joint_limits[k], f"limits.{side}", "rad") for k, side in enumerate(("left", "right"))])
-    for k, side in enumerate(("left", "right")):
+    names = hand.joint_names if chain else ("left", "right")
+    if not isinstance(joint_limits, (list, tuple, np.ndarray)) or len(joint_limits) != len(names):
+        raise QsplanError(f"limits: expected the ranges of the joints {', '.join(names)}; got {short_repr(joint_limits)}")
+    limits = np.array([_pair(joint_limits[k], f"limits.{side}", "rad") for k, side in enumerate(names)])
+    for k, side in enumerate(names):
         for v in limits[k]:
-            _in_range(float(v), f"limits.{side}", "joint_limit")
+            in_task_range(float(v), f"limits.{side}", "joint_limit")
         if not limits[k, 0] < limits[k, 1]:
-            raise QsplanError(f"limits.{side}: expected lo < hi (the finger must move); got {limits[k].tolist()}")
+            raise QsplanError(f"limits.{side}: expected lo < hi (the joint must move); got {limits[k].tolist()}")
     base = hand.workpiece[:2, 0]
     if not base.min() < 0.0 < base.max():
         raise QsplanError("hand.workpiece: its centre of mass must lie over its bottom edge, so that it rests on the "
@@ -305,14 +243,39 @@ def make_task(hand, start_x, waypoints=None, mu_range=(0.0, 0.2), torque_resolut
     wp.setflags(write=False)
     limits.setflags(write=False)
     if not isinstance(shared_mu, (bool, np.bool_)):
-        raise QsplanError(f"friction.shared: expected true or false; got {_short(shared_mu)}")
-    checked = {key: _in_range(_number(value, field, TASK_RANGES[key][2], positive=True), field, key)
+        raise QsplanError(f"friction.shared: expected true or false; got {short_repr(shared_mu)}")
+    checked = {key: in_task_range(task_number(value, field, TASK_RANGES[key][2], positive=True), field, key)
                for key, field, value in (("torque_resolution", "controller.torque_resolution", torque_resolution),
                                          ("joint_speed", "limits.joint_speed", joint_speed),
                                          ("workpiece_speed", "limits.workpiece_speed", workpiece_speed))}  # fmt: skip
     force_margin = PLAN_FORCE_MARGIN if force_margin is None else check_force_margin(force_margin)
+    if speeds is not None:
+        speeds = np.array(speeds, dtype=float)
+        speeds.setflags(write=False)
     return Task(name, hand, start_x, wp, (lo, hi), bool(shared_mu), checked["torque_resolution"], limits,
-                checked["joint_speed"], checked["workpiece_speed"], force_margin, goal, start_features)  # fmt: skip
+                checked["joint_speed"], checked["workpiece_speed"], force_margin, goal, start_features, speeds,
+                start_joints)  # fmt: skip
+
+
+def _start_joints(hand, table) -> np.ndarray | None:
+    """A described hand's ``[start]``: every free joint by name (rad or m), or none of them (the planner chooses)."""
+    if not isinstance(table, dict):
+        raise QsplanError(f"start: expected a table of the free joints' positions; got {short_repr(table)}")
+    free = [hand.joint_names[j] for j in hand.free_joints()]
+    extra = sorted(set(table) - set(free))
+    if extra:
+        raise QsplanError(f"start.{extra[0]}: unknown field; expected the free joints {', '.join(free)} (each finger's "
+                          "last joint closes onto the workpiece)")  # fmt: skip
+    if not table:
+        return None
+    missing = [n for n in free if n not in table]
+    if missing:
+        raise QsplanError(f"start.{missing[0]}: missing (give every free joint: {', '.join(free)})")
+    q = np.zeros(len(hand.joint_names))
+    for j in hand.free_joints():
+        q[j] = task_number(table[hand.joint_names[j]], f"start.{hand.joint_names[j]}", "rad or m")
+    q.setflags(write=False)
+    return q
 
 
 _KNOWN = {"name", "hand", "motion", "friction", "controller", "limits", "goal", "start"}
@@ -321,7 +284,7 @@ _KNOWN = {"name", "hand", "motion", "friction", "controller", "limits", "goal", 
 def _table(doc, key):
     v = doc.get(key, {})
     if not isinstance(v, dict):
-        raise QsplanError(f"{key}: expected a table; got {_short(v)}")
+        raise QsplanError(f"{key}: expected a table; got {short_repr(v)}")
     return v
 
 
@@ -366,10 +329,11 @@ def load_task(path) -> Task:
         kw["mu_range"] = friction["range"]
     if "shared" in friction:
         if not isinstance(friction["shared"], bool):
-            raise QsplanError(f"friction.shared: expected true or false; got {_short(friction['shared'])}")
+            raise QsplanError(f"friction.shared: expected true or false; got {short_repr(friction['shared'])}")
         kw["shared_mu"] = friction["shared"]
     if "left" in limits or "right" in limits:
         kw["joint_limits"] = (limits.get("left", (0.05, 3.09)), limits.get("right", (0.05, 3.09)))
+    kw["base_dir"] = path.parent
     for key in ("joint_speed", "workpiece_speed"):
         if key in limits:
             kw[key] = limits[key]

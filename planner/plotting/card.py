@@ -16,22 +16,29 @@ import numpy as np
 
 from qsplan.planner.plotting.plan_panels import (
     draw_band,
+    effort_words,
     is_contact,
+    joint_math,
+    joint_title,
     mark_narrowest,
     plot_mode_timeline,
     snapshot_keys,
     timeline_handles,
     torque_limits,
 )
-from qsplan.planner.plotting.style import A4_PORTRAIT, FONT, NARROWEST, finger_colour, torque_text
+from qsplan.planner.plotting.style import A4_PORTRAIT, FONT, NARROWEST, joint_colour, torque_text
 
-__all__ = ["CARD_DPI", "MAX_SNAPSHOTS", "card_snapshots", "plan_card", "verdict"]
+__all__ = ["CARD_DPI", "LEGEND_LABEL_CHARS", "MAX_SNAPSHOTS", "card_snapshots", "plan_card", "verdict"]
 
 #: Resolution (dots per inch) the card is written at: 150 keeps 7.5 pt text sharp on an A4 print.
 CARD_DPI = 150
 
 #: Snapshots on the card, at most (the instants are thinned evenly beyond it).
 MAX_SNAPSHOTS = 10
+
+#: Longest legend label (characters) that three legend columns hold on the A4 page at the legend's 8 pt; longer
+#: labels (a described hand's joint names in the timeline's entries) take two columns.
+LEGEND_LABEL_CHARS = 44
 
 _OK, _BAD = "#1a7f37", "#b42318"
 
@@ -115,12 +122,13 @@ def _facts(plan) -> str:
     lo, hi = task.mu_range
     model = "one shared friction coefficient" if task.shared_mu else "each contact's friction coefficient"
     name, t, w = plan.narrowest()
+    unit = next((effort_words(task.hand, s.effort_joint)[1] for s in plan.segments if s.name == name), "N m")
     n_seg = len(plan.segments)
     where = f" at t = {t:.3g} s ({str(name).split(':')[0]})" if name else ""
     return (f"Bands guaranteed for {model} in [{lo:g}, {hi:g}]; controller torque resolution "
             f"{task.torque_resolution:g} N m. {n_seg} in-contact segment{'s' if n_seg != 1 else ''}, "
             f"{len(plan.phases) - n_seg} regrasp{'s' if len(plan.phases) - n_seg != 1 else ''}, "
-            f"{plan.duration:.3g} s of motion; narrowest band {torque_text(w) if np.isfinite(w) else 'unbounded'}{where}.")  # fmt: skip
+            f"{plan.duration:.3g} s of motion; narrowest band {torque_text(w, unit) if np.isfinite(w) else 'unbounded'}{where}.")  # fmt: skip
 
 
 def _snapshot_row(sub, plan, shots, letters):
@@ -159,10 +167,14 @@ def plan_card(plan, certificate=None, replays=(), snapshots: int = MAX_SNAPSHOTS
     from matplotlib.lines import Line2D
     from matplotlib.patches import Patch
 
+    from qsplan.hands.interface import joint_names, joint_units
+
+    hand = plan.task.hand
+    names, units = joint_names(hand), dict(zip(joint_names(hand), joint_units(hand, "qd")))
     shots = card_snapshots(plan, snapshots)
     letters = _letters(len(shots))
-    torque_joints = [j for j in ("left", "right") if any(is_contact(p) and p.effort_joint == j for p in plan.phases)]
-    velocity_joints = [j for k, j in enumerate(("left", "right")) if any(np.isfinite(p.qd[:, k]).any() for p in plan.phases)]
+    torque_joints = [j for j in names if any(is_contact(p) and p.effort_joint == j for p in plan.phases)]
+    velocity_joints = [j for k, j in enumerate(names) if any(np.isfinite(p.qd[:, k]).any() for p in plan.phases)]
     fig = Figure(figsize=A4_PORTRAIT, layout="constrained")
     head, body = fig.subfigures(2, 1, height_ratios=[0.095, 0.905])
     line, ok = verdict(certificate, replays)
@@ -185,24 +197,29 @@ def plan_card(plan, certificate=None, replays=(), snapshots: int = MAX_SNAPSHOTS
         ax = body.add_subplot(grid[2 + i], sharex=timeline)
         segs = [p for p in plan.phases if is_contact(p) and p.effort_joint == joint]
         ylim = torque_limits(segs, res)
+        word, unit = effort_words(hand, joint)
         for seg in segs:
-            draw_band(ax, seg.t, seg.lower, seg.upper, seg.command, finger_colour(joint), ylim, label=False)
-            mark_narrowest(ax, seg, ylim, label=False)
+            draw_band(ax, seg.t, seg.lower, seg.upper, seg.command, joint_colour(hand, joint), ylim, label=False)
+            mark_narrowest(ax, seg, ylim, label=False, unit=unit)
         _shade_other_control(ax, plan, joint, torque=True)
         ax.set_ylim(*ylim)
         ax.axhline(0.0, color="0.6", lw=0.5)
-        ax.set_ylabel(f"$\\tau_{{{joint}}}$ (N m)", fontsize=FONT["label"])
-        ax.set_title(f"{joint} finger: torque command inside its guaranteed band", fontsize=FONT["label"], loc="left")
+        symbol = "\\tau" if word == "torque" else "f"
+        ax.set_ylabel(f"${symbol}_{{{joint_math(joint)}}}$ ({unit})", fontsize=FONT["label"])
+        ax.set_title(f"{joint_title(joint)}: {word} command inside its guaranteed band", fontsize=FONT["label"],
+                     loc="left")  # fmt: skip
         axes.append(ax)
     for joint in velocity_joints:
         ax = body.add_subplot(grid[len(axes) + 1], sharex=timeline)
         for ph in plan.phases:  # a free motion's rows hold the velocity until the next row: steps
-            ax.plot(ph.t, ph.qd[:, 0 if joint == "left" else 1], color=finger_colour(joint), lw=1.3,
+            ax.plot(ph.t, ph.qd[:, names.index(joint)], color=joint_colour(hand, joint), lw=1.3,
                     drawstyle="default" if is_contact(ph) else "steps-post")  # fmt: skip
         _shade_other_control(ax, plan, joint, torque=False)
         ax.axhline(0.0, color="0.6", lw=0.5)
-        ax.set_ylabel(f"$\\dot q_{{{joint}}}$ (rad/s)", fontsize=FONT["label"])
-        ax.set_title(f"{joint} finger: velocity command", fontsize=FONT["label"], loc="left")
+        short = joint in ("left", "right")  # a described hand's long joint names stay in the title: short panels
+        ax.set_ylabel(f"$\\dot q_{{{joint}}}$ ({units[joint]})" if short else f"$\\dot q$ ({units[joint]})",
+                      fontsize=FONT["label"])  # fmt: skip
+        ax.set_title(f"{joint_title(joint)}: velocity command", fontsize=FONT["label"], loc="left")
         axes.append(ax)
     switches = [float(p.t[0]) for p in plan.phases[1:]]
     for ax in axes:
@@ -215,15 +232,17 @@ def plan_card(plan, certificate=None, replays=(), snapshots: int = MAX_SNAPSHOTS
     axes[-1].set_xlabel("t (s) from the plan's start (dotted lines: phase switches)", fontsize=FONT["label"])
     from qsplan.planner.plotting.hands import snapshot_legend_handles
 
-    colour = finger_colour(torque_joints[0]) if torque_joints else "0.3"
-    handles = snapshot_legend_handles() + timeline_handles(plan) + [
-        Patch(fc=colour, alpha=0.16, label="guaranteed torque band"),
+    colour = joint_colour(hand, torque_joints[0]) if torque_joints else "0.3"
+    word = effort_words(hand, torque_joints[0])[0] if torque_joints else "torque"
+    handles = snapshot_legend_handles(hand=hand) + timeline_handles(plan) + [
+        Patch(fc=colour, alpha=0.16, label=f"guaranteed {word} band"),
         Line2D([], [], color=colour, lw=1.3, label="band's upper edge"),
         Line2D([], [], color=colour, lw=1.3, ls="--", label="band's lower edge"),
         Line2D([], [], color=colour, ls="none", marker="^", ms=5, label="edge off the plot or unbounded"),
-        Line2D([], [], color="k", lw=1.6, label="torque command"),
+        Line2D([], [], color="k", lw=1.6, label=f"{word} command"),
         Line2D([], [], color=NARROWEST, ls="none", marker="$\\updownarrow$", ms=9, label="narrowest band, with its width"),
         Patch(fc="none", ec="0.8", hatch="////", label="joint under the other kind of control"),
     ]
-    body.legend(handles=handles, loc="outside lower center", ncol=3, fontsize=FONT["legend"], frameon=False)
+    ncol = 3 if max(len(h.get_label()) for h in handles) <= LEGEND_LABEL_CHARS else 2
+    body.legend(handles=handles, loc="outside lower center", ncol=ncol, fontsize=FONT["legend"], frameon=False)
     return fig

@@ -1,4 +1,4 @@
-"""Operator plots of a two-finger plan: bands along the whole plan, the mode timeline, hand snapshots.
+"""Operator plots of a plan of any two-finger hand: bands along the whole plan, the mode timeline, hand snapshots.
 
 Each function takes a :class:`qsplan.planner.Plan`, draws into ``ax`` (or a new figure) and returns
 the axes or the figure; matplotlib is imported inside.  Only the plan's public fields are read
@@ -14,13 +14,15 @@ import numpy as np
 
 from qsplan.planner.plotting.plan_panels import (
     draw_band,
+    effort_words,
+    joint_math,
     mark_narrowest,
     phase_label,
     plot_mode_timeline,
     snapshot_keys,
     torque_limits,
 )
-from qsplan.planner.plotting.style import FONT, finger_colour, legend_below, torque_text
+from qsplan.planner.plotting.style import FONT, joint_colour, legend_below, torque_text
 
 __all__ = ["SNAPSHOT_COLUMNS", "plan_figures", "plan_snapshots_figure", "plot_mode_timeline", "plot_plan_bands"]
 
@@ -29,7 +31,7 @@ SNAPSHOT_COLUMNS = 6
 
 
 def plot_plan_bands(plan, axes=None, sharey=False):
-    """The guaranteed band and the command of the torque-controlled finger along each in-contact segment.
+    """The guaranteed band and the command of the torque-controlled joint along each in-contact segment.
 
     One panel per segment (N m against s from the plan's start), each scaled to its command, lower
     edge and margin (bands differ by orders of magnitude between segments), or one scale for all
@@ -56,17 +58,20 @@ def plot_plan_bands(plan, axes=None, sharey=False):
         axes = [row[0] for row in grid]
     res = plan.task.torque_resolution
     shared = torque_limits(segs, res) if sharey else None
+    hand = plan.task.hand
     for i, (ax, seg) in enumerate(zip(axes, segs)):
         ylim = shared or torque_limits([seg], res)
-        draw_band(ax, seg.t, seg.lower, seg.upper, seg.command, finger_colour(seg.effort_joint), ylim, label=i == 0)
-        mark_narrowest(ax, seg, ylim, label=i == 0)
+        word, unit = effort_words(hand, seg.effort_joint)
+        draw_band(ax, seg.t, seg.lower, seg.upper, seg.command, joint_colour(hand, seg.effort_joint), ylim, label=i == 0)
+        mark_narrowest(ax, seg, ylim, label=i == 0, unit=unit)
         ax.axhline(0.0, color="0.6", lw=0.5)
         ax.set_ylim(*ylim)
         ax.set_xlim(seg.t[0], seg.t[-1])
-        ax.set_ylabel(f"$\\tau_{{{seg.effort_joint}}}$ (N m)", fontsize=FONT["label"])
-        mode, control = phase_label(seg)
+        symbol = "\\tau" if word == "torque" else "f"
+        ax.set_ylabel(f"${symbol}_{{{joint_math(seg.effort_joint)}}}$ ({unit})", fontsize=FONT["label"])
+        mode, control = phase_label(seg, hand)
         ax.set_title(f"{seg.name.split(':')[0]}: {mode}, {control}-controlled; smallest margin "
-                     f"{torque_text(np.min(seg.margin))}", fontsize=FONT["note"] + 0.5, loc="left")  # fmt: skip
+                     f"{torque_text(np.min(seg.margin), unit)}", fontsize=FONT["note"] + 0.5, loc="left")  # fmt: skip
     axes[-1].set_xlabel("t (s) from the plan's start", fontsize=FONT["label"])
     legend_below(axes[-1], handles=axes[0].get_legend_handles_labels()[0], ncol=3)
     lo, hi = plan.task.mu_range
@@ -101,7 +106,7 @@ def plan_snapshots_figure(plan, per_phase=3, columns=SNAPSHOT_COLUMNS):
         ax.set_title(f"t = {t:.3g} s" + (" (fingers open)" if opened else ""), fontsize=FONT["note"])
     for ax in flat[len(shots):]:
         ax.set_visible(False)
-    figure_legend(fig, snapshot_legend_handles(), ncol=3)
+    figure_legend(fig, snapshot_legend_handles(hand=plan.task.hand), ncol=3)
     fig.suptitle(f"{plan.task.name}: the hand along the plan", fontsize=FONT["title"])
     return fig
 

@@ -22,12 +22,13 @@ from qsplan.planner.plotting.style import (
     UPPER,
     axes_or_new,
     finger_colour,
+    joint_colour,
     legend_below,
     torque_text,
 )
 
-__all__ = ["draw_band", "is_contact", "mark_narrowest", "phase_colour", "phase_label", "plot_mode_timeline",
-           "snapshot_keys", "timeline_handles", "torque_limits"]
+__all__ = ["draw_band", "effort_words", "is_contact", "joint_math", "joint_title", "mark_narrowest", "phase_colour",
+           "phase_label", "plot_mode_timeline", "snapshot_keys", "timeline_handles", "torque_limits"]
 
 
 def is_contact(phase) -> bool:
@@ -37,8 +38,30 @@ def is_contact(phase) -> bool:
     return isinstance(phase, ContactSegmentPlan)
 
 
-def phase_label(phase) -> tuple:
-    """``(mode, control)`` in words: ``("4S (SSSS)", "right finger torque")`` or ``("regrasp", "fingers velocity")``."""
+def effort_words(hand, joint) -> tuple:
+    """``(word, unit)`` of a joint's effort: ``("torque", "N m")`` for a revolute joint (the paper's fingers, and
+    without a hand), ``("force", "N")`` for a prismatic one."""
+    if hand is not None:
+        from qsplan.hands.interface import joint_kinds, joint_names
+
+        if dict(zip(joint_names(hand), joint_kinds(hand))).get(joint) == "prismatic":
+            return "force", "N"
+    return "torque", "N m"
+
+
+def joint_math(name) -> str:
+    """A joint's name for a mathtext subscript (``left_distal`` -> ``left\\_distal``)."""
+    return str(name).replace("_", "\\_")
+
+
+def joint_title(name) -> str:
+    """A joint in words: the paper's ``"left finger"``, a described hand's ``"left_distal joint"``."""
+    return f"{name} finger" if name in ("left", "right") else f"{name} joint"
+
+
+def phase_label(phase, hand=None) -> tuple:
+    """``(mode, control)`` in words: ``("4S (SSSS)", "right finger torque")`` or ``("regrasp", "fingers velocity")``;
+    a described ``hand``'s joints by name (``"left_jaw joint force"``)."""
     from qsplan.mechanics.modes.contact_mode import ContactMode
 
     if not is_contact(phase):
@@ -47,12 +70,14 @@ def phase_label(phase) -> tuple:
         kind = ContactMode(phase.mode).kind
     except (ValueError, TypeError):
         kind = str(phase.mode)
-    return f"{kind} ({phase.mode})", f"{phase.effort_joint} finger torque"
+    return f"{kind} ({phase.mode})", f"{joint_title(phase.effort_joint)} {effort_words(hand, phase.effort_joint)[0]}"
 
 
-def phase_colour(phase) -> str:
-    """The colour of a phase: its torque-controlled finger's, grey for a regrasp."""
-    return finger_colour(phase.effort_joint) if is_contact(phase) else REGRASP
+def phase_colour(phase, hand=None) -> str:
+    """The colour of a phase: its torque-controlled joint's finger's, grey for a regrasp."""
+    if not is_contact(phase):
+        return REGRASP
+    return finger_colour(phase.effort_joint) if hand is None else joint_colour(hand, phase.effort_joint)
 
 
 def torque_limits(segments, resolution=0.0) -> tuple:
@@ -104,7 +129,7 @@ def draw_band(ax, t, lower, upper, command, colour, ylim, *, label=True) -> None
     ax.plot(t, command, color=COMMAND, lw=1.6, label="torque command" if label else None)
 
 
-def mark_narrowest(ax, seg, ylim, label=True) -> None:
+def mark_narrowest(ax, seg, ylim, label=True, unit: str = "N m") -> None:
     """The narrowest point of a segment's band: a red double arrow, labelled with its width (off the edges)."""
     k = int(np.argmin(seg.width))
     t, lo, up = float(seg.t[k]), float(seg.lower[k]), float(seg.upper[k])
@@ -118,7 +143,7 @@ def mark_narrowest(ax, seg, ylim, label=True) -> None:
     c = float(seg.command[k])  # the label sits beside the arrow, halfway from the command to the farther end
     y = 0.5 * (c + top) if top - c > c - bottom else 0.5 * (bottom + c)
     va, dy = "center", 0
-    width = torque_text(up - lo) if np.isfinite(up - lo) else "unbounded"
+    width = torque_text(up - lo, unit) if np.isfinite(up - lo) else "unbounded"
     ax.annotate(f"narrowest {width}{cut}", (t, y), xytext=(3 if right else -3, dy),
                 textcoords="offset points", ha="left" if right else "right", va=va, fontsize=FONT["note"],
                 color=NARROWEST, bbox={"boxstyle": "round,pad=0.15", "fc": "white", "ec": "none", "alpha": 0.85})  # fmt: skip
@@ -131,9 +156,10 @@ def timeline_handles(plan) -> list:
     from matplotlib.patches import Patch
 
     out = {}
+    hand = plan.task.hand
     for ph in plan.phases:
-        mode, control = phase_label(ph)
-        out.setdefault((mode, control), Patch(fc=phase_colour(ph), ec="k", lw=0.5, alpha=0.75,
+        mode, control = phase_label(ph, hand)
+        out.setdefault((mode, control), Patch(fc=phase_colour(ph, hand), ec="k", lw=0.5, alpha=0.75,
                                               label=f"{mode}, {control}-controlled"))  # fmt: skip
     return list(out.values())
 
@@ -160,11 +186,12 @@ def plot_mode_timeline(plan, ax=None, marks=None, legend=True, xlabel=True):
     t0, t1 = float(plan.phases[0].t[0]), float(plan.duration)
     width_in = ax.get_figure(root=True).get_figwidth() * 0.85
     above, last_x = [], -np.inf
+    hand = plan.task.hand
     for ph in plan.phases:
         a, b = float(ph.t[0]), float(ph.t[-1])
-        colour = phase_colour(ph)
+        colour = phase_colour(ph, hand)
         ax.barh(0, b - a, left=a, height=0.8, color=colour, alpha=0.75, edgecolor="k", lw=0.5)
-        mode, control = phase_label(ph)
+        mode, control = phase_label(ph, hand)
         text = f"{mode}\n{control}"
         need = max(len(s) for s in text.split("\n")) * FONT["note"] * 0.52 / 72
         if need < 0.92 * (b - a) / max(t1 - t0, 1e-12) * width_in:
@@ -207,7 +234,8 @@ def snapshot_keys(plan, per_phase=3) -> list:
     Returns
     -------
     list of (t, pose, q, effort_joint or None, open)
-        Time (s), workpiece pose (3,), joint angles (2,), the torque-controlled finger, whether the fingers are open.
+        Time (s), workpiece pose (3,), joint positions (n_j,), the torque-controlled joint, whether the fingers are
+        open.
     """
     out = []
     for ph in plan.phases:

@@ -39,6 +39,7 @@ __all__ = [
     "body_style",
     "figure_legend",
     "finger_colour",
+    "joint_colour",
     "legend_below",
     "legend_right",
     "mode_set_colour",
@@ -84,6 +85,14 @@ A4_LANDSCAPE = (11.69, 8.27)
 def finger_colour(name: str) -> str:
     """The edge colour of finger ``name`` (:data:`FINGER`); other joints of a chain get purple."""
     return FINGER.get(str(name), _OTHER_BODY[1])
+
+
+def joint_colour(hand, name: str) -> str:
+    """The colour of joint ``name`` of ``hand``: its finger's (:data:`FINGER`; a chain hand's links share their
+    finger's colour)."""
+    from qsplan.hands.interface import finger_of_joint
+
+    return finger_colour(finger_of_joint(hand).get(str(name), name))
 
 
 def body_style(name: str) -> tuple:

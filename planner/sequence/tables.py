@@ -6,8 +6,11 @@ dense sweep does (:func:`qsplan.planner.planning.contact_state.check_contact_sta
 four contacts exist (the grasp's closed form), the joints inside their limits, no two bodies
 overlapping (:mod:`qsplan.planner.planning.collision`), and for each effort-controlled finger
 and each direction of the slide the guaranteed 4S band with every competitor precluded
-(:func:`qsplan.mechanics.bands.batched_robust.robust_bands`, batched over the grid; per-state
-competitors: a mode kinematically impossible at a state cannot occur there).  The tables are
+(:func:`qsplan.mechanics.bands.batched_robust.robust_band_arrays`, batched over the grid and the
+grasps; per-state competitors: a mode kinematically impossible at a state cannot occur there).
+The scenes are never built as objects: their arrays come from the grasp's closed form for all
+states at once (:func:`qsplan.planner.planning.grasped.grasp_scene_arrays`), a state's scene
+only where a per-state search needs it.  The tables are
 the search graph of :mod:`qsplan.planner.sequence.widest`; the plan built from the route is
 judged again sample by sample, so the tables only propose.  Units SI (m, rad, N m).
 """
@@ -38,6 +41,9 @@ _GRID_ROUNDING = 1e-9
 #: need (a slide away from the goal to where another grasp is valid); 6 cm is most of the span between
 #: the default hand's fingers (0.18 m) minus a workpiece.
 SEARCH_MARGIN = 0.06
+
+#: The scene arrays the tables stack (:class:`qsplan.hands.batch_scenes.SceneArrays`).
+_ARRAYS = ("Wn", "Wt", "Jn", "Jt", "g_obj", "g_man")
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -165,10 +171,7 @@ def band_tables(task, grasps, x, progress=None) -> BandTables:
     -------
     BandTables
     """
-    from qsplan.mechanics.bands.batched_robust import robust_bands
-
-    from qsplan.planner.planning.contact_state import MODE
-    from qsplan.planner.planning.grasped import controlled, grasp_scenes
+    from qsplan.planner.planning.grasped import grasp_scene_arrays
 
     t0 = time.perf_counter()
     x = np.asarray(x, dtype=float)
@@ -179,7 +182,7 @@ def band_tables(task, grasps, x, progress=None) -> BandTables:
     lower = np.full((G, 2, 2, n), np.nan)
     upper = np.full((G, 2, 2, n), np.nan)
     why = np.empty((G, n), dtype=object)
-    jobs, scenes = [], []  # (g, e, d, k) of every band to evaluate, and its scene
+    parts = []  # per grasp with valid configurations: (g, idx, scene arrays, generic scenes, dq_dx)
     for g, grasp in enumerate(grasps):
         conf, ok, reasons = _geometry(task, grasp, x)
         valid[g], touched[g], q[g] = ok, conf.touched, conf.q
@@ -190,23 +193,55 @@ def band_tables(task, grasps, x, progress=None) -> BandTables:
         if not idx.size:
             continue
         failed = {}
-        base = grasp_scenes(task.hand, conf, idx, 1, 0.0, failed)  # contacts found once per configuration
+        arrays, generic = grasp_scene_arrays(task.hand, conf, idx, failed)  # contacts found once per configuration
         for k, why_not in failed.items():  # no four-contact scene there: not a configuration of this grasp
             valid[g, idx[k]] = False
             why[g, idx[k]] = why_not
-        keep = [k for k in range(len(idx)) if k not in failed]
-        base, idx = [base[k] for k in keep], idx[keep]
-        for e in range(2):
+        keep = np.array([k not in failed for k in range(len(idx))], dtype=bool)
+        if keep.any():
+            rows = np.flatnonzero(keep)
+            renumber = {int(k): j for j, k in enumerate(rows)}
+            parts.append((g, idx[keep], [getattr(arrays, f)[keep] for f in _ARRAYS],
+                          {renumber[k]: s for k, s in generic.items() if k in renumber}, conf.dq_dx[idx[keep]]))  # fmt: skip
+    band_states = 0
+    for e in range(2):  # one batch per effort finger: the states of every grasp and direction
+        if parts:
+            b = _effort_bands(task, parts, e)
+            band_states += b.lower.size
+            at = 0
             for d in range(2):
-                xdot = (1.0 if d else -1.0) * task.workpiece_speed
-                scenes += [controlled(b, e, conf.dq_dx[k, 1 - e] * xdot) for b, k in zip(base, idx)]
-                jobs += [(g, e, d, k) for k in idx]
-    # one call: the states of every grasp and direction with the same effort finger form one batch
-    bands = robust_bands(scenes, MODE, task.mu_range, shared=task.shared_mu, force_margin=task.force_margin) if scenes else []
-    for (g, e, d, k), b in zip(jobs, bands):
-        if b.feasible:
-            lower[g, e, d, k], upper[g, e, d, k] = b.lower, b.upper
-    band_states = len(scenes)
+                for g, idx, *_ in parts:
+                    part = slice(at, at + idx.size)
+                    at += idx.size
+                    lower[g, e, d, idx], upper[g, e, d, idx] = b.lower[part], b.upper[part]
     width = np.where(np.isnan(lower) | np.isnan(upper), -np.inf, upper - lower)
     graph = SearchGraph(valid, touched, width, float(task.torque_resolution))
     return BandTables(tuple(grasps), x, graph, q, lower, upper, why, G * n, band_states, time.perf_counter() - t0)
+
+
+def _effort_bands(task, parts, e: int):
+    """The guaranteed 4S bands, competitors precluded, of every configuration of ``parts`` with finger ``e``
+    effort-controlled, moving left (``d = 0``) then right (``d = 1``): one :class:`StateBatch` from the arrays,
+    :func:`qsplan.mechanics.bands.batched_robust.robust_band_arrays` (NaN edges where there is no band)."""
+    from qsplan.hands.two_finger_analytic import scene_from_arrays
+    from qsplan.mechanics.bands.batched import LazyScenes, batch_from_arrays
+    from qsplan.mechanics.bands.batched_robust import robust_band_arrays
+
+    from qsplan.planner.planning.contact_state import MODE
+    from qsplan.planner.planning.grasped import controlled
+
+    effort = np.arange(2) == e
+    speeds = [(1.0 if d else -1.0) * task.workpiece_speed for d in range(2)]
+    stacked = [np.concatenate([arrays[i] for _ in speeds for _, _, arrays, _, _ in parts]) for i in range(len(_ARRAYS))]
+    velocity = np.concatenate([dq_dx[:, 1 - e] * xdot for xdot in speeds for *_, dq_dx in parts])
+    where = [(generic, k) for _ in speeds for _, idx, _, generic, _ in parts for k in range(idx.size)]
+
+    def scene(s):  # the scene of state s, as grasp_scenes and controlled build it (a per-state search needs it)
+        generic, k = where[s]
+        if k in generic:
+            return controlled(generic[k], e, velocity[s])
+        return scene_from_arrays(task.hand, *(a[s].copy() for a in stacked), effort, velocity[s], 0.0)
+
+    joint_velocity = np.where(effort, np.nan, velocity[:, None])
+    batch = batch_from_arrays(LazyScenes(velocity.size, scene), *stacked, joint_velocity)
+    return robust_band_arrays(batch, MODE, task.mu_range, shared=task.shared_mu, force_margin=task.force_margin)

@@ -2,15 +2,18 @@
 
 Wherever the generic path (:func:`qsplan.mechanics.find_contacts` on the hand's polygons) builds a
 scene, ``hand_scene``'s default path gives the same one to round-off (every array, the contacts in
-the same order, the names); wherever the generic path refuses, so does the default one.
+the same order, the names); wherever the generic path refuses, so does the default one.  The
+closed form batched over states (:func:`qsplan.hands.batch_scenes.grasp_contacts_batch`, the band
+tables' path) is the one-state closed form bit for bit, and so are the scene arrays built from it.
 """
 
 import numpy as np
 import pytest
 
+from qsplan.hands.batch_scenes import checked_scene_arrays, grasp_contacts_batch, grasp_scenes
 from qsplan.hands.segments import first_segment
 from qsplan.hands.two_finger import default_hand, finger_angles, make_two_finger_hand
-from qsplan.hands.two_finger_analytic import analytic_hand_scene, grasp_contacts
+from qsplan.hands.two_finger_analytic import analytic_hand_scene, grasp_contacts, scene_from_arrays
 from qsplan.hands.two_finger_scene import hand_scene
 from qsplan.mechanics import SceneError
 from qsplan.planner.planning.task import load_task, task_paths
@@ -46,7 +49,13 @@ def test_demo_hand_along_segment_1(effort_joint, finger_mass):
     assert used == 101  # every configuration of the segment is a grasp the hand knows
 
 
-@pytest.mark.parametrize("name", sorted(task_paths()))
+def _paper_task_names() -> list:
+    """The bundled tasks of the paper's hand (a described hand has no closed-form grasps: tests/hands/test_closing.py)."""
+    return sorted(name for name, path in task_paths().items() if 'file = "' not in path.read_text()
+                  or 'file = "paper_hand"' in path.read_text())  # fmt: skip
+
+
+@pytest.mark.parametrize("name", _paper_task_names())
 def test_bundled_tasks_along_their_segments(name):
     from qsplan.hands.grasp_geometry import candidate_grasps, grasp_configurations
 
@@ -134,3 +143,93 @@ def test_the_manipulator_is_built_once_per_hand():
     hand, other = default_hand(), default_hand()
     assert hand_manipulator(hand) is hand_manipulator(hand)
     assert hand_manipulator(other) is not hand_manipulator(hand)  # hands compare by identity
+
+
+def _bits(a, b) -> bool:
+    a, b = np.asarray(a), np.asarray(b)
+    return a.shape == b.shape and a.dtype == b.dtype and a.tobytes() == b.tobytes()
+
+
+def _two_finger_tasks():
+    from qsplan.hands.two_finger import TwoFingerHand
+
+    tasks = [load_task(p) for p in task_paths().values()]
+    return [t for t in tasks if isinstance(t.hand, TwoFingerHand) and t.goal is not None]
+
+
+def _assert_batch_is_the_closed_form(hand, poses, q) -> tuple:
+    """:func:`grasp_contacts_batch` against :func:`grasp_contacts` at every state: ``(found, tips)`` counts."""
+    batch = grasp_contacts_batch(hand, poses, q)
+    found = tips = 0
+    for k in range(len(poses)):
+        one = grasp_contacts(hand, poses[k], q[k])
+        assert batch.ok[k] == (one is not None), k
+        if one is None:
+            continue
+        found += 1
+        tips += int(one.tips.sum())
+        for f in ("points", "normals", "features", "tips"):
+            assert _bits(getattr(batch, f)[k], getattr(one, f)), (k, f)
+    return found, tips
+
+
+def test_batched_closed_form_is_the_one_state_closed_form_bit_for_bit():
+    """Every grasp of the bundled goal tasks along the palm, the same turned by 1e-9 to 1e-3 rad or lifted and
+    tilted (refusals at the margins), and random polygons at their vertices of tangency."""
+    from qsplan.hands.grasp_geometry import candidate_grasps, grasp_configurations
+
+    rng = np.random.default_rng(2025)
+    found = tips = total = 0
+    for task in _two_finger_tasks():
+        xs = np.linspace(-0.15, 0.15, 121)
+        for grasp in candidate_grasps(task.hand):
+            conf = grasp_configurations(task.hand, grasp, xs)
+            poses, q = conf.poses(task.hand.rest_height)[conf.ok], conf.q[conf.ok]
+            dq = rng.choice([0.0, 1e-9, 1e-7, 1e-5, 1e-3], size=q.shape) * rng.choice([-1.0, 1.0], size=q.shape)
+            lift = np.column_stack([np.zeros(len(poses)), rng.choice([0.0, 2e-7, 5e-6], len(poses)),
+                                    rng.choice([0.0, 1e-4], len(poses))])  # fmt: skip
+            for p, a in ((poses, q), (poses, q + dq), (poses + lift, q)):
+                counts = _assert_batch_is_the_closed_form(task.hand, p, a)
+                found, tips, total = found + counts[0], tips + counts[1], total + len(p)
+    hands = [h for h in (_random_hand(rng) for _ in range(30)) if h is not None][:8]
+    for hand in hands:
+        poses = np.column_stack([rng.uniform(-0.06, 0.06, 40), np.full(40, hand.rest_height), np.zeros(40)])
+        q = np.array([finger_angles(hand, p)[0] if _reaches(hand, p) else [np.nan, np.nan] for p in poses])
+        counts = _assert_batch_is_the_closed_form(hand, poses, q)
+        found, tips, total = found + counts[0], tips + counts[1], total + len(poses)
+    assert found > 500 and tips > 50 and total - found > 300  # contacts found, fingertips among them, and refusals
+
+
+def _reaches(hand, pose) -> bool:
+    try:
+        finger_angles(hand, pose)
+    except SceneError:
+        return False
+    return True
+
+
+def test_checked_scene_arrays_are_the_scenes_of_grasp_scenes():
+    """The band tables' arrays (no object per state) are the arrays of the scenes the one-state path builds, bit
+    for bit, and :func:`scene_from_arrays` rebuilds those scenes."""
+    from qsplan.hands.grasp_geometry import candidate_grasps, grasp_configurations
+
+    used = 0
+    for task in _two_finger_tasks():
+        hand = task.hand
+        for grasp in candidate_grasps(hand):
+            conf = grasp_configurations(hand, grasp, np.linspace(-0.12, 0.12, 97))
+            arrays, ok = checked_scene_arrays(hand, conf)
+            scenes = grasp_scenes(hand, conf, "left", -0.02)
+            for k, scene in enumerate(scenes):
+                assert ok[k] == (scene is not None), k
+                if scene is None:
+                    continue
+                used += 1
+                rows = [getattr(arrays, f)[k] for f in ("Wn", "Wt", "Jn", "Jt", "g_obj", "g_man")]
+                for f, row in zip(("Wn", "Wt", "Jn", "Jt", "g_obj", "g_man"), rows):
+                    assert _bits(row, getattr(scene, f)), f
+                again = scene_from_arrays(hand, *rows, scene.effort_controlled, conf.dq_dx[k, 1] * -0.02)
+                for f in ("mu", "effort_controlled", "joint_velocity", "joint_effort"):
+                    assert _bits(getattr(again, f), getattr(scene, f)), f
+                assert (again.joint_names, again.contact_names) == (scene.joint_names, scene.contact_names)
+    assert used > 150

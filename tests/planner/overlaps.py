@@ -4,7 +4,9 @@ Rebuilds every body of a row of ``plan.csv`` from the hand's dimensions alone (f
 rectangles from the joint axes, lengths and widths; the palm slab; the workpiece from
 :func:`qsplan.hands.two_finger.workpiece_world` at the row's pose) and measures each
 pair's overlap with shapely, so that a bug in
-:mod:`qsplan.planner.planning.collision` cannot hide itself.
+:mod:`qsplan.planner.planning.collision` cannot hide itself.  A described hand's bodies
+(:class:`qsplan.hands.chain_hand.ChainHand`) come from its description: the palm polygon and
+each link's polygon placed by :func:`qsplan.mechanics.model.manipulator.link_polygons`.
 """
 
 from __future__ import annotations
@@ -50,9 +52,39 @@ def row_bodies(hand, pose, q) -> dict:
             "workpiece": Polygon(workpiece_world(hand, pose))}  # fmt: skip
 
 
+def _chain_overlaps(hand, pose, q) -> list:
+    """:func:`row_overlaps` of a described hand: every pair of palm, links and workpiece; a revolute joint's link and
+    its carrier (the palm or the parent link) outside a disk of 1.2 link widths about the joint's axis."""
+    from qsplan.mechanics.model.manipulator import link_polygons, link_poses
+
+    man = hand.manipulator
+    links = link_polygons(man, q)
+    bodies = {"palm": Polygon(man.base_shape), "workpiece": Polygon(workpiece_world(hand, pose))}
+    bodies.update((j.name, p) for j, p in zip(man.joints, links))
+    axes = link_poses(man, q)[:, :2]
+    carrier = {j.name: ("palm" if j.parent < 0 else man.joints[j.parent].name, i) for i, j in enumerate(man.joints)
+               if j.kind == "revolute"}  # fmt: skip
+    out = []
+    for a, b in combinations(bodies, 2):
+        region = bodies[a].intersection(bodies[b])
+        for link, other in ((a, b), (b, a)):
+            if link in carrier and carrier[link][0] == other:
+                i = carrier[link][1]
+                y = np.asarray(man.joints[i].link_shape)[:, 1]
+                region = region.difference(Point(axes[i]).buffer(1.2 * float(y.max() - y.min())))
+        if region.is_empty or region.area <= 0:
+            continue
+        d = _depth(region)
+        if d > DEPTH:
+            out.append((a, b, region.area, d))
+    return out
+
+
 def row_overlaps(hand, pose, q) -> list:
     """``[(body, body, area m^2, depth m)]`` of every pair overlapping deeper than :data:`DEPTH`; a finger
     and the palm are compared outside a disk of 1.2 finger widths about the joint (the joint housing)."""
+    if hasattr(hand, "description"):  # a described hand
+        return _chain_overlaps(hand, pose, q)
     bodies = row_bodies(hand, pose, q)
     out = []
     for a, b in combinations(bodies, 2):
@@ -73,7 +105,8 @@ def plan_overlaps(hand, cols) -> list:
     out = []
     for k in range(len(cols["t"])):
         pose = np.array([cols["x_workpiece"][k], cols["y_workpiece"][k], cols["theta_workpiece"][k]])
-        q = np.array([cols["q_left"][k], cols["q_right"][k]])
+        names = hand.joint_names if hasattr(hand, "description") else ("left", "right")
+        q = np.array([cols[f"q_{n}"][k] for n in names])
         out += [(k, *o) for o in row_overlaps(hand, pose, q)]
     return out
 
