@@ -21,7 +21,7 @@ import numpy as np
 from qsplan.mechanics.errors import QsplanError
 
 from qsplan.planner.manifold.slide import free_grid, plan_slide
-from qsplan.planner.manifold.states import closed_state, judge_states, motion_mode, slip_signs, state_problem
+from qsplan.planner.manifold.states import check_state, closed_state, judge_states, motion_mode, slip_signs
 from qsplan.planner.planning.failure import configuration_report
 from qsplan.planner.planning.results import Plan, PlanFailure
 
@@ -61,9 +61,9 @@ def start_grasps(task, x: float, features=(None, None)) -> list:
     the same features :data:`STABLE_DX` either side (:func:`_stable`)."""
     out = []
     for q in free_grid(task):
-        if state_problem(task, x, q) is not None:
+        qc, keys, why = check_state(task, x, q)
+        if why is not None:
             continue
-        qc, keys, _, _ = closed_state(task.hand, x, q)
         if all(_feature_ok(task.hand, keys[f], features[f]) for f in range(2)) and _stable(task, x, q, keys):
             out.append((qc, keys))
     return out
@@ -86,8 +86,8 @@ def _held(task, starts, x: float) -> list:
     follow the workpiece), where valid: ``[(q, keys)]``."""
     out = []
     for q, _ in starts:
-        if state_problem(task, x, q) is None:
-            qc, keys, _, _ = closed_state(task.hand, x, q)
+        qc, keys, why = check_state(task, x, q)
+        if why is None:
             out.append((qc, keys))
     return out
 
@@ -196,10 +196,9 @@ def plan_chain_task(task, options=None, progress=None) -> Plan:
     t_start = time.perf_counter()
     hand, x0, x1 = task.hand, task.start_x, task.goal.x
     if task.start_joints is not None:
-        why = state_problem(task, x0, task.start_joints)
+        qc, keys, why = check_state(task, x0, task.start_joints)
         if why:
             raise PlanFailure(configuration_report(task, "slide 1", "the start", x0, None, why))
-        qc, keys, _, _ = closed_state(hand, x0, task.start_joints)
         starts = [(qc, keys)]
     else:
         starts = start_grasps(task, x0)

@@ -5,7 +5,7 @@ finger's closing joint opens (:data:`OPENING`, against its closing direction), O
 collision-free motion of all joints to the new grasp opened, and the fingers close.  Every leg is
 planned by :func:`qsplan.planner.planning.ompl_bridge.plan_path` over the joint box with validity
 "inside the limits and no two bodies overlapping" (the fingers may touch the workpiece, within the
-contact tolerance, :func:`qsplan.planner.planning.collision.find_collisions`); the lines between the
+contact tolerance, :func:`qsplan.planner.manifold.states.free_problem`); the lines between the
 exported rows are checked again every :data:`ROW_STEP` of joint motion.  Units SI.
 """
 
@@ -13,10 +13,11 @@ from __future__ import annotations
 
 import numpy as np
 
+from qsplan.planner.manifold.states import free_problem
 from qsplan.planner.planning.failure import configuration_report
 from qsplan.planner.planning.results import PlanFailure, RegraspPlan
 
-__all__ = ["OPENING", "ROW_STEP", "chain_regrasp", "free_problem", "opening_vector"]
+__all__ = ["OPENING", "ROW_STEP", "chain_regrasp", "opening_vector"]
 
 #: How far each finger's closing joint opens to let go (rad for a revolute joint, m for a prismatic one):
 #: 0.1 rad is about 7 mm at the tip of a 7 cm link; 5 mm of jaw travel.  Both far above the contact tolerance
@@ -40,19 +41,6 @@ def opening_vector(hand, q) -> np.ndarray:
         qm[k] = 0.5 * (lim[k, 0] + lim[k, 1])
         out[k] = -closing_direction(man, qm, k, side) * OPENING[man.joints[k].kind]
     return out
-
-
-def free_problem(task, x: float, q) -> str | None:
-    """Why the free-space configuration ``q`` with the workpiece at ``x`` is invalid, or None."""
-    from qsplan.planner.planning.collision import find_collisions
-
-    lim = task.joint_limits
-    out = (q < lim[:, 0]) | (q > lim[:, 1])
-    if out.any():
-        j = int(np.flatnonzero(out)[0])
-        return f"joint {task.hand.joint_names[j]} at {q[j]:.6g} outside its limits {lim[j].tolist()}"
-    hits = find_collisions(task.hand, task.pose(x), q, first=True)
-    return f"collision: {hits[0]}" if hits else None
 
 
 def chain_regrasp(task, name, x, q_from, q_to, t0, options, progress, counters) -> RegraspPlan:

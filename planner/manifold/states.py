@@ -24,8 +24,8 @@ import numpy as np
 
 from qsplan.mechanics.errors import QsplanError
 
-__all__ = ["SLIP_TOL", "JudgedStates", "closed_state", "closing_rates", "judge_states", "motion_mode", "slip_signs",
-           "state_problem"]
+__all__ = ["SLIP_TOL", "JudgedStates", "check_state", "closed_state", "closing_rates", "free_problem", "judge_states",
+           "motion_mode", "slip_signs", "state_problem"]
 
 #: Tangential speed (m/s), relative to the workpiece's speed, below which a contact rolls rather than
 #: slides: the rates of a rolling contact compute as ~1e-16 of the speed; a sliding finger contact of the
@@ -78,27 +78,37 @@ def closed_state(hand, x: float, q) -> tuple:
     return qc, tuple(c.key for c in closed), any(c.flush for c in closed), None
 
 
-def state_problem(task, x: float, q, keys=None) -> str | None:
-    """Why the closed state at ``x`` (free joints of ``q``) is no state of a slide with contact ``keys`` (None: any),
-    or None: a grasp with one contact per finger, not flush, the same features, limits, no collision."""
+def free_problem(task, x: float, q) -> str | None:
+    """Why the configuration ``q`` (n_j,) with the workpiece at ``x`` is invalid, or None: inside the limits and no
+    two bodies overlapping (the fingers may touch the workpiece, :func:`qsplan.planner.planning.collision.find_collisions`)."""
     from qsplan.planner.planning.collision import find_collisions
 
-    qc, got, flush, problem = closed_state(task.hand, x, q)
-    if problem:
-        return problem
-    if keys is not None and got != tuple(keys):
-        return f"the fingers touch {got}, not the grasp's {tuple(keys)} (a contact change)"
-    if flush:
-        return "a link lies flush with a workpiece edge (two contacts on one finger)"
     lim = task.joint_limits
-    out = (qc < lim[:, 0]) | (qc > lim[:, 1])
+    out = (q < lim[:, 0]) | (q > lim[:, 1])
     if out.any():
         j = int(np.flatnonzero(out)[0])
-        return f"joint {task.hand.joint_names[j]} at {qc[j]:.6g} outside its limits {lim[j].tolist()}"
-    hits = find_collisions(task.hand, task.pose(x), qc, first=True)
-    if hits:
-        return f"collision: {hits[0]}"
-    return None
+        return f"joint {task.hand.joint_names[j]} at {q[j]:.6g} outside its limits {lim[j].tolist()}"
+    hits = find_collisions(task.hand, task.pose(x), q, first=True)
+    return f"collision: {hits[0]}" if hits else None
+
+
+def check_state(task, x: float, q, keys=None) -> tuple:
+    """The closed state at ``x`` (free joints of ``q``) judged as a state of a slide with contact ``keys`` (None: any):
+    ``(q closed, keys, problem)``, ``problem`` None for a grasp with one contact per finger, not flush, the same
+    features, inside the limits and free of collisions (:func:`free_problem`), else why not (in words)."""
+    qc, got, flush, problem = closed_state(task.hand, x, q)
+    if problem:
+        return None, None, problem
+    if keys is not None and got != tuple(keys):
+        return qc, got, f"the fingers touch {got}, not the grasp's {tuple(keys)} (a contact change)"
+    if flush:
+        return qc, got, "a link lies flush with a workpiece edge (two contacts on one finger)"
+    return qc, got, free_problem(task, x, qc)
+
+
+def state_problem(task, x: float, q, keys=None) -> str | None:
+    """Why the closed state at ``x`` is no state of a slide with contact ``keys``, or None (:func:`check_state`)."""
+    return check_state(task, x, q, keys)[2]
 
 
 def closing_rates(hand, scene, qd, xdot: float) -> np.ndarray:
@@ -172,11 +182,10 @@ def judge_states(task, x, q_free, rates_free, xdot: float, effort: int, keys, mo
     q, qd = np.full((n, n_j), np.nan), np.full((n, n_j), np.nan)
     reasons, scenes = [None] * n, [None] * n
     for k in range(n):
-        why = state_problem(task, x[k], q_free[k], keys)
+        qk, _, why = check_state(task, x[k], q_free[k], keys)
         if why:
             reasons[k] = why
             continue
-        qk = closed_state(task.hand, x[k], q_free[k])[0]
         try:
             s0 = _scene(task, x[k], qk, np.zeros(n_j), effort)
             qdk = closing_rates(task.hand, s0, rates_free[k], xdot)
