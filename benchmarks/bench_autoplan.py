@@ -30,8 +30,9 @@ def search_rows(task, iterations):
     from qsplan.planner.sequence.autoplan import goal_nodes, start_nodes
 
     t0 = time.perf_counter()
-    tables = band_tables(task, candidate_grasps(task.hand), table_grid(task.start_x, task.goal.x,
-                                                                       float(task.hand.palm_halfwidth)))  # fmt: skip
+    from qsplan.planner.planning.goal import palm_x_range
+
+    tables = band_tables(task, candidate_grasps(task.hand), table_grid(task.start_x, task.goal.x, palm_x_range(task.hand)))
     t_tables = time.perf_counter() - t0
     starts, goals = start_nodes(tables, task), goal_nodes(tables, task)
     rows = []

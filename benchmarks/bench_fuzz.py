@@ -1,8 +1,10 @@
 """Benchmark: the input fuzzer of ``tests/test_fuzz.py`` at 10,000 cases, with a table of outcomes.
 
 Mutated scene files (through ``modes``, ``partition``, ``band``, ``muspace``), mutated task files
-(through ``plan`` up to planning; OMPL itself is stubbed) and hostile command-line options, each run
-in-process through ``qsplan``'s ``main`` with a time bound (:mod:`tests.fuzzing`).  Prints one row per
+(through ``plan`` up to planning; OMPL itself is stubbed), mutated hand files (through ``hands`` and
+through a task naming the file), deep TOML dotted keys in scene, task and hand files, and hostile
+command-line options, each run in-process through ``qsplan``'s ``main`` with a time bound
+(:mod:`tests.fuzzing`; the kinds' shares are its ``CASE_MIX``).  Prints one row per
 (kind, outcome) with its count, the slowest case, and every non-clean case (tracebacks, multi-line
 exit-2 errors, timeouts), so a regression names its input.  Exit status 1 when any case is not clean.
 

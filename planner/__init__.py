@@ -38,6 +38,7 @@ _LAZY = {
     "make_task": "qsplan.planner.planning.task",
     "demo_task_path": "qsplan.planner.planning.task",
     "task_paths": "qsplan.planner.planning.task",
+    "task_path": "qsplan.planner.planning.task",
     # planning
     "plan_task": "qsplan.planner.planning.plan",
     "DEFAULT_OPTIONS": "qsplan.planner.planning.plan",

@@ -1,4 +1,10 @@
-"""A seeded mutation fuzzer of qsplan's inputs: scene files, task files and command-line options (issue 12).
+"""A seeded mutation fuzzer of qsplan's inputs: scene, task and hand files and command-line options (issues 12, 21).
+
+Hand files (the bundled ``hands/data/*.toml``, mutated as data and as text: numbers scaled by 1e3, 1e-3,
+1e5, written in degrees or millimetres, fields deleted or duplicated) run through ``qsplan hands FILE``
+and through a task whose ``[hand]`` names the file (``file = "hand.toml"``).  Dotted keys (``a.a.a...``
+bare, quoted or spaced, in key/value lines, inline tables and ``[table.headers]``, from 13 to 20,000
+levels) are put into valid scene, task and hand files.
 
 Shared by ``tests/test_fuzz.py`` (a few hundred cases) and ``benchmarks/bench_fuzz.py`` (10,000).
 Each case is a command line run in-process through :func:`qsplan.planner.cli.main.main` with
@@ -20,6 +26,7 @@ import io
 import json
 import math
 import random
+import re
 import signal
 import time
 import tomllib
@@ -68,6 +75,16 @@ def seed_scenes() -> dict:
 def seed_tasks() -> dict:
     """``{name: document}`` of the bundled task files."""
     return {p.stem: tomllib.loads(p.read_text()) for p in sorted((ROOT / "planner" / "data").glob("*.toml"))}
+
+
+def seed_hands() -> dict:
+    """``{name: text}`` of the bundled hand files, with the task that uses each (its ``[hand] file``)."""
+    tasks = seed_tasks()
+    out = {}
+    for p in sorted((ROOT / "hands" / "data").glob("*.toml")):
+        users = [t for t, doc in tasks.items() if doc.get("hand", {}).get("file") == p.stem]
+        out[p.stem] = (p.read_text(), tasks[users[0]] if users else None)
+    return out
 
 
 def toml_text(doc: dict) -> str:
@@ -138,6 +155,74 @@ def mutate_document(doc, rng: random.Random, n_mutations: int = 2):
     return doc
 
 
+#: Factors of the unit slips and typos a hand file's numbers get: kilo, milli, 1e5, degrees.
+SCALES = [1e3, 1e-3, 1e5, 180.0 / math.pi, -1.0]
+
+_NUMBER = re.compile(r"(?<![\w.])-?\d+(?:\.\d+)?(?:[eE][-+]?\d+)?(?![\w.])")
+
+
+def scale_numbers(doc, rng: random.Random):
+    """A copy of ``doc`` with one number, or every number of one list (a polygon, limits), scaled by a slip."""
+    doc = json.loads(json.dumps(doc))
+    paths = [p for p, v in _paths(doc) if p and (_is_number(v) or (isinstance(v, list) and v))]
+    if not paths:
+        return doc
+    path = rng.choice(paths)
+    parent, key, factor = _parent(doc, path), path[-1], rng.choice(SCALES)
+
+    def scaled(v):
+        return [scaled(x) for x in v] if isinstance(v, list) else v * factor if _is_number(v) else v
+
+    parent[key] = scaled(parent[key])
+    return doc
+
+
+def _is_number(v) -> bool:
+    return isinstance(v, (int, float)) and not isinstance(v, bool) and abs(v) < 1e300
+
+
+def mutate_text(text: str, rng: random.Random) -> str:
+    """A TOML text edited as text: a number scaled, a line deleted or repeated, a header or a dotted key added."""
+    lines = text.splitlines()
+    op = rng.random()
+    if op < 0.4:
+        numbers = list(_NUMBER.finditer(text))
+        if numbers:
+            m = rng.choice(numbers)
+            return text[: m.start()] + repr(float(m.group()) * rng.choice(SCALES)) + text[m.end():]
+    if op < 0.6 and lines:
+        del lines[rng.randrange(len(lines))]
+    elif op < 0.8 and lines:
+        k = rng.randrange(len(lines))
+        lines.insert(k, lines[k])  # a duplicated key, header or table
+    else:
+        return dotted_text(text, rng)
+    return "\n".join(lines) + "\n"
+
+
+#: How deep the fuzzer's dotted keys go: just past MAX_DEPTH, past Python's recursion limit, 40 kB.
+DOTTED_DEPTHS = [13, 50, 1200, 20000]
+
+
+def dotted_key(depth: int, rng: random.Random) -> str:
+    """A key path of ``depth`` keys: bare, quoted (basic or literal) or spaced around the dots."""
+    style = rng.choice(["bare", "basic", "literal", "spaced", "mixed"])
+    keys = {"bare": ["a"] * depth, "basic": ['"a"'] * depth, "literal": ["'a'"] * depth, "spaced": ["a"] * depth,
+            "mixed": [rng.choice(["a", '"b.c"', "'d'", "e-1"]) for _ in range(depth)]}[style]  # fmt: skip
+    return (" . " if style == "spaced" else ".").join(keys)
+
+
+def dotted_text(text: str, rng: random.Random, depth: int | None = None) -> str:
+    """``text`` (a valid TOML file) with a deep dotted key put in: a key/value line, an inline table or a header."""
+    key = dotted_key(depth or rng.choice(DOTTED_DEPTHS), rng)
+    where = rng.choice(["line", "inline", "header", "array-header", "under"])
+    extra = {"line": f"{key} = 1\n", "inline": f"zz = {{ {key} = 1 }}\n", "header": f"[{key}]\nx = 1\n",
+             "array-header": f"[[{key}]]\nx = 1\n", "under": f"name.{key} = 1\n"}[where]  # fmt: skip
+    # before the first table header (a key/value line must not land in a table), or after everything
+    head, sep, tail = text.partition("\n[")
+    return extra + text if where in ("header", "array-header") or not sep else head + "\n" + extra + sep[1:] + tail
+
+
 def encode(doc, suffix: str, rng: random.Random) -> bytes:
     """Serialise ``doc`` (JSON or TOML), sometimes damaged at the byte level."""
     text = toml_text(doc) if suffix == ".toml" else json.dumps(doc)
@@ -181,6 +266,39 @@ def task_case(rng: random.Random, seeds: dict) -> dict:
             "suffix": ".toml"}  # fmt: skip
 
 
+def hand_case(rng: random.Random, seeds: dict) -> dict:
+    """A mutated bundled hand file through ``qsplan hands FILE``, or through a task naming it (``plan``)."""
+    name = rng.choice(sorted(seeds))
+    text, task = seeds[name]
+    r = rng.random()
+    if r < 0.35:
+        text = toml_text(scale_numbers(tomllib.loads(text), rng))
+    elif r < 0.55:
+        text = toml_text(mutate_document(tomllib.loads(text), rng, rng.randint(1, 2)))
+    else:
+        text = mutate_text(text, rng)
+    data = text.encode() if rng.random() < 0.9 else encode({}, ".toml", rng)
+    if task is None or rng.random() < 0.5:
+        return {"kind": "hand", "argv": ["hands", "FILE"], "file": data, "suffix": ".toml"}
+    task = json.loads(json.dumps(task))
+    task["hand"]["file"] = "hand.toml"  # relative to the task file's folder
+    return {"kind": "hand", "argv": ["plan", "FILE", "--out", "OUT", "--quiet", "--no-plots"],
+            "file": toml_text(task).encode(), "suffix": ".toml", "extra": {"hand.toml": data}}  # fmt: skip
+
+
+def dotted_case(rng: random.Random, seeds: dict) -> dict:
+    """A valid scene, task or hand file with a deep dotted key, through ``modes``, ``plan`` or ``hands``."""
+    which = rng.choice(["scene", "task", "hand"])
+    if which == "scene":
+        text, argv = toml_text(seeds["scenes"]["joints_toml"][0]), ["modes", "FILE", "--workers", "1"]
+    elif which == "task":
+        text = (ROOT / "planner" / "data" / rng.choice(["demo_task.toml", "two_link_task.toml"])).read_text()
+        argv = ["plan", "FILE", "--out", "OUT", "--quiet", "--no-plots"]
+    else:
+        text, argv = seeds["hands"][rng.choice(sorted(seeds["hands"]))][0], ["hands", "FILE"]
+    return {"kind": "dotted", "argv": argv, "file": dotted_text(text, rng).encode(), "suffix": ".toml"}
+
+
 def option_case(rng: random.Random, seeds: dict) -> dict:
     """A command line with hostile option values (files are valid)."""
     h = lambda: rng.choice(HOSTILE_OPTION_TEXT)  # noqa: E731
@@ -219,15 +337,26 @@ def option_case(rng: random.Random, seeds: dict) -> dict:
     return {"kind": "option", "argv": ["verify", "OUT", "--random", h(), "--seed", h()]}
 
 
+#: The share of each kind of case (they add up to 1).
+CASE_MIX = (("scene", 0.35), ("task", 0.2), ("hand", 0.2), ("dotted", 0.1), ("option", 0.15))
+
+
 def make_cases(seed: int, n: int) -> list:
-    """``n`` seeded cases: about 45% scene files, 30% task files, 25% command-line options."""
+    """``n`` seeded cases, of each kind in the shares of :data:`CASE_MIX`."""
     rng = random.Random(seed)
-    scenes, tasks = seed_scenes(), seed_tasks()
+    seeds = {"scenes": seed_scenes(), "tasks": seed_tasks(), "hands": seed_hands()}
+    makers = {"scene": (scene_case, "scenes"), "task": (task_case, "tasks"), "hand": (hand_case, "hands"),
+              "dotted": (dotted_case, None), "option": (option_case, "scenes")}  # fmt: skip
     out = []
     for _ in range(n):
-        r = rng.random()
-        make = scene_case if r < 0.45 else task_case if r < 0.75 else option_case
-        out.append(make(rng, scenes if make is not task_case else tasks))
+        r, kind = rng.random(), CASE_MIX[-1][0]
+        for k, share in CASE_MIX:
+            if r < share:
+                kind = k
+                break
+            r -= share
+        make, key = makers[kind]
+        out.append(make(rng, seeds if key is None else seeds[key]))
     return out
 
 
@@ -246,6 +375,8 @@ def run_case(case: dict, workdir: Path, timeout: float = 10.0) -> tuple:
         path = workdir / f"input{case['suffix']}"
         path.write_bytes(case["file"])
         argv = [str(path) if a == "FILE" else a for a in argv]
+    for name, data in case.get("extra", {}).items():  # files the input names (a task's hand file)
+        (workdir / name).write_bytes(data)
     argv = [str(workdir / "out") if a == "OUT" else a for a in argv]
     out, err = io.StringIO(), io.StringIO()
 

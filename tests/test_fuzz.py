@@ -1,20 +1,24 @@
-"""Fuzzing the inputs (issue 12): mutated scene and task files and hostile command-line options.
+"""Fuzzing the inputs (issues 12, 21): mutated scene, task and hand files, TOML dotted keys, hostile options.
 
 Every outcome is a clean result (exit 0 or 1), a task accepted up to planning, or a one-line exit-2
 error, each within a time bound; never a traceback or a hang.  The fuzzer is :mod:`tests.fuzzing`
 (seeded); ``benchmarks/bench_fuzz.py`` runs it at 10,000 cases.  A few cases run the installed
-``qsplan`` in a subprocess, Ctrl-C included.
+``qsplan`` in a subprocess, Ctrl-C included, and deep dotted keys (1,200 levels; 40 kB) through
+``modes``, ``plan`` and ``hands``.
 """
 
 import json
+import random
 import signal
 import subprocess
 import sys
 import time
+import tomllib
 
 import pytest
 
-from tests.fuzzing import CLEAN, make_cases, run_case
+from qsplan.mechanics.model.fields import MAX_DEPTH, nesting_depth
+from tests.fuzzing import CASE_MIX, CLEAN, ROOT, dotted_key, dotted_text, make_cases, run_case, seed_scenes, toml_text
 
 #: Cases per run, and the bound on each (s): small inputs answer in well under a second.
 N_CASES = 300
@@ -37,6 +41,44 @@ def test_fuzz_cases_are_seeded():
     assert [c["argv"] for c in a] == [c["argv"] for c in b] and [c.get("file") for c in a] == [c.get("file") for c in b]
 
 
+def test_fuzz_covers_hand_files_and_dotted_keys():
+    cases = make_cases(seed=2024, n=N_CASES)
+    kinds = {c["kind"] for c in cases}
+    assert kinds == {k for k, _ in CASE_MIX} and {"hand", "dotted"} <= kinds
+    hand_commands = {c["argv"][0] for c in cases if c["kind"] == "hand"}
+    assert hand_commands == {"hands", "plan"}  # the file alone, and through a task's [hand] file = "hand.toml"
+    assert all("hand.toml" in c["extra"] for c in cases if c["kind"] == "hand" and c["argv"][0] == "plan")
+    assert {c["argv"][0] for c in cases if c["kind"] == "dotted"} == {"modes", "plan", "hands"}
+
+
+def _true_depth(value) -> int:
+    """Levels of lists and tables below ``value`` (a parsed document's value)."""
+    if isinstance(value, dict):
+        return 1 + max(map(_true_depth, value.values()), default=0)
+    if isinstance(value, list):
+        return 1 + max(map(_true_depth, value), default=0)
+    return 0
+
+
+def test_nesting_depth_of_dotted_keys_is_the_parsed_depth():
+    """The pre-parse scan equals the depth tomllib builds, for seeded deep dotted keys in every position."""
+    rng = random.Random(21)
+    base = [(ROOT / "hands" / "data" / "two_link_hand.toml").read_text(), (ROOT / "planner" / "data" / "demo_task.toml").read_text(),
+            toml_text(seed_scenes()["joints_toml"][0])]  # fmt: skip
+    for k in range(200):
+        text = dotted_text(base[k % 3], rng, depth=rng.randint(1, MAX_DEPTH + 2)).replace("name.", "name_.")
+        doc = tomllib.loads(text)
+        assert nesting_depth(text, toml=True) == max(map(_true_depth, doc.values())), text[:200]
+
+
+def test_nesting_depth_is_linear_in_a_dotted_keys_length():
+    for depth in (20_000, 1_000_000):  # 40 kB and 2 MB
+        text = dotted_key(depth, random.Random(depth)) + " = 1\n"
+        t0 = time.perf_counter()
+        assert nesting_depth(text, toml=True) == depth - 1
+        assert time.perf_counter() - t0 < 0.05 * depth / 20_000 + 0.5
+
+
 def _qsplan(*args, **kwargs):
     return subprocess.run([sys.executable, "-m", "qsplan.planner.cli", *args], capture_output=True, text=True,
                           timeout=60, **kwargs)  # fmt: skip
@@ -53,6 +95,37 @@ def test_subprocess_hostile_scene_one_line(tmp_path, data):
     path.write_bytes(data)
     p = _qsplan("modes", str(path), "--workers", "1")
     assert p.returncode == 2 and p.stderr.count("\n") == 1 and p.stderr.startswith("qsplan: error: ")
+
+
+#: Wall time (s) a subprocess may take to refuse a 40 kB dotted key: Python's start and qsplan's imports
+#: take about 0.35 s here; before the scan counted dotted keys, tomllib took 19.5 s and 1.6 GiB.
+DOTTED_SECONDS = 3.0
+
+
+@pytest.mark.parametrize("command,depth,where", [
+    ("modes", 1200, "line"), ("modes", 20_000, "header"), ("plan", 1200, "inline"), ("plan", 20_000, "line"),
+    ("hands", 1200, "array-header"), ("hands", 20_000, "line"),
+])  # fmt: skip
+def test_subprocess_deep_dotted_key_one_line(tmp_path, command, depth, where):
+    key = ".".join(["a"] * depth)  # 1,200 levels: 2.4 kB; 20,000: 40 kB
+    extra = {"line": f"{key} = 1\n", "inline": f"zz = {{ {key} = 1 }}\n", "header": f"[{key}]\nx = 1\n",
+             "array-header": f"[[{key}]]\nx = 1\n"}[where]  # fmt: skip
+    source = {"modes": toml_text(seed_scenes()["joints_toml"][0]),
+              "plan": (ROOT / "planner" / "data" / "two_link_task.toml").read_text(),
+              "hands": (ROOT / "hands" / "data" / "two_link_hand.toml").read_text()}[command]  # fmt: skip
+    path = tmp_path / "input.toml"
+    path.write_text(extra + source)
+    argv = {"modes": ["modes", str(path), "--workers", "1"], "plan": ["plan", str(path), "--out", str(tmp_path / "out")],
+            "hands": ["hands", str(path)]}[command]  # fmt: skip
+    t0 = time.perf_counter()
+    p = _qsplan(*argv)
+    elapsed = time.perf_counter() - t0
+    assert p.returncode == 2 and p.stderr.count("\n") == 1, p.stderr[-500:]
+    assert p.stderr.startswith(f"qsplan: error: {path}: ") and f"nests lists/tables {nesting_depth(extra + source, True)} deep" in p.stderr
+    assert nesting_depth(extra + source, True) >= depth - 1
+    assert p.stdout == "" and not (tmp_path / "out").exists()
+    if depth == 20_000:
+        assert elapsed < DOTTED_SECONDS
 
 
 def test_ctrl_c_leaves_no_partial_file(tmp_path):

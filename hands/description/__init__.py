@@ -11,6 +11,7 @@ from qsplan import lazy_attributes
 
 _LAZY = {
     "FINGER_NAMES": "qsplan.hands.description.model",
+    "HAND_RANGES": "qsplan.hands.description.model",
     "FingerChain": "qsplan.hands.description.model",
     "HandDescription": "qsplan.hands.description.model",
     "make_hand_description": "qsplan.hands.description.model",

@@ -9,9 +9,9 @@ limits and speed.
 
 :func:`make_hand_description` is the one validator: the file loader
 (:mod:`qsplan.hands.description.files`) and the two-finger form
-(:mod:`qsplan.hands.description.two_finger_form`) build through it.  Errors are
-:class:`~qsplan.mechanics.errors.SceneError` naming the field path, e.g.
-``fingers[0].joints[1].limits: expected [lo, hi] with lo < hi (rad); got [2, 1]``.
+(:mod:`qsplan.hands.description.two_finger_form`) build through it, every number inside its plausible
+range (:data:`HAND_RANGES`).  Errors are :class:`~qsplan.mechanics.errors.SceneError` naming the field
+path, e.g. ``fingers[0].joints[1].limits: expected [lo, hi] with lo < hi (rad); got [2, 1]``.
 
 All quantities are SI: m, kg, rad (m for a prismatic joint), rad/s (m/s), m/s^2.
 """
@@ -24,13 +24,14 @@ import numpy as np
 from shapely.geometry import Polygon
 
 from qsplan.mechanics.errors import SceneError
-from qsplan.mechanics.model.fields import number, vector
+from qsplan.mechanics.model.fields import in_range, number, short_repr, vector
 from qsplan.mechanics.model.geometry import check_polygon
 from qsplan.mechanics.model.manipulator import JOINT_KINDS, Manipulator, link_poses, make_joint, make_manipulator
 
 __all__ = [
     "FINGER_NAMES",
     "PALM_TOP_TOL",
+    "HAND_RANGES",
     "JOINT_KEYS",
     "LINK_KEYS",
     "FingerChain",
@@ -45,6 +46,37 @@ FINGER_NAMES = ("left", "right")
 #: How far (m) the palm's highest vertices may lie from ``y = 0``: decimal coordinates written in a
 #: file are exact to ~1e-17 m at hand scale, so 1e-12 m is rounding, not a tilted palm.
 PALM_TOP_TOL = 1e-12
+
+#: Plausible range ``(lo, hi, unit)`` of every number of a hand; outside it a value is a mistake (a unit
+#: slip, a typo), not a hand (100 t links were planned at -35,140 N m, 1e5 rad limits drawn).  Where the
+#: paper hand's parameter form has the quantity, the numbers are ``TASK_RANGES``'
+#: (:mod:`qsplan.planner.planning.task_fields`): a file may not allow what a task's ``[hand]`` refuses.
+HAND_RANGES = {
+    # the parameter form's palm [-P, P] x [-T, 0], P and T from a millimetre to a metre (TASK_RANGES' size)
+    "palm_vertex": (-1.0, 1.0, "m"),
+    "palm_width": (2e-3, 2.0, "m"),  # 2 P
+    "palm_thickness": (1e-3, 1.0, "m"),  # T
+    # a finger's first joint above the palm's lowest point (from under the palm no finger reaches the
+    # workpiece on top) and at most a metre (size) above it
+    "palm_joint_height": (0.0, 1.0, "m"),
+    # a joint's origin x, y: within a metre of the previous joint, whose link is at most a metre long
+    # (size); a first joint's x on a palm at most a metre either side (position)
+    "joint_offset": (-1.0, 1.0, "m"),
+    "origin_angle": (-2.0 * np.pi, 2.0 * np.pi, "rad"),  # a frame turned up to a full turn (bundled jaw: 3.40 rad)
+    # a link's polygon and centre of mass within a metre of its joint, the link a millimetre to a metre (size)
+    "link_vertex": (-1.0, 1.0, "m"),
+    "link_size": (1e-3, 1.0, "m"),  # the longer side of the link's bounding box
+    "com_offset": (-1.0, 1.0, "m"),
+    "revolute_limit": (-np.pi, np.pi, "rad"),  # joint_limit: a half turn either way
+    "prismatic_limit": (-1.0, 1.0, "m"),  # a slide of at most a metre either way (position)
+    "revolute_speed": (1e-3, 10.0, "rad/s"),  # joint_speed: slower is holding still; 10 is a fast servo
+    # workpiece_speed: a jaw carries the workpiece along; beyond 0.5 m/s its inertia breaks the quasistatic model
+    "prismatic_speed": (1e-4, 0.5, "m/s"),
+    "link_mass": (0.0, 100.0, "kg"),  # finger_mass
+    "gravity": (0.0, 100.0, "m/s^2"),  # gravity: Earth's 9.81; 100 is 10 g
+    "joints_per_finger": (1, 6, "joints"),  # a human finger has four; the planner's state holds every free joint
+    "polygon_vertices": (3, 64, "vertices"),  # as a task's workpiece: collision checks visit every edge
+}
 
 #: The fields of a joint table, and of its link table.
 JOINT_KEYS = ("name", "type", "origin", "limits", "speed", "link")
@@ -188,12 +220,13 @@ def check_unknown(table, allowed, prefix: str) -> None:
     """Refuse a key of ``table`` outside ``allowed``, naming its path (``prefix.key``)."""
     unknown = sorted(set(table) - set(allowed), key=str)
     if unknown:
-        raise SceneError(f"{_path(prefix, str(unknown[0]))}: unknown field; expected some of {', '.join(allowed)}")
+        key = str(unknown[0]) if len(str(unknown[0])) <= 40 else short_repr(str(unknown[0]))  # a 4 MB key: one short line
+        raise SceneError(f"{_path(prefix, key)}: unknown field; expected some of {', '.join(allowed)}")
 
 
 def _table(value, field: str) -> dict:
     if not isinstance(value, dict):
-        raise SceneError(f"{field}: expected a table; got {_short(value)}")
+        raise SceneError(f"{field}: expected a table; got {short_repr(value)}")
     return value
 
 
@@ -203,16 +236,21 @@ def _required(table: dict, key: str, prefix: str, what: str):
     return table[key]
 
 
-def _short(value) -> str:
-    text = repr(value)
-    return text if len(text) <= 40 else text[:20] + "..." + text[-10:]
+def _ranged(value, field: str, kind: str, shift: float = 0.0, where: str = "", slips: bool = True):
+    """``value`` inside ``HAND_RANGES[kind]`` (moved by ``shift``): :func:`in_range`, which names a unit slip."""
+    lo, hi, unit = HAND_RANGES[kind]
+    source = f"qsplan.hands.description.model.HAND_RANGES[{kind!r}]{where}"
+    return in_range(value, field, lo + shift, hi + shift, unit, source, SceneError, slips)
 
 
-def _polygon(value, field: str) -> np.ndarray:
+def _polygon(value, field: str, kind: str) -> np.ndarray:
+    """A polygon whose vertices lie in ``HAND_RANGES[kind]`` (m)."""
     value = _plain(value)
     if not isinstance(value, (list, tuple)):
-        raise SceneError(f"{field}: expected a polygon, a list of [x, y] vertices (m); got {_short(value)}")
-    vertices = [vector(_plain(p), f"{field}[{i}]", 2) for i, p in enumerate(value)]
+        raise SceneError(f"{field}: expected a polygon, a list of [x, y] vertices (m); got {short_repr(value)}")
+    if len(value) > HAND_RANGES["polygon_vertices"][1]:  # fewer than 3 distinct ones: check_polygon says so
+        _ranged(len(value), f"{field} (its number of vertices)", "polygon_vertices")
+    vertices = [_ranged(vector(_plain(p), f"{field}[{i}]", 2, np.inf), f"{field}[{i}]", kind) for i, p in enumerate(value)]
     return check_polygon(np.array(vertices).reshape(-1, 2), field)
 
 
@@ -223,7 +261,7 @@ def _palm(palm, prefix: str) -> np.ndarray:
         check_unknown(palm, ("polygon",), field)
         field = _path(field, "polygon")
         palm = _required(palm, "polygon", _path(prefix, "palm"), "the palm polygon [[x, y], ...] (m)")
-    v = _polygon(palm, field)
+    v = _polygon(palm, field, "palm_vertex")
     top = np.abs(v[:, 1]) <= PALM_TOP_TOL
     y_max = float(v[:, 1].max())
     if abs(y_max) > PALM_TOP_TOL:
@@ -234,18 +272,23 @@ def _palm(palm, prefix: str) -> np.ndarray:
     edges = int(np.sum(top & np.roll(top, -1)))
     if edges != top.sum() - 1:
         raise SceneError(f"{field}: expected one horizontal top edge on y = 0; got {top.sum() - edges} separate pieces")
+    _ranged(float(np.ptp(v[:, 0])), f"{field} (its width)", "palm_width", slips=False)
+    _ranged(-float(v[:, 1].min()), f"{field} (its thickness below y = 0)", "palm_thickness", slips=False)
     v = v.copy()
     v[top, 1] = 0.0
     return v
 
 
-def _joint(jd, f: str, parent: int, index: int, seen: dict):
-    """One joint table -> (Joint, limits (2,), speed); ``seen`` maps names to their field paths."""
+def _joint(jd, f: str, parent: int, index: int, seen: dict, palm_bottom: float):
+    """One joint table -> (Joint, limits (2,), speed); ``seen`` maps names to their field paths.
+
+    ``palm_bottom``: the palm's lowest y (m), below which a first joint (``parent == -1``) may not sit.
+    """
     jd = _table(jd, f)
     check_unknown(jd, JOINT_KEYS, f)
     name = _required(jd, "name", f, "a name unique in the hand")
     if not isinstance(name, str) or not name.strip():
-        raise SceneError(f"{f}.name: expected a non-empty string; got {_short(name)}")
+        raise SceneError(f"{f}.name: expected a non-empty string; got {short_repr(name)}")
     if name == "palm":
         raise SceneError(f"{f}.name: 'palm' is reserved for the palm; choose another name")
     if name in seen:
@@ -253,25 +296,34 @@ def _joint(jd, f: str, parent: int, index: int, seen: dict):
     seen[name] = f
     kind = _required(jd, "type", f, "'revolute' or 'prismatic'")
     if kind not in JOINT_KINDS:
-        raise SceneError(f"{f}.type: expected 'revolute' or 'prismatic'; got {_short(kind)}")
+        raise SceneError(f"{f}.type: expected 'revolute' or 'prismatic'; got {short_repr(kind)}")
     unit = _UNITS[kind]
     origin = vector(_plain(_required(jd, "origin", f, "[x, y, angle] (m, m, rad) in the previous link's frame")),
-                    f"{f}.origin", 3)  # fmt: skip
-    limits = vector(_plain(_required(jd, "limits", f, f"[lo, hi] ({unit})")), f"{f}.limits", 2)
+                    f"{f}.origin", 3, np.inf)  # fmt: skip
+    _ranged(origin[0], f"{f}.origin[0]", "joint_offset")
+    if parent == -1:
+        _ranged(origin[1], f"{f}.origin[1]", "palm_joint_height", palm_bottom, f" above the palm's bottom y = {palm_bottom:g} m")
+    else:
+        _ranged(origin[1], f"{f}.origin[1]", "joint_offset")
+    _ranged(origin[2], f"{f}.origin[2]", "origin_angle")
+    limits = vector(_plain(_required(jd, "limits", f, f"[lo, hi] ({unit})")), f"{f}.limits", 2, np.inf)
     if not limits[0] < limits[1]:
         raise SceneError(f"{f}.limits: expected [lo, hi] with lo < hi ({unit}); got [{limits[0]:g}, {limits[1]:g}]")
-    speed = number(_required(jd, "speed", f, f"the joint's largest speed ({unit}/s)"), f"{f}.speed")
-    if speed <= 0:
-        raise SceneError(f"{f}.speed: expected a positive speed ({unit}/s); got {speed:g}")
+    _ranged(limits, f"{f}.limits", f"{kind}_limit")
+    speed = number(_required(jd, "speed", f, f"the joint's largest speed ({unit}/s)"), f"{f}.speed", np.inf)
+    _ranged(speed, f"{f}.speed", f"{kind}_speed")  # positive
     lf = f"{f}.link"
     link = _table(_required(jd, "link", f, "the link's polygon"), lf)
     check_unknown(link, LINK_KEYS, lf)
-    shape = _polygon(_required(link, "polygon", lf, "[[x, y], ...] (m) in the link frame"), f"{lf}.polygon")
-    mass = number(link.get("mass", 0.0), f"{lf}.mass")
-    if mass < 0:
-        raise SceneError(f"{lf}.mass: expected a nonnegative mass (kg); got {mass:g}")
+    shape = _polygon(_required(link, "polygon", lf, "[[x, y], ...] (m) in the link frame"), f"{lf}.polygon", "link_vertex")
+    lower, upper = shape.min(axis=0), shape.max(axis=0)
+    _ranged(float(np.max(upper - lower)), f"{lf}.polygon (the longer side of its bounding box)", "link_size", slips=False)
+    mass = _ranged(number(link.get("mass", 0.0), f"{lf}.mass", np.inf), f"{lf}.mass", "link_mass")  # nonnegative
     if "com" in link:
-        com = vector(_plain(link["com"]), f"{lf}.com", 2)
+        com = _ranged(vector(_plain(link["com"]), f"{lf}.com", 2, np.inf), f"{lf}.com", "com_offset")
+        if np.any(com < lower - PALM_TOP_TOL) or np.any(com > upper + PALM_TOP_TOL):  # to decimal rounding
+            raise SceneError(f"{lf}.com: expected a point of the polygon's bounding box [{lower[0]:g}, {upper[0]:g}] x "
+                             f"[{lower[1]:g}, {upper[1]:g}] m (a centre of mass lies in its body); got {com.tolist()}")
     else:
         com = np.array(Polygon(shape).centroid.coords[0])
     return make_joint(name, kind, parent, origin, mass, com, shape, index=index), limits, speed
@@ -296,6 +348,7 @@ def make_hand_description(name, palm, fingers, gravity=9.81, source="inline", *,
         (rad, or m); ``speed`` > 0 (rad/s, or m/s); ``link`` ``{"polygon", "mass", "com"}`` with the
         polygon (link frame, m), the mass (kg, >= 0, default 0) and the centre of mass (link frame, m,
         default the polygon's centroid).  Joint names are unique in the hand; ``"palm"`` is reserved.
+        Every number, size and count inside :data:`HAND_RANGES`.
     gravity : float
         m/s^2 along -y, >= 0.
     source : str
@@ -309,17 +362,15 @@ def make_hand_description(name, palm, fingers, gravity=9.81, source="inline", *,
         Naming the field path, e.g. ``hand.fingers[1].joints[0].type: expected 'revolute' or 'prismatic'; got 'ball'``.
     """
     if not isinstance(name, str) or not name.strip():
-        raise SceneError(f"{_path(field, 'name')}: expected a non-empty string; got {_short(name)}")
+        raise SceneError(f"{_path(field, 'name')}: expected a non-empty string; got {short_repr(name)}")
     if not isinstance(source, str):
-        raise SceneError(f"source: expected a string; got {_short(source)}")
-    g = number(gravity, _path(field, "gravity"))
-    if g < 0:
-        raise SceneError(f"{_path(field, 'gravity')}: expected a nonnegative magnitude (m/s^2, acting along -y); got {g:g}")
+        raise SceneError(f"source: expected a string; got {short_repr(source)}")
+    g = _ranged(number(gravity, _path(field, "gravity"), np.inf), _path(field, "gravity"), "gravity")  # along -y
     palm = _palm(palm, field)
     ff = _path(field, "fingers")
     fingers = _plain(fingers)
     if not isinstance(fingers, (list, tuple)) or len(fingers) != 2:
-        got = f"{len(fingers)}" if isinstance(fingers, (list, tuple)) else _short(fingers)
+        got = f"{len(fingers)}" if isinstance(fingers, (list, tuple)) else short_repr(fingers)
         raise SceneError(f"{ff}: expected two fingers, 'left' then 'right'; got {got}")
     joints, limits, speeds, chains, seen = [], [], [], [], {}
     for k, (fd, expected) in enumerate(zip(fingers, FINGER_NAMES)):
@@ -328,14 +379,15 @@ def make_hand_description(name, palm, fingers, gravity=9.81, source="inline", *,
         check_unknown(fd, _FINGER_KEYS, f)
         got = _required(fd, "name", f, f"{expected!r}")
         if got != expected:
-            raise SceneError(f"{f}.name: expected {expected!r} (fingers are 'left' then 'right'); got {_short(got)}")
+            raise SceneError(f"{f}.name: expected {expected!r} (fingers are 'left' then 'right'); got {short_repr(got)}")
         jds = _plain(_required(fd, "joints", f, "a list of joints, base to tip"))
         if not isinstance(jds, (list, tuple)) or not jds:
-            raise SceneError(f"{f}.joints: expected a non-empty list of joints, base to tip; got {_short(jds)}")
+            raise SceneError(f"{f}.joints: expected a non-empty list of joints, base to tip; got {short_repr(jds)}")
+        _ranged(len(jds), f"{f}.joints (their number)", "joints_per_finger")
         indices = []
         for m, jd in enumerate(jds):
             parent = indices[-1] if indices else -1
-            joint, lim, speed = _joint(jd, f"{f}.joints[{m}]", parent, len(joints), seen)
+            joint, lim, speed = _joint(jd, f"{f}.joints[{m}]", parent, len(joints), seen, float(palm[:, 1].min()))
             indices.append(len(joints))
             joints.append(joint)
             limits.append(lim)

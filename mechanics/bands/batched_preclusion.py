@@ -7,7 +7,7 @@ set); its control values, point bands and lower bounds are computed for all (com
 pairs at once, by the reference's own functions
 (:func:`~qsplan.mechanics.bands.preclusion.cell_lower_bounds`,
 :func:`~qsplan.mechanics.bands.preclusion.point_bands`,
-:func:`~qsplan.mechanics.bands.preclusion.bernstein_matrix`; the rows of every competitor in one
+:func:`~qsplan.mechanics.bands.guaranteed.bernstein_matrix`; the rows of every competitor in one
 factorisation, :func:`qsplan.mechanics.bands.batched_modes.batch_rows_many`).  Where the root cell
 resolves both searches (the smallest and the largest possibly-feasible effort: the control values
 do not depend on the interval, so one evaluation serves both) the answer is the reference's; the
@@ -23,12 +23,11 @@ import numpy as np
 
 from qsplan.mechanics.bands.batched import StateBatch, take_states
 from qsplan.mechanics.bands.batched_modes import BatchKinematics, batch_kinematics, batch_rows_many
-from qsplan.mechanics.bands.guaranteed import shared_nodes
+from qsplan.mechanics.bands.guaranteed import bernstein_matrix, shared_coordinate, shared_coordinates, shared_nodes
 from qsplan.mechanics.bands.preclusion import (
     MAX_CELLS,
     PRECLUSION_RTOL,
     CompetitorTorques,
-    bernstein_matrix,
     cell_lower_bounds,
     competitor_torques,
     friction_set,
@@ -114,13 +113,14 @@ def _root_cells(jobs, lo, hi, shared: bool) -> list:
     pts = np.stack([a, 0.5 * (a + b), b], axis=1)
     at_points = batch_rows_many([(bt, bk, np.repeat(pts.reshape(-1, 1), bt.n_c, axis=1)) for bt, bk in jobs])
     out = []
-    for nd, (s0, s1, det, _), (p0, p1, _, scale) in zip(nodes, at_nodes, at_points):
+    for (_, bk), nd, (s0, s1, det, _), (p0, p1, _, scale) in zip(jobs, nodes, at_nodes, at_points):
         deg = nd.size - 1
-        V = np.broadcast_to(np.vander(nd, deg + 1, increasing=True), (det.shape[0], deg + 1, deg + 1))
-        cdet = np.linalg.solve(V, det[..., None])[..., 0]  # power-basis coefficients in mu
+        V = np.vander(shared_coordinates(bk.mode), deg + 1, increasing=True)
+        V = np.broadcast_to(V, (det.shape[0], deg + 1, deg + 1))
+        cdet = np.linalg.solve(V, det[..., None])[..., 0]  # power-basis coefficients in t (shared_coordinate)
         cN0 = np.linalg.solve(V, s0 * det[..., None])
         cN1 = np.linalg.solve(V, s1 * det[..., None])
-        Mb = bernstein_matrix(deg, a, b)  # (1, K, j); products shaped as the reference's, so bit-identical
+        Mb = bernstein_matrix(deg, shared_coordinate(a, lo, hi), shared_coordinate(b, lo, hi))  # (1, K, j); as the reference's
         det_c = np.concatenate([Mb @ c for c in cdet])
         N0 = np.concatenate([Mb @ c for c in cN0])
         N1 = np.concatenate([Mb @ c for c in cN1])

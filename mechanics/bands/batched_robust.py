@@ -24,6 +24,7 @@ from qsplan.mechanics.bands.effort import check_force_margin
 from qsplan.mechanics.bands.robust import TOUCH_RTOL, assemble_robust_band, check_mu_pair
 from qsplan.mechanics.model.friction import check_mu_range
 from qsplan.mechanics.modes.contact_mode import enumerate_modes, mode_from_letters
+from qsplan.mechanics.modes.kinematics import check_mode_fits
 from qsplan.mechanics.numerics import DEFAULT_TOLERANCES, Status, Tolerances
 
 __all__ = ["RobustArrays", "RootStats", "admissible_competitors_batch", "assemble_band_arrays", "competitor_torques_batch",
@@ -67,8 +68,8 @@ def admissible_competitors_batch(batch: StateBatch, mode, tol: Tolerances = DEFA
     per_state : list of tuple of str, length S
     union : tuple of str
     """
-    mode = mode_from_letters(mode)
     s0 = batch.scenes[0]
+    mode = check_mode_fits(s0, mode)
     kin = {} if kin is None else kin
     kin.update(modes_kinematics(batch, [m for m in enumerate_modes(s0.n_contacts, s0.dof) if m.letters != mode.letters], tol))
     oks = [(c, bk.ok) for c, bk in kin.items()]

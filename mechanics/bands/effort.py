@@ -22,7 +22,7 @@ from qsplan.mechanics.modes.contact_mode import ContactMode
 from qsplan.mechanics.numerics import DEFAULT_TOLERANCES, Status, Tolerances
 from qsplan.mechanics.model.scene import Scene
 from qsplan.mechanics.modes.equilibrium import coulomb_slacks, equilibrium_matrix
-from qsplan.mechanics.modes.kinematics import ScenePool, single_mode_kinematics
+from qsplan.mechanics.modes.kinematics import ScenePool, check_mode_fits, single_mode_kinematics
 
 __all__ = [
     "Band",
@@ -323,7 +323,7 @@ def effort_bands(scene: Scene, mode: ContactMode, mu_rows, tol: Tolerances = DEF
     return lower, upper, ok
 
 
-def effort_band(scene: Scene, mode: ContactMode, mu=None, tol: Tolerances = DEFAULT_TOLERANCES, *,
+def effort_band(scene: Scene, mode: ContactMode | str, mu=None, tol: Tolerances = DEFAULT_TOLERANCES, *,
                 force_margin=None) -> Band:
     """The band of ``mode`` at the scene's friction (or at ``mu``), eq. (28).
 
@@ -331,12 +331,14 @@ def effort_band(scene: Scene, mode: ContactMode, mu=None, tol: Tolerances = DEFA
     ----------
     scene : Scene
         Exactly one effort-controlled joint; its commanded effort is ignored.
-    mode : ContactMode
+    mode : ContactMode or str
+        Letters are checked against the scene (one per contact, eq. 29): a ModeError names ``mode``.
     mu : array-like, shape (n_c,), optional
     force_margin : ForceMargin or (float, float), optional
         Minimum normal force and Coulomb slack (N) the band keeps (default none: eq. 28 as is).
     """
     joint = check_one_effort_joint(scene)
+    mode = check_mode_fits(scene, mode)
     force_margin = None if force_margin is None else check_force_margin(force_margin)
     mk = band_kinematics(scene, mode, tol)
     if not mk.ok:

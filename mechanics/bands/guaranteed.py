@@ -12,7 +12,9 @@ Over uncertain friction the guarantee is exact:
   box, the mode is degenerate there, and nothing is guaranteed (reported).
 * **one shared coefficient** (:func:`guaranteed_band_shared`): each band edge is a
   ratio of polynomials in mu; its extremes over ``[lo, hi]`` are found from the
-  polynomial's roots (critical points and sign changes), not from samples.
+  polynomial's roots (critical points and sign changes), not from samples.  The
+  polynomials are fitted in ``t`` (``[lo, hi]`` mapped onto ``[-1, 1]``), so any
+  range wider than zero, however narrow, is fitted as well as ``[0, 1]``.
 
 A force margin (:class:`qsplan.mechanics.bands.effort.ForceMargin`: ``s_r >= m_r``
 with a constant ``m_r`` instead of ``s_r >= 0``) keeps both exact: where ``det Q_AI``
@@ -28,6 +30,7 @@ for comparison.
 from __future__ import annotations
 
 from itertools import product
+from math import comb
 
 import numpy as np
 
@@ -44,16 +47,32 @@ from qsplan.mechanics.bands.effort import (
 from qsplan.mechanics.model.friction import check_mu_range
 from qsplan.mechanics.model.scene import Scene
 from qsplan.mechanics.modes.contact_mode import ContactMode
+from qsplan.mechanics.modes.kinematics import check_mode_fits
 from qsplan.mechanics.numerics import DEFAULT_TOLERANCES, Tolerances
 
 __all__ = [
+    "CRITICAL_IMAG_TOL",
+    "ROOT_IMAG_TOL",
     "guaranteed_band_box",
     "guaranteed_band_shared",
     "possible_band_box",
     "sampled_band",
+    "bernstein_matrix",
     "shared_band_from_rows",
+    "shared_coordinate",
+    "shared_coordinates",
     "shared_nodes",
 ]
+
+#: A root of ``det Q_AI`` or of a row's slope polynomial whose imaginary part is below this counts as
+#: real.  In units of the range's half-width (the polynomials are in ``t``, :func:`shared_coordinate`;
+#: before, 1e-12 in units of mu): well above the ~1e-15 rounding of a simple root of these well-scaled
+#: polynomials.
+ROOT_IMAG_TOL = 1e-12
+
+#: The same for the critical points of a row's effort bound, looser: a double critical point splits into a
+#: pair ~sqrt(rounding) ~ 1e-8 apart, and a spurious candidate only adds an effort that must hold anyway.
+CRITICAL_IMAG_TOL = 1e-9
 
 
 def _box_vertices(scene: Scene, mode: ContactMode, lo, hi) -> np.ndarray:
@@ -79,6 +98,7 @@ def guaranteed_band_box(scene: Scene, mode: ContactMode, lo, hi, tol: Tolerances
         Minimum normal force and Coulomb slack (N) kept for every mu in the box (default none).
     """
     joint = check_one_effort_joint(scene)
+    mode = check_mode_fits(scene, mode)
     force_margin = None if force_margin is None else check_force_margin(force_margin)
     verts = _box_vertices(scene, mode, lo, hi)
     mk = band_kinematics(scene, mode, tol)
@@ -112,6 +132,7 @@ def possible_band_box(scene: Scene, mode: ContactMode, lo, hi, tol: Tolerances =
     the whole line is returned.
     """
     joint = check_one_effort_joint(scene)
+    mode = check_mode_fits(scene, mode)
     verts = _box_vertices(scene, mode, lo, hi)
     mk = band_kinematics(scene, mode, tol)
     if not mk.ok:
@@ -158,6 +179,7 @@ def sampled_band(scene: Scene, mode: ContactMode, mu_rows, tol: Tolerances = DEF
         As in :func:`guaranteed_band_box`.
     """
     joint = check_one_effort_joint(scene)
+    mode = check_mode_fits(scene, mode)
     mu_rows = np.asarray(mu_rows, dtype=float)
     if mu_rows.ndim == 1:
         mu_rows = np.repeat(mu_rows[:, None], scene.n_contacts, axis=1)
@@ -191,6 +213,7 @@ def guaranteed_band_shared(scene: Scene, mode: ContactMode, lo: float, hi: float
     (as in :func:`guaranteed_band_box`) ``N0_r`` is ``det Q_AI (s0_r - m_r)``, of the same degree.
     """
     joint = check_one_effort_joint(scene)
+    mode = check_mode_fits(scene, mode)
     force_margin = None if force_margin is None else check_force_margin(force_margin)
     lo, hi = check_mu_range(lo, hi)
     mk = band_kinematics(scene, mode, tol)
@@ -204,43 +227,64 @@ def guaranteed_band_shared(scene: Scene, mode: ContactMode, lo: float, hi: float
     return shared_band_from_rows(mode, joint, nodes, s0, s1, det, scale, lo, hi, tol)
 
 
+def shared_coordinates(mode: ContactMode) -> np.ndarray:
+    """The ``n_S + 2`` Chebyshev points of ``[-1, 1]``: :func:`shared_nodes` in the coordinate of :func:`shared_coordinate`.
+
+    The polynomials of the shared coefficient are fitted in this coordinate, not in mu: at the
+    Chebyshev points of ``[-1, 1]`` the fit is well conditioned for any range, where powers of mu
+    on a narrow range (``[0.3, 0.30001]``, ``[0, 1e-100]``) made it singular.
+    """
+    deg = len(mode.sliding) + 1
+    return np.cos(np.pi * (np.arange(deg + 1) + 0.5) / (deg + 1))
+
+
 def shared_nodes(mode: ContactMode, lo: float, hi: float) -> np.ndarray:
     """The ``n_S + 2`` Chebyshev points of ``[lo, hi]`` at which :func:`guaranteed_band_shared` evaluates the rows."""
-    deg = len(mode.sliding) + 1
-    return 0.5 * (lo + hi) + 0.5 * (hi - lo) * np.cos(np.pi * (np.arange(deg + 1) + 0.5) / (deg + 1))
+    return 0.5 * (lo + hi) + 0.5 * (hi - lo) * shared_coordinates(mode)
+
+
+def shared_coordinate(mu, lo: float, hi: float):
+    """``t = (2 mu - lo - hi) / (hi - lo)`` (``lo < hi``): ``[lo, hi]`` onto ``[-1, 1]``, the polynomials' variable."""
+    return (2.0 * np.asarray(mu, dtype=float) - (lo + hi)) / (hi - lo)
 
 
 def shared_band_from_rows(mode: ContactMode, joint: int, nodes, s0, s1, det, scale, lo: float, hi: float,
                           tol: Tolerances = DEFAULT_TOLERANCES) -> Band:  # fmt: skip
-    """:func:`guaranteed_band_shared` from the rows at :func:`shared_nodes` (:func:`band_rows`' output, (deg + 1, r))."""
+    """:func:`guaranteed_band_shared` from the rows at :func:`shared_nodes` (:func:`band_rows`' output, (deg + 1, r)).
+
+    The polynomials are in ``t`` (:func:`shared_coordinate`), their extremes sought on ``[-1, 1]``.
+    """
     deg = len(mode.sliding) + 1
-    pdet = _poly_fit_exact(nodes, det, deg)
+    t = shared_coordinates(mode)
+    mu_of = lambda x: 0.5 * (lo + hi) + 0.5 * (hi - lo) * x  # noqa: E731 - for messages
+    pdet = _poly_fit_exact(t, det, deg)
     P = np.polynomial.Polynomial
-    roots_det = [r.real for r in P(pdet).roots() if abs(r.imag) < 1e-12 and lo <= r.real <= hi]
+    roots_det = [r.real for r in P(pdet).roots() if abs(r.imag) < ROOT_IMAG_TOL and -1.0 <= r.real <= 1.0]
     if roots_det or np.any(det == 0):
         return Band(mode.letters, joint, np.nan, np.nan, False,
-                    f"equilibrium_singular: det Q_AI vanishes at mu = {roots_det[0] if roots_det else nodes[det == 0][0]:.6g}",
+                    f"equilibrium_singular: det Q_AI vanishes at mu = {mu_of(roots_det[0]) if roots_det else nodes[det == 0][0]:.6g}",
                     "shared-roots")  # fmt: skip
     lower, upper = -np.inf, np.inf
     fscale = float(np.max(scale))
     for r in range(s0.shape[1]):
-        n0 = P(_poly_fit_exact(nodes, s0[:, r] * det, deg))
-        n1 = P(_poly_fit_exact(nodes, s1[:, r] * det, deg))
+        n0 = P(_poly_fit_exact(t, s0[:, r] * det, deg))
+        n1 = P(_poly_fit_exact(t, s1[:, r] * det, deg))
         d = P(pdet)
-        cand = [lo, hi]
+        cand = [-1.0, 1.0]
         crit = (n0.deriv() * n1 - n0 * n1.deriv()).roots()
-        cand += [c.real for c in np.atleast_1d(crit) if abs(c.imag) < 1e-9 and lo < c.real < hi]
-        zeros1 = [c.real for c in np.atleast_1d(n1.roots()) if abs(c.imag) < 1e-12 and lo <= c.real <= hi]
+        cand += [c.real for c in np.atleast_1d(crit) if abs(c.imag) < CRITICAL_IMAG_TOL and -1.0 < c.real < 1.0]
+        zeros1 = [c.real for c in np.atleast_1d(n1.roots()) if abs(c.imag) < ROOT_IMAG_TOL and -1.0 <= c.real <= 1.0]
         for z in zeros1:
             # at a root of the slope the row holds for every effort iff s0 >= 0 there
             if n0(z) / d(z) < -tol.force * fscale:
                 return Band(mode.letters, joint, np.nan, np.nan, False,
-                            f"coulomb: row {r} fails for every effort at mu = {z:.6g}", "shared-roots")  # fmt: skip
+                            f"coulomb: row {r} fails for every effort at mu = {mu_of(z):.6g}", "shared-roots")  # fmt: skip
         for c in cand:
             sl = n1(c) / d(c)
             if abs(sl) <= tol.force * max(1e-300, float(np.max(np.abs(s1[:, r])))):
                 if n0(c) / d(c) < -tol.force * fscale:
-                    return Band(mode.letters, joint, np.nan, np.nan, False, f"coulomb: row {r} fails at mu = {c:.6g}", "shared-roots")
+                    return Band(mode.letters, joint, np.nan, np.nan, False, f"coulomb: row {r} fails at mu = {mu_of(c):.6g}",
+                                "shared-roots")  # fmt: skip
                 continue
             e = -n0(c) / n1(c)
             if sl > 0:
@@ -250,3 +294,16 @@ def shared_band_from_rows(mode: ContactMode, joint: int, nodes, s0, s1, det, sca
     if lower > upper:
         return Band(mode.letters, joint, np.nan, np.nan, False, "coulomb: no effort works for every mu in the range", "shared-roots")
     return Band(mode.letters, joint, float(lower), float(upper), True, None, "shared-roots")
+
+
+def bernstein_matrix(n: int, a, b) -> np.ndarray:
+    """(m, n + 1, n + 1): the Bernstein coefficients on ``[a, b]`` (m,) of a degree-``n`` polynomial from its power coefficients."""
+    h = b - a
+    # T[m, j, i]: coefficient of t^i in (a + h t)^j
+    j = np.arange(n + 1)
+    C = np.array([[comb(jj, ii) for ii in range(n + 1)] for jj in range(n + 1)], dtype=float)
+    expo = j[:, None] - j[None, :]
+    T = C[None] * np.where(expo[None] >= 0, a[:, None, None] ** np.maximum(expo, 0)[None], 0.0) * h[:, None, None] ** j[None, None, :]
+    # Bernstein: beta_k = sum_{i<=k} C(k,i)/C(n,i) d_i
+    Bm = np.array([[comb(k, i) / comb(n, i) if i <= k else 0.0 for i in range(n + 1)] for k in range(n + 1)])
+    return np.einsum("ki,mji->mkj", Bm, T)  # (m, K, j): control value k from power coefficient j

@@ -21,6 +21,11 @@ Method (branch and bound over friction cells, exact to a tolerance):
   efforts lie in the intersection over rows.  Where ``det`` changes sign (the
   mode is singular inside the cell), a pair of rows whose numerators keep
   opposite signs on the whole cell still excludes the effort.
+* Where ``det`` keeps its sign on a cell and the per-row bound leaves the cell open, a
+  certificate (:mod:`qsplan.mechanics.bands.certificates`: a combination of rows negative at
+  every control value, found by a small linear programme) proves efforts infeasible on the
+  whole cell at once, rows that fail at different vertices included (tried once a search has
+  spent :data:`CERTIFY_AFTER` cells, within :data:`~qsplan.mechanics.bands.certificates.MAX_CERTIFICATES`).
 * Cells are bisected best-first, each along the side where its control values
   change most.  Every evaluated friction point whose band (from the model, eq. 28)
   is not empty gives a truly feasible effort (an incumbent); cells whose bound
@@ -42,17 +47,18 @@ efforts are not an interval): precluding the hull is then conservative.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from math import comb
 
 import numpy as np
 
+from qsplan.mechanics.bands.certificates import MAX_CERTIFICATES, certified_lower_bounds
 from qsplan.mechanics.bands.effort import band_kinematics, band_rows, intersect_rows
-from qsplan.mechanics.bands.guaranteed import shared_nodes
+from qsplan.mechanics.bands.guaranteed import bernstein_matrix, shared_coordinate, shared_coordinates, shared_nodes
 from qsplan.mechanics.errors import SceneError
+from qsplan.mechanics.model.friction import check_mu_range
 from qsplan.mechanics.modes.contact_mode import mode_from_letters
 from qsplan.mechanics.numerics import DEFAULT_TOLERANCES, Tolerances
 
-__all__ = ["MAX_CELLS", "PRECLUSION_RTOL", "CompetitorTorques", "bernstein_matrix", "cell_lower_bounds", "competitor_torques",
+__all__ = ["CERTIFY_AFTER", "MAX_CELLS", "PRECLUSION_RTOL", "CompetitorTorques", "cell_lower_bounds", "competitor_torques",
            "friction_set", "point_bands"]
 
 #: Relative tolerance of the branch and bound (of the effort interval's largest finite
@@ -66,6 +72,13 @@ PRECLUSION_RTOL = 1e-6
 #: friction box); random scenes take up to a few hundred; near a singular set of the
 #: competitor (``det Q_AI`` changing sign) cells never resolve, and the budget bounds the time.
 MAX_CELLS = 4000
+
+#: Cells a search evaluates before it tries certificates (:mod:`qsplan.mechanics.bands.certificates`) on the
+#: cells left open, a small share of :data:`MAX_CELLS`: searches the root cell leaves open mostly end within a
+#: few dozen cells by bisection alone, and those that certificates rescue ran for thousands.  Measured: the
+#: demo hand's segment 1 (200 states, shared friction) spent 41 programmes for no change at 0, 6 at 16, none
+#: at 64; on 15 hard bands of the band-safety scenes 64 gives the answers of 0 (256 loses two exact bands).
+CERTIFY_AFTER = 64
 
 #: Weight of a cell side's relative width when choosing the side to bisect (the change of the
 #: control values along it weighs 1): small, so it only breaks ties between sides the rows do not
@@ -115,10 +128,10 @@ class _Cells:
         self.n_c = n_c
         if shared:
             nodes = shared_nodes(mk.mode, lo, hi)
-            self.deg = nodes.size - 1
+            self.deg, self.range = nodes.size - 1, (lo, hi)
             s0, s1, det, _ = band_rows(scene, mk, np.repeat(nodes[:, None], n_c, axis=1))
-            V = np.vander(nodes, self.deg + 1, increasing=True)
-            self.cdet = np.linalg.solve(V, det)  # (deg+1,) power-basis coefficients in mu
+            V = np.vander(shared_coordinates(mk.mode), self.deg + 1, increasing=True)
+            self.cdet = np.linalg.solve(V, det)  # (deg+1,) power-basis coefficients in t (shared_coordinate)
             self.cN0 = np.linalg.solve(V, s0 * det[:, None])  # (deg+1, R)
             self.cN1 = np.linalg.solve(V, s1 * det[:, None])
             self.root = (np.array([[lo]]), np.array([[hi]]))
@@ -151,7 +164,7 @@ class _Cells:
         return det, N0, N1, pl.reshape(m, K), pu.reshape(m, K), pok.reshape(m, K), _spread(det, N0, N1, d)
 
     def _bernstein(self, a, b):
-        M = bernstein_matrix(self.deg, a, b)
+        M = bernstein_matrix(self.deg, shared_coordinate(a, *self.range), shared_coordinate(b, *self.range))
         det = M @ self.cdet
         N0 = M @ self.cN0
         N1 = M @ self.cN1
@@ -179,19 +192,6 @@ class _Cells:
         hi1[rows, k] = mid
         lo2[rows, k] = mid
         return np.vstack([clo, lo2]), np.vstack([hi1, chi])
-
-
-def bernstein_matrix(n: int, a, b) -> np.ndarray:
-    """(m, n + 1, n + 1): the Bernstein coefficients on ``[a, b]`` (m,) of a degree-``n`` polynomial from its power coefficients."""
-    h = b - a
-    # T[m, j, i]: coefficient of t^i in (a + h t)^j
-    j = np.arange(n + 1)
-    C = np.array([[comb(jj, ii) for ii in range(n + 1)] for jj in range(n + 1)], dtype=float)
-    expo = j[:, None] - j[None, :]
-    T = C[None] * np.where(expo[None] >= 0, a[:, None, None] ** np.maximum(expo, 0)[None], 0.0) * h[:, None, None] ** j[None, None, :]
-    # Bernstein: beta_k = sum_{i<=k} C(k,i)/C(n,i) d_i
-    Bm = np.array([[comb(k, i) / comb(n, i) if i <= k else 0.0 for i in range(n + 1)] for k in range(n + 1)])
-    return np.einsum("ki,mji->mkj", Bm, T)  # (m, K, j): control value k from power coefficient j
 
 
 def _spread(det, N0, N1, d):
@@ -298,7 +298,7 @@ def _search(cells: _Cells, lo_, hi_, flip, atol, budget, tol):
     """
     sign = -1.0 if flip else 1.0
     clo, chi = cells.root
-    incumbent, floor, used, exact, straddling = np.inf, np.inf, 0, True, False
+    incumbent, floor, used, exact, straddling, proofs = np.inf, np.inf, 0, True, False, 0
     while clo.shape[0]:
         det, N0, N1, pl, pu, pok, spread = cells.evaluate(clo, chi)
         used += clo.shape[0]
@@ -311,6 +311,10 @@ def _search(cells: _Cells, lo_, hi_, flip, atol, budget, tol):
         if feas.any():
             incumbent = min(incumbent, float(np.min(np.where(feas, np.clip(pl, lo_, hi_), np.inf))))
         lb, steady = cell_lower_bounds(det, N0, sign * N1, lo_, hi_, tol)
+        target = min(incumbent, hi_) - atol  # no proof needed above it: where a certificate's work ends
+        if used > CERTIFY_AFTER and proofs < MAX_CERTIFICATES and np.any(steady & (lb < target)):
+            lb, n = certified_lower_bounds(det, N0, sign * N1, lb, target, steady, tol, MAX_CERTIFICATES - proofs)
+            lb[lb > hi_], proofs = np.inf, proofs + n
         possible = lb < np.inf  # lb is +inf for a cell where nothing is possible, and may be -inf
         straddling |= bool(np.any(~steady & possible))
         # a cell that cannot beat the incumbent, or the interval's far end, by more than atol is resolved
@@ -330,17 +334,10 @@ def _search(cells: _Cells, lo_, hi_, flip, atol, budget, tol):
 
 
 def friction_set(lo, hi, n_c: int, shared: bool):
-    """The friction set, checked (``SceneError`` unless ``0 <= lo <= hi``, finite): floats, or shape (n_c,) (a box)."""
+    """The friction set checked by :func:`qsplan.mechanics.model.friction.check_mu_range`: floats, or shape (n_c,) (a box)."""
     if shared:
-        lo_a, hi_a = float(lo), float(hi)
-        if not (np.isfinite(lo_a) and np.isfinite(hi_a)) or lo_a < 0 or lo_a > hi_a:
-            raise SceneError(f"mu range: expected 0 <= lo <= hi, finite; got {lo}, {hi}")
-        return lo_a, hi_a
-    lo_a = np.broadcast_to(np.asarray(lo, float), (n_c,)).copy()
-    hi_a = np.broadcast_to(np.asarray(hi, float), (n_c,)).copy()
-    if np.any(lo_a > hi_a) or np.any(lo_a < 0) or not (np.all(np.isfinite(lo_a)) and np.all(np.isfinite(hi_a))):
-        raise SceneError(f"mu range: expected 0 <= lo <= hi, finite; got lo={lo_a.tolist()}, hi={hi_a.tolist()}")
-    return lo_a, hi_a
+        return check_mu_range(lo, hi)
+    return tuple(np.array(v) for v in check_mu_range(lo, hi, n=n_c))
 
 
 def competitor_torques(scene, mode, lo, hi, g_lo, g_hi, shared=False, tol: Tolerances = DEFAULT_TOLERANCES,

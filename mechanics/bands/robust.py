@@ -29,6 +29,7 @@ from qsplan.mechanics.bands.preclusion import CompetitorTorques, competitor_torq
 from qsplan.mechanics.errors import QsplanError
 from qsplan.mechanics.model.friction import check_mu_range
 from qsplan.mechanics.modes.contact_mode import enumerate_modes, mode_from_letters
+from qsplan.mechanics.modes.kinematics import check_mode_fits
 from qsplan.mechanics.numerics import Status
 
 __all__ = ["TOUCH_RTOL", "RobustBand", "admissible_competitors", "assemble_robust_band", "robust_band", "subtract_hull"]
@@ -115,8 +116,8 @@ def admissible_competitors(scenes, mode) -> tuple:
 
     A mode whose kinematics fail is infeasible for every effort and friction, so only these can compete.
     """
-    mode = mode_from_letters(mode)
     scene0 = scenes[0]
+    mode = check_mode_fits(scene0, mode)
     return tuple(m.letters for m in enumerate_modes(scene0.n_contacts, scene0.dof)
                  if m.letters != mode.letters and any(band_kinematics(s, m).ok for s in scenes))  # fmt: skip
 
@@ -163,7 +164,7 @@ def robust_band(scene, mode, mu_range, *, shared: bool = False, competitors=None
     Trinkle & Zeng (1995), Section 5.2 (Figs. 12-13), eq. 28.
     """
     lo, hi = check_mu_pair(mu_range)
-    mode = mode_from_letters(mode)
+    mode = check_mode_fits(scene, mode)
     comps = admissible_competitors([scene], mode) if competitors is None else tuple(competitors)
     guaranteed = guaranteed_band_shared if shared else guaranteed_band_box
     desired = guaranteed(scene, mode, lo, hi, force_margin=force_margin)

@@ -38,6 +38,7 @@ from qsplan.mechanics.errors import QsplanError
 from qsplan.mechanics.numerics import DEFAULT_TOLERANCES, Tolerances
 from qsplan.mechanics.parallel import chunk_count, map_chunks, split_range
 from qsplan.mechanics.model.scene import Scene
+from qsplan.mechanics.quiet import quiet_highs
 
 __all__ = [
     "CONE_WIDENING",
@@ -140,8 +141,7 @@ class _Programme:
         except ImportError:
             self.highs = None
             return
-        h = highspy.Highs()
-        h.setOptionValue("output_flag", False)
+        h = quiet_highs(highspy)  # highspy prints a banner on descriptor 1 when built (see qsplan.mechanics.quiet)
         h.setOptionValue("simplex_strategy", 1)  # dual simplex: the bounds change, the last basis stays dual feasible
         inf = highspy.kHighsInf
         h.addVars(self.n_vars, np.full(self.n_vars, -inf), np.full(self.n_vars, inf))

@@ -27,4 +27,4 @@ def add_parser(subparsers):
 def run(args, out) -> int:
     from qsplan.planner.planning.task import demo_task_path, load_task
 
-    return run_task(load_task(demo_task_path()), args, out)
+    return run_task(load_task(demo_task_path()), args, out, inputs=(demo_task_path(),))

@@ -16,7 +16,10 @@ trajectory), ``replay.json`` (the exported file re-simulated at ``--verify``
 friction vectors of the interval; exit 1 if any run leaves the planned modes) and,
 unless ``--no-plots``, ``plan_bands.png``, ``mode_timeline.png`` and
 ``hand_snapshots.png``.  Existing files are not overwritten without ``--force``
-(checked first).  Progress lines go to stderr unless ``--quiet``; a summary to stdout.
+(checked first; the task file never, even with it).  The files appear in DIR only once the plan
+is certified (written into a staging directory inside DIR, then renamed into place); a second run
+into a DIR that a run is writing fails at once (exit 2).  Progress lines go to stderr unless
+``--quiet``; a summary to stdout.
 
 When no plan exists the report (where the band closes, which mode closes it, at
 which friction) is written to DIR/failure.json and the command fails with one
@@ -43,8 +46,9 @@ def add_parser(subparsers):
     return p
 
 
-def run_task(task, args, out) -> int:
-    """Run the pipeline on ``task`` as ``args`` ask and print the summary (shared by ``qsplan demo``)."""
+def run_task(task, args, out, inputs=()) -> int:
+    """Run the pipeline on ``task`` as ``args`` ask and print the summary (shared by ``qsplan demo``); ``inputs``: the
+    files read (the task file), never replaced."""
     from qsplan.planner.planning.pipeline import run_plan
     from qsplan.planner.plotting.style import torque_text
 
@@ -57,7 +61,7 @@ def run_task(task, args, out) -> int:
 
     result = run_plan(task, args.out, seed=args.seed, planner=args.planner, time_limit=args.time_limit,
                       verify=args.verify, force=args.force, plots=not args.no_plots, progress=progress,
-                      sequence_planner=args.sequence_planner)  # fmt: skip
+                      sequence_planner=args.sequence_planner, inputs=inputs)  # fmt: skip
     plan = result.plan
     name, t, w = plan.narrowest()
     out.write(f"{task.name}: planned {len(plan.segments)} in-contact segments and {len(plan.phases) - len(plan.segments)} "
@@ -96,4 +100,4 @@ def run(args, out) -> int:
 
     bundled = task_paths()
     path = bundled[args.task] if args.task in bundled and not Path(args.task).exists() else args.task
-    return run_task(load_task(path), args, out)
+    return run_task(load_task(path), args, out, inputs=(path,))

@@ -4,13 +4,16 @@
 
     qsplan verify PLAN_DIR [--task TASK.toml] [--json] [--random N] [--seed S] [--force-margin N]
 
-Rebuilds every row of ``PLAN_DIR/plan.csv`` (or ``plan.json``; a file path works too)
-from the task and checks it (:func:`qsplan.planner.planning.certify.certify_plan`):
-no overlap between fingers, palm and workpiece; joint and speed limits; continuity;
-the planned contacts present; with the exported commands, the planned mode the only
-feasible one at the friction set's vertices and at N seeded random points; the
-torque inside its band.  Without ``--task`` the task recorded in ``plan.json``'s
-metadata is used (said on the first line).
+Checks every fact ``PLAN_DIR``'s ``plan.csv`` and ``plan.json`` state (a file path works too: it and the other
+file beside it) from the task alone (:func:`qsplan.planner.planning.certify.certify_plan`; its ``CHECKS`` say
+what each kind covers): both files hold the same cells and the metadata states the task; the start and the
+goal (or the waypoints) reached; no overlap between fingers, palm and workpiece, at every row and along the
+free motions; the workpiece resting on the palm while regrasped; joint and speed limits; continuity; the
+planned contacts present; every exported band recomputed for the whole friction set, the command and its
+margin inside it; with the exported commands, the planned mode the only feasible one at the friction set's
+vertices and at N seeded random points.  ``--task`` takes a task file or a bundled task's name; without it the
+task recorded in ``plan.json``'s metadata is used (said on the first line): to hold a plan to your own task,
+name it.
 
 Exit 0: certified.  Exit 1: not certified, one line per violation (the first
 :data:`MAX_LINES`, then a count).  Exit 2: bad input, one line on stderr.
@@ -35,7 +38,8 @@ MAX_LINES = 20
 def add_parser(subparsers):
     p = subparsers.add_parser("verify", help="certify an exported plan row by row from the task alone")
     p.add_argument("plan", metavar="PLAN_DIR", help="plan directory (plan.csv or plan.json), or one of the files")
-    p.add_argument("--task", metavar="TASK", help="task file (.toml); default: the task recorded in plan.json")
+    p.add_argument("--task", metavar="TASK", help="task file (.toml) or a bundled task's name (demo_task, ...); "
+                                                  "default: the task recorded in plan.json")
     p.add_argument("--json", action="store_true", help="print the certificate as JSON")
     p.add_argument("--random", type=int, default=8, metavar="N",
                    help="seeded random friction vectors per row besides the friction set's vertices (default 8)")  # fmt: skip
@@ -51,7 +55,10 @@ def _task(args):
     from qsplan.planner import load_task
 
     if args.task is not None:
-        return load_task(args.task), f"task {args.task}"
+        from qsplan.planner.planning.task import task_path
+
+        path = task_path(args.task)
+        return load_task(path), f"task {path}"
     cols, meta = read_plan(args.plan)
     if meta is None:
         from qsplan.mechanics import QsplanError

@@ -5,17 +5,23 @@ The next run into the same directory may replace an output whose content is stil
 recorded (qsplan wrote it and nobody changed it since); any other existing file of the same
 name (not recorded, edited, or replaced by someone) is refused without ``force``, as before.
 So ``qsplan demo --out out`` can be run twice, and a hand-edited ``plan.csv`` is never lost.
+
+:func:`publish_outputs` moves a run's staged outputs into the directory (removing the earlier run's,
+recording the new ones, renaming them into place) in an order that leaves a consistent directory
+wherever it is interrupted.
 """
 
 from __future__ import annotations
 
 import hashlib
 import json
+import os
 from pathlib import Path
 
-from qsplan.planner.export.files import atomic_write
+from qsplan.mechanics.errors import QsplanError
+from qsplan.planner.export.files import atomic_write, remove_stale
 
-__all__ = ["MANIFEST", "own_outputs", "record_outputs"]
+__all__ = ["MANIFEST", "own_outputs", "publish_outputs", "record_outputs"]
 
 #: The manifest's file name inside an output directory.
 MANIFEST = ".qsplan-outputs.json"
@@ -81,3 +87,34 @@ def record_outputs(out_dir, paths) -> Path:
            "meaning": "files qsplan wrote into this directory; a later run may replace them while unchanged",
            "files": dict(sorted(files.items()))}  # fmt: skip
     return atomic_write(out / MANIFEST, json.dumps(doc, indent=1) + "\n", force=True)
+
+
+def publish_outputs(out_dir, stage, names, remove=(), last=()) -> list:
+    """Move the files ``names``, written into the staging directory ``stage``, into ``out_dir``; returns their paths.
+
+    The caller holds the directory (:func:`qsplan.planner.export.files.locked_out_dir`) and has checked that every
+    existing file of ``names`` may be replaced (an earlier run's own output, or ``force``).  In this order, so
+    that a run interrupted anywhere leaves a directory that does not mislead:
+
+    1. the files ``remove`` (the earlier run's outputs, ``names`` among them where they exist) are removed:
+       an old file never sits beside a new one (a new certificate beside an old plan);
+    2. the manifest records the staged files: whichever of them is in place is known as qsplan's, and a
+       rerun replaces it without ``force``;
+    3. each file is renamed into place (one atomic rename each, the same file system), those in ``last``
+       (the plan files) last: where a plan file is, every other output of its run is.
+
+    Raises
+    ------
+    QsplanError
+        A rename failed (naming the file and the OS reason).
+    """
+    out, stage = Path(out_dir), Path(stage)
+    order = [n for n in names if n not in last] + [n for n in last if n in names]
+    remove_stale(out, remove)
+    record_outputs(out, [stage / n for n in order])
+    for name in order:
+        try:
+            os.replace(stage / name, out / name)
+        except OSError as exc:
+            raise QsplanError(f"out_dir: cannot move {name!r} into {str(out)!r}: {exc.strerror or exc}") from None
+    return [out / n for n in names]

@@ -54,7 +54,7 @@ from qsplan.planner.export.files import atomic_write, check_out_dir, check_outpu
 from qsplan.planner.export.schedule import FORMAT, VERSION
 
 __all__ = ["PLAN_COLUMNS", "PLAN_FORMAT", "column_meanings", "export_plan", "plan_columns", "plan_joints",
-           "plan_metadata", "plain_json", "read_plan_csv"]
+           "plan_metadata", "plan_metadata_limits", "plain_json", "read_plan_csv", "task_tables"]
 
 PLAN_FORMAT = FORMAT + ".plan"
 
@@ -222,7 +222,8 @@ def plan_metadata(plan) -> dict:
                             "records its m (command.margin_N_m)",
                     "max_margin_resolutions": MAX_MARGIN_RESOLUTIONS, "torque_resolution_N_m": task.torque_resolution,
                     "velocity_controlled_torque_cells": "nan in CSV, null in JSON"},
-        "limits": _limits(task, chain),
+        "limits": plan_metadata_limits(task),
+        "task_tables": task_tables(task),
         "narrowest_band": {"phase": name, "t_s": _num(t), "width_N_m": _num(w)},
         "planner": {"name": plan.options.planner, "seed": plan.options.seed, "seconds": plan.seconds,
                     "validity_checks": plan.validity_checks, "checks_per_second": _num(plan.checks_per_second)},
@@ -242,11 +243,38 @@ def _joint_units(hand) -> dict:
     return {n: JOINT_UNITS[k] for n, k in zip(joint_names(hand), joint_kinds(hand))}
 
 
-def _limits(task, chain: bool) -> dict:
-    """The task's limits: the paper's hand as always (``joints_rad``, one ``joint_speed_rad_s``); a described hand
-    per joint by name (``joints``: range, speed and their units)."""
-    if not chain:
+def task_tables(task) -> dict:
+    """Where the task starts and ends, as its file's ``[motion]``, ``[start]`` and ``[goal]`` tables say it (features
+    ``"edge:K"``/``"vertex:K"``/``"inner"`` in the polygon's numbering as written; a described hand's ``[start]`` by
+    joint name), so that the certifier can check a plan against the task it records, not against its own rows."""
+    from qsplan.hands.interface import is_chain_hand
+
+    def feature(f):
+        return "inner" if f is None or f[0] == "inner" else f"{f[0]}:{f[1]}"
+
+    out = {"motion": {"start_x": float(task.start_x)}}
+    if task.goal is None:
+        out["motion"]["waypoints"] = [float(v) for v in task.waypoints]
+    else:
+        out["goal"] = {"x": float(task.goal.x), **{side: feature(f) for side, f in (("left", task.goal.left),
+                                                                                  ("right", task.goal.right)) if f}}
+    if is_chain_hand(task.hand):
+        if task.start_joints is not None:
+            out["start"] = {task.hand.joint_names[j]: float(task.start_joints[j]) for j in task.hand.free_joints()}
+    else:
+        out["start"] = {side: feature(f) for side, f in zip(("left", "right"), task.start_features)}
+    return out
+
+
+def plan_metadata_limits(task) -> dict:
+    """The task's limits as ``metadata.limits`` records them: the paper's hand as always (``joints_rad``, one
+    ``joint_speed_rad_s``, and per finger ``joint_speeds_rad_s``); a described hand per joint by name (``joints``:
+    range, speed and their units)."""
+    from qsplan.hands.interface import is_chain_hand
+
+    if not is_chain_hand(task.hand):  # joint_speed_rad_s: the slowest finger's (the planner's one speed); per finger beside it
         return {"joints_rad": task.joint_limits.tolist(), "joint_speed_rad_s": task.joint_speed,
+                "joint_speeds_rad_s": [float(v) for v in task.joint_speeds],
                 "workpiece_speed_m_s": task.workpiece_speed}  # fmt: skip
     units = _joint_units(task.hand)
     speeds = np.asarray(task.joint_speeds, dtype=float)

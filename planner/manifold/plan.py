@@ -24,6 +24,7 @@ from qsplan.planner.manifold.slide import free_grid, plan_slide
 from qsplan.planner.manifold.states import check_state, closed_state, judge_states, motion_mode, slip_signs
 from qsplan.planner.planning.failure import configuration_report
 from qsplan.planner.planning.results import Plan, PlanFailure
+from qsplan.planner.planning.task import MIN_SEGMENT_LENGTH
 
 __all__ = ["MAX_ATTEMPTS", "STABLE_DX", "effort_candidates", "plan_chain_task", "start_grasps"]
 
@@ -193,6 +194,10 @@ def plan_chain_task(task, options=None, progress=None) -> Plan:
     if task.goal is None:
         raise QsplanError("goal: a task of a described hand gives [goal] x (and optionally left, right); "
                           "scripted waypoints are planned for the paper's hand only")  # fmt: skip
+    if abs(task.goal.x - task.start_x) < MIN_SEGMENT_LENGTH:  # the plan's one slide: a direction and slopes
+        raise QsplanError(f"goal.x: a described hand's plan slides the workpiece from motion.start_x to goal.x; "
+                          f"expected them at least {MIN_SEGMENT_LENGTH:g} m apart, got {task.start_x:g} and "
+                          f"{task.goal.x:g} m")  # fmt: skip
     t_start = time.perf_counter()
     hand, x0, x1 = task.hand, task.start_x, task.goal.x
     if task.start_joints is not None:

@@ -21,16 +21,20 @@ __all__ = [
     "LIMIT_TOL",
     "SPEED_RTOL",
     "JUMP_TOL",
+    "COMMAND_RTOL",
     "row_pose",
     "row_q",
     "joint_speeds",
     "overlap_pairs",
     "joint_housings",
     "row_bodies",
+    "bodies_at",
+    "body_overlaps",
     "overlap_checks",
     "contact_checks",
     "limit_checks",
     "step_checks",
+    "command_step_checks",
     "friction_points",
 ]
 
@@ -62,6 +66,11 @@ SPEED_RTOL = 1e-6
 
 #: Jump (rad or m) tolerated between two rows at the same time (a phase switch): rounding.
 JUMP_TOL = 1e-9
+
+#: Relative difference tolerated between an in-contact step of a velocity-controlled joint and the trapezoid of
+#: its velocity commands: the commands sample the closed-form rate of a smooth path at 0.5 mm of workpiece
+#: travel, whose trapezoid errs by about dt^3 (d3q/dt3) / 12, well under 1 % of a step on the bundled plans.
+COMMAND_RTOL = 1e-2
 
 def row_pose(cols, k) -> np.ndarray:
     """Workpiece ``(x, y, theta)`` of row ``k`` (m, m, rad), shape (3,)."""
@@ -113,12 +122,18 @@ def row_bodies(task, cols, k, roots=None) -> dict:
     ``roots``: :func:`joint_housings` of the task's hand, when already built (a joint on a moving link gets its
     disk about its axis at the row's joint positions).
     """
+    from qsplan.hands.interface import joint_names
+
+    return bodies_at(task, row_pose(cols, k), row_q(cols, k, joint_names(task.hand)), roots)
+
+
+def bodies_at(task, pose, q, roots=None) -> dict:
+    """:func:`row_bodies` at workpiece pose ``pose`` (3,) and joint positions ``q`` (n_j,) (m, rad)."""
     from shapely.geometry import Point, Polygon
 
-    from qsplan.hands.interface import hand_body_polygons, joint_axes, joint_names
+    from qsplan.hands.interface import hand_body_polygons, joint_axes
 
-    q = row_q(cols, k, joint_names(task.hand))
-    polys = {name: Polygon(v) for name, v in hand_body_polygons(task.hand, row_pose(cols, k), q).items()}
+    polys = {name: Polygon(v) for name, v in hand_body_polygons(task.hand, pose, q).items()}
     housings = joint_housings(task.hand) if roots is None else roots
     axes = None
     disks = {}
@@ -172,8 +187,12 @@ def overlap_checks(task, cols, k, bodies=None) -> list:
 
     ``bodies``: :func:`row_bodies` of the row, when already built.
     """
-    b = row_bodies(task, cols, k) if bodies is None else bodies
-    polys, roots, out = b["polys"], b["roots"], []
+    return body_overlaps(task, row_bodies(task, cols, k) if bodies is None else bodies)
+
+
+def body_overlaps(task, bodies) -> list:
+    """:func:`overlap_checks` of bodies built by :func:`bodies_at`."""
+    polys, roots, out = bodies["polys"], bodies["roots"], []
     for a, c in overlap_pairs(task.hand):
         A, C = polys[a], polys[c]
         if a in roots and roots[a][0] == c:  # the link first, clipped, as its housing allows
@@ -245,13 +264,16 @@ def limit_checks(task, cols, k) -> list:
         edge = lo if tau < lo else hi
         out.append(("torque", f"{e} joint {what} {tau:.6g} {unit} outside its band [{lo:.6g}, {hi:.6g}] {unit} "
                               f"({abs(tau - edge):.3g} {unit} past the edge)"))  # fmt: skip
+    if not np.isnan(cols[f"qd_{e}"][k]):
+        out.append(("input", f"{e} joint (torque-controlled): a velocity command {cols[f'qd_{e}'][k]!r} beside its "
+                             f"{what}; one command per joint"))  # fmt: skip
     for v in names:
         if v == e:
             continue
         if not np.isfinite(cols[f"qd_{v}"][k]):
             out.append(("input", f"{v} joint (velocity-controlled): no velocity command"))
-        if np.isfinite(cols[f"tau_{v}"][k]):
-            out.append(("input", f"{v} joint: a torque command on a row whose effort_joint is {e}"))
+        if any(not np.isnan(cols[f"tau_{v}{s}"][k]) for s in ("", "_min", "_max")):
+            out.append(("input", f"{v} joint: a torque command or band on a row whose effort_joint is {e}"))
     return out
 
 
@@ -273,7 +295,7 @@ def step_checks(task, cols, k) -> list:
         jumps += [f"workpiece {dx * 1e3:.3g} mm"] if dx > JUMP_TOL else []
         jumps += [f"workpiece {dth:.3g} rad"] if dth > JUMP_TOL else []
         return [("continuity", f"jump at t = {t0:.6g} s to the next row: " + ", ".join(jumps))] if jumps else []
-    out = []
+    out = command_step_checks(cols, k, names, units, dq, dt)
     for side, u, limit, d in zip(names, units, speeds, dq):
         if abs(d) > limit * dt * (1 + SPEED_RTOL) + JUMP_TOL:
             out.append(("speed", f"{side} joint moves {abs(d):.4g} {u} in {dt:.4g} s to the next row: "
@@ -281,6 +303,32 @@ def step_checks(task, cols, k) -> list:
     if dx > task.workpiece_speed * dt * (1 + SPEED_RTOL) + JUMP_TOL:
         out.append(("speed", f"workpiece moves {dx * 1e3:.4g} mm in {dt:.4g} s to the next row: "
                              f"{dx / dt:.4g} m/s > limit {task.workpiece_speed:g} m/s"))  # fmt: skip
+    return out
+
+
+def command_step_checks(cols, k, names, units, dq, dt) -> list:
+    """The velocity commands reach the next row: a controller that follows them arrives where the rows say.
+
+    A regrasp row's ``qd`` holds until the next row (zero-order hold): ``q[k+1] - q[k] = qd[k] dt`` to
+    :data:`JUMP_TOL`.  In contact, ``qd`` samples the velocity of a smooth path: the trapezoid
+    ``(qd[k] + qd[k+1]) dt / 2`` matches the step to :data:`COMMAND_RTOL` of the step (and :data:`JUMP_TOL`).
+    """
+    free = str(cols["mode"][k]) == "free"
+    if "phase" in cols and cols["phase"][k] != cols["phase"][k + 1]:
+        return []
+    out = []
+    for j, (n, u) in enumerate(zip(names, units)):
+        a, b = cols[f"qd_{n}"][k], cols[f"qd_{n}"][k + 1]
+        if np.isnan(a):
+            continue  # torque-controlled: its motion follows from the contacts
+        step = a * dt if free else (0.5 * (a + b) * dt if np.isfinite(b) else np.nan)
+        if np.isnan(step):
+            continue
+        tol = JUMP_TOL + (0.0 if free else COMMAND_RTOL * abs(dq[j]))
+        if abs(step - dq[j]) > tol:
+            rule = "qd held over the step" if free else "the trapezoid of qd"
+            out.append(("motion", f"{n} joint's velocity command moves it {step:.6g} {u} to the next row ({rule}); "
+                                  f"the rows move it {dq[j]:.6g} {u}"))  # fmt: skip
     return out
 
 

@@ -17,7 +17,8 @@ from itertools import product
 
 import numpy as np
 
-__all__ = ["ClosedPoint", "ConfigurationReport", "FailureReport", "configuration_report", "failure_report"]
+__all__ = ["ClosedPoint", "ConfigurationReport", "FailureReport", "PalmReport", "configuration_report",
+           "failure_report", "palm_report"]
 
 #: Configurations sampled along the straight line of a failed segment.
 REPORT_SAMPLES = 21
@@ -161,6 +162,70 @@ class ConfigurationReport:
                 "q_rad": None if self.q is None else list(self.q), "reason": self.reason, "bodies": list(self.bodies),
                 "overlap_area_m2": self.overlap_area, "overlap_depth_m": self.overlap_depth,
                 "planner_status": self.planner_status, "message": self.message}  # fmt: skip
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class PalmReport:
+    """Why a task has no plan, known from its geometry before any planning: a workpiece x it names puts the
+    workpiece's resting edge beyond an end of the palm (no grasp has its two palm contacts there).
+
+    Attributes
+    ----------
+    where : str
+        Which position, in words ("the start", "the goal", "the end of segment 1").
+    field : str
+        The task field that names it (``motion.start_x``, ``motion.waypoints[k]``, ``goal.x``).
+    x : float
+        That workpiece x (m).
+    x_range : (float, float)
+        The workpiece x (m) for which the resting edge lies on the palm
+        (:func:`qsplan.planner.planning.goal.palm_x_range`).
+    edge : (float, float)
+        The resting edge's ends (m) at ``x``.
+    side : str
+        ``"left"`` or ``"right"``: the end of the palm the edge passes,
+    palm_end : float
+        at this x (m).
+    """
+
+    where: str
+    field: str
+    x: float
+    x_range: tuple
+    edge: tuple
+    side: str
+    palm_end: float
+
+    @property
+    def message(self) -> str:
+        lo, hi = self.x_range
+        return (f"no plan: {self.where} x = {self.x:.4g} m ({self.field}) puts the workpiece's resting edge (from x = "
+                f"{self.edge[0]:.4g} to {self.edge[1]:.4g} m) beyond the palm's {self.side} end at {self.palm_end:.4g} "
+                f"m; the workpiece rests on the palm for x in [{lo:.4g}, {hi:.4g}] m")  # fmt: skip
+
+    def as_dict(self) -> dict:
+        return {"kind": "beyond the palm", "where": self.where, "field": self.field, "x_m": self.x,
+                "x_range_m": list(self.x_range), "resting_edge_m": list(self.edge), "side": self.side,
+                "palm_end_m": self.palm_end, "planner_status": "not run (refused from the task's geometry)",
+                "message": self.message}  # fmt: skip
+
+
+def palm_report(task) -> PalmReport | None:
+    """The first workpiece x of ``task`` (its start, waypoints, goal) beyond the palm (a :class:`PalmReport`), or None.
+
+    Exact (no tolerance): ``x`` in :func:`qsplan.planner.planning.goal.palm_x_range`, ends included, passes.
+    """
+    from qsplan.planner.planning.goal import palm_x_range, task_positions
+
+    lo, hi = palm_x_range(task.hand)
+    V = task.hand.workpiece
+    for where, field, x in task_positions(task):
+        if lo <= x <= hi:
+            continue
+        edge = (x + float(V[0, 0]), x + float(V[1, 0]))
+        side, end = ("left", lo + float(V[0, 0])) if x < lo else ("right", hi + float(V[1, 0]))
+        return PalmReport(where, field, x, (lo, hi), edge, side, end)
+    return None
 
 
 def configuration_report(task, phase, where, x, q, reason=None, planner_status=None) -> ConfigurationReport:

@@ -23,9 +23,12 @@ from __future__ import annotations
 import re
 from dataclasses import dataclass
 
+import numpy as np
+
 from qsplan.mechanics.errors import QsplanError
 
-__all__ = ["Goal", "FEATURE_KINDS", "parse_feature", "make_goal", "make_start_features"]
+__all__ = ["Goal", "FEATURE_KINDS", "parse_feature", "make_goal", "make_start_features", "palm_x_range",
+           "task_positions"]
 
 #: The feature kinds of a goal: the fingertip on an edge, the inner long edge on a vertex.
 FEATURE_KINDS = ("edge", "vertex")
@@ -112,3 +115,31 @@ def make_start_features(table, n_vertices: int) -> tuple:
         raise QsplanError(f"start.{extra[0]}: unknown field; expected some of left, right")
     return tuple(parse_feature(table.get(side, "inner"), f"start.{side}", n_vertices, allow_inner=True)
                  for side in ("left", "right"))  # fmt: skip
+
+
+def palm_x_range(hand) -> tuple:
+    """The workpiece x (m) over which its resting edge lies on the palm's top: ``(lo, hi)``.
+
+    The workpiece rests on its bottom edge (vertices 0 and 1, relative to its centre of mass) on the palm's
+    top edge ``y = 0``; both ends of that edge must be on the palm (the two palm contacts of every grasp,
+    eq. 1), so ``x + V[0, 0] >= palm's left end`` and ``x + V[1, 0] <= palm's right end``.  Exact, from
+    the hand's palm polygon (an asymmetric palm included).
+    """
+    from qsplan.hands.interface import manipulator_of
+
+    palm = np.asarray(manipulator_of(hand).base_shape, dtype=float)
+    top = palm[palm[:, 1] == 0.0, 0]
+    V = hand.workpiece
+    return float(top.min() - V[0, 0]), float(top.max() - V[1, 0])
+
+
+def task_positions(task) -> list:
+    """Every workpiece x (m) a task names, in order: ``[(where, field, x)]`` (the start, each waypoint, the goal)."""
+    out = [("the start", "motion.start_x", float(task.start_x))]
+    last = len(task.waypoints) - 1
+    for i, x in enumerate(task.waypoints):
+        where = "the goal" if i == last else f"the end of segment {i + 1}"
+        out.append((where, f"motion.waypoints[{i}]", float(x)))
+    if task.goal is not None:
+        out.append(("the goal", "goal.x", float(task.goal.x)))
+    return out

@@ -218,6 +218,11 @@ def plan_task(task: Task, options: PlannerOptions | None = None, progress=None, 
     if options is None:
         options = DEFAULT_OPTIONS
     from qsplan.hands.chain_hand import ChainHand
+    from qsplan.planner.planning.failure import palm_report
+
+    beyond = palm_report(task)  # from the task's geometry alone, before any table or grid is built
+    if beyond is not None:
+        raise PlanFailure(beyond)
 
     if isinstance(task.hand, ChainHand):  # a described hand: slides planned on the contact manifold
         from qsplan.planner.manifold.plan import plan_chain_task

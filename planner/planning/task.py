@@ -29,10 +29,11 @@ TOML form (all SI: m, kg, rad, s, N m)::
     torque_resolution = 0.02     # N m: the narrowest band the controller can hold
     min_normal_force = 0.05      # N, optional: every contact's normal force at least this, for all friction
     min_coulomb_slack = 0.05     # N, optional: rolling contacts' cone slacks at least this (qsplan.planner.torque.command.PLAN_FORCE_MARGIN)
-    [limits]
-    left = [0.05, 3.09]          # joint range (rad) of each finger
+    [limits]                     # optional: narrows the hand's own limits, never widens them
+    left = [0.05, 3.09]          # a joint's range by its name (rad; m for a prismatic joint)
     right = [0.05, 3.09]
-    joint_speed = 0.5            # rad/s, each joint
+    joint_speed = 0.5            # rad/s, every revolute joint
+    speed = { left = 0.4 }       # optional: a joint's speed by name, in its unit (rad/s, m/s)
     workpiece_speed = 0.01       # m/s
 
 :func:`load_task` reads it; :func:`make_task` is the Python equivalent.  Errors
@@ -51,11 +52,12 @@ from qsplan.mechanics.bands.effort import ForceMargin, check_force_margin
 from qsplan.mechanics.errors import QsplanError
 from qsplan.mechanics.model.friction import check_mu_range
 from qsplan.planner.planning.goal import Goal, make_goal, make_start_features
-from qsplan.planner.planning.task_fields import (TASK_RANGES, check_hand, hand_from_task_table, in_task_range,
-                                                 short_repr, task_number)  # fmt: skip
+from qsplan.planner.planning.limits import LIMIT_KEYS, resolve_limits
+from qsplan.planner.planning.task_fields import (TASK_RANGES, check_hand, field_name, hand_from_task_table,
+                                                 in_task_range, short_repr, task_number)  # fmt: skip
 from qsplan.planner.torque.command import PLAN_FORCE_MARGIN, plan_force_margin
 
-__all__ = ["Task", "load_task", "make_task", "demo_task_path", "task_paths", "TASK_RANGES", "MAX_WAYPOINTS",
+__all__ = ["Task", "load_task", "make_task", "demo_task_path", "task_path", "task_paths", "TASK_RANGES", "MAX_WAYPOINTS",
            "MIN_SEGMENT_LENGTH"]
 
 #: Most in-contact segments a task may have: each is one OMPL query of up to its time limit, so
@@ -71,7 +73,6 @@ _TABLE_KEYS = {
     "motion": {"start_x", "waypoints"},
     "friction": {"range", "shared"},
     "controller": {"torque_resolution", "min_normal_force", "min_coulomb_slack"},
-    "limits": {"left", "right", "joint_speed", "workpiece_speed"},
 }
 
 _DATA = Path(__file__).parent.parent / "data"  # planner/data, installed as qsplan.planner package data
@@ -97,9 +98,10 @@ class Task:
         N m, positive: every guaranteed band along the plan must be at least this wide.
     joint_limits : ndarray, shape (n_j, 2)
         ``[[lo, hi], ...]`` (rad, m for a prismatic joint) of each joint: the left and right finger of the paper's
-        hand, a described hand's joints in its order.
+        hand, a described hand's joints in its order (:func:`qsplan.planner.planning.limits.resolve_limits`: the
+        hand's, narrowed by the task's ``[limits]``).
     joint_speed : float
-        rad/s, positive: limit on each joint's speed.
+        rad/s, positive: the slowest joint's speed limit (the paper hand's single-speed planner uses it).
     workpiece_speed : float
         m/s, positive: limit on the workpiece's speed.
     force_margin : ForceMargin
@@ -109,8 +111,8 @@ class Task:
         Where an automatically planned task ends (then ``waypoints`` is empty).
     start_features : ((str, int or None), (str, int or None))
         Where each finger touches at the start: ``("inner", None)`` or ``(kind, K)`` (polygon as written).
-    speeds : ndarray, shape (n_j,), or None
-        A described hand's joint speed limits (rad/s or m/s); None: ``joint_speed`` (see :attr:`joint_speeds`).
+    speeds : ndarray, shape (n_j,)
+        Each joint's speed limit (rad/s or m/s): the hand's, narrowed by the task's (see :attr:`joint_speeds`).
     start_joints : ndarray, shape (n_j,), or None
         A described hand's free joints at the start (``[start]`` by joint name; the closing joints' entries 0);
         None: the planner chooses.
@@ -134,8 +136,7 @@ class Task:
 
     @property
     def joint_speeds(self) -> np.ndarray:
-        """Speed limit of each joint (rad/s, m/s for a prismatic joint), shape (n_j,): a described hand's own, else
-        ``joint_speed`` for both fingers."""
+        """Speed limit of each joint (rad/s, m/s for a prismatic joint), shape (n_j,)."""
         return self.speeds if self.speeds is not None else np.full(len(self.joint_limits), self.joint_speed)
 
     @property
@@ -159,15 +160,18 @@ def _pair(value, field, unit) -> tuple:
 
 def make_task(hand, start_x, waypoints=None, mu_range=(0.0, 0.2), torque_resolution=0.02, shared_mu=False,
               joint_limits=None, joint_speed=None, workpiece_speed=0.01,
-              name="task", force_margin=None, goal=None, start=None, base_dir=None) -> Task:  # fmt: skip
+              name="task", force_margin=None, goal=None, start=None, base_dir=None, joint_speeds=None) -> Task:  # fmt: skip
     """Validate and build a :class:`Task` (parameters as its attributes; ``hand`` a TwoFingerHand or a dict of
     :func:`qsplan.hands.two_finger.make_two_finger_hand` arguments).  Either ``waypoints`` (a scripted
     sequence) or ``goal`` (the ``[goal]`` table as a dict, or a :class:`Goal`: the planner finds the sequence);
     ``start`` the ``[start]`` table as a dict (default both fingers ``"inner"``; a described hand: its free joints
     by name).  ``hand`` may also be a :class:`qsplan.hands.chain_hand.ChainHand` or a ``[hand]`` table naming a
     hand description (:mod:`qsplan.planner.planning.task_fields`; ``base_dir`` resolves its relative ``file``).
-    ``joint_limits`` default: the description's, else ``[0.05, 3.09]`` rad for each finger; ``joint_speed``
-    (rad/s, the paper's hand) default: the description's, else 0.5.
+    Limits (:func:`qsplan.planner.planning.limits.resolve_limits`, the one place): ``joint_limits``
+    (``{joint: [lo, hi]}`` for some joints, or one pair per joint in order), ``joint_speed`` (rad/s, every
+    revolute joint) and ``joint_speeds`` (``{joint: speed}`` in each joint's unit) narrow the hand's own
+    (a description's; the paper hand's parameter form has none: ``[0.05, 3.09]`` rad and 0.5 rad/s by
+    default), never widen them.
 
     Raises
     ------
@@ -177,21 +181,18 @@ def make_task(hand, start_x, waypoints=None, mu_range=(0.0, 0.2), torque_resolut
     from qsplan.hands.chain_hand import ChainHand
     from qsplan.hands.two_finger import TwoFingerHand
 
-    lim_default = speeds = None
+    own_limits = own_speeds = None
+    hand_label = "the hand"
     if isinstance(hand, dict):
-        hand, lim_default, speeds = hand_from_task_table(hand, base_dir)
+        hand, own_limits, own_speeds = hand_from_task_table(hand, base_dir)
+        hand_label = "the hand file" if own_limits is not None else hand_label
     elif isinstance(hand, ChainHand):
-        lim_default, speeds = hand.description.joint_limits, hand.description.joint_speeds
+        own_limits, own_speeds = hand.description.joint_limits, hand.description.joint_speeds
+        hand_label = f"the hand {hand.description.name!r}"
     if not isinstance(hand, (TwoFingerHand, ChainHand)):
         raise QsplanError(f"hand: expected a TwoFingerHand, a ChainHand or a [hand] table; got {type(hand).__name__}")
     check_hand(hand)
     chain = isinstance(hand, ChainHand)
-    if not chain and speeds is not None:  # a described paper hand: one speed for both fingers
-        joint_speed = float(np.min(speeds)) if joint_speed is None else joint_speed
-        speeds = None
-    joint_speed = 0.5 if joint_speed is None else joint_speed
-    if joint_limits is None:
-        joint_limits = ((0.05, 3.09), (0.05, 3.09)) if lim_default is None else np.asarray(lim_default).tolist()
     if not isinstance(name, str) or len(name) > 200:
         raise QsplanError(f"name: expected a string of at most 200 characters; got {short_repr(name)}")
     start_x = in_task_range(task_number(start_x, "motion.start_x", "m"), "motion.start_x", "position")
@@ -228,32 +229,27 @@ def make_task(hand, start_x, waypoints=None, mu_range=(0.0, 0.2), torque_resolut
         raise QsplanError(f"friction.range: expected lo < hi (plans are guaranteed over an interval of friction; for "
                           f"one known coefficient give a small interval around it); got [{lo:g}, {hi:g}]")  # fmt: skip
     names = hand.joint_names if chain else ("left", "right")
-    if not isinstance(joint_limits, (list, tuple, np.ndarray)) or len(joint_limits) != len(names):
-        raise QsplanError(f"limits: expected the ranges of the joints {', '.join(names)}; got {short_repr(joint_limits)}")
-    limits = np.array([_pair(joint_limits[k], f"limits.{side}", "rad") for k, side in enumerate(names)])
-    for k, side in enumerate(names):
-        for v in limits[k]:
-            in_task_range(float(v), f"limits.{side}", "joint_limit")
-        if not limits[k, 0] < limits[k, 1]:
-            raise QsplanError(f"limits.{side}: expected lo < hi (the joint must move); got {limits[k].tolist()}")
+    kinds = hand.description.joint_kinds if chain else ("revolute", "revolute")
+    resolved = resolve_limits(names, kinds, own_limits, own_speeds, ranges=joint_limits, joint_speed=joint_speed,
+                              speeds=joint_speeds, hand_label=hand_label)  # fmt: skip
+    limits, speeds = resolved.ranges, resolved.speeds
     base = hand.workpiece[:2, 0]
     if not base.min() < 0.0 < base.max():
         raise QsplanError("hand.workpiece: its centre of mass must lie over its bottom edge, so that it rests on the "
                           "palm while the fingers regrasp")  # fmt: skip
     wp.setflags(write=False)
-    limits.setflags(write=False)
     if not isinstance(shared_mu, (bool, np.bool_)):
         raise QsplanError(f"friction.shared: expected true or false; got {short_repr(shared_mu)}")
     checked = {key: in_task_range(task_number(value, field, TASK_RANGES[key][2], positive=True), field, key)
                for key, field, value in (("torque_resolution", "controller.torque_resolution", torque_resolution),
-                                         ("joint_speed", "limits.joint_speed", joint_speed),
                                          ("workpiece_speed", "limits.workpiece_speed", workpiece_speed))}  # fmt: skip
-    force_margin = PLAN_FORCE_MARGIN if force_margin is None else check_force_margin(force_margin)
-    if speeds is not None:
-        speeds = np.array(speeds, dtype=float)
-        speeds.setflags(write=False)
+    if force_margin is not None:  # the task file's ranges for the API too (plan_force_margin names the fields)
+        fm = check_force_margin(force_margin)
+        force_margin = plan_force_margin(fm.normal, fm.slack, "force_margin")
+    else:
+        force_margin = PLAN_FORCE_MARGIN
     return Task(name, hand, start_x, wp, (lo, hi), bool(shared_mu), checked["torque_resolution"], limits,
-                checked["joint_speed"], checked["workpiece_speed"], force_margin, goal, start_features, speeds,
+                float(np.min(speeds)), checked["workpiece_speed"], force_margin, goal, start_features, speeds,
                 start_joints)  # fmt: skip
 
 
@@ -264,7 +260,7 @@ def _start_joints(hand, table) -> np.ndarray | None:
     free = [hand.joint_names[j] for j in hand.free_joints()]
     extra = sorted(set(table) - set(free))
     if extra:
-        raise QsplanError(f"start.{extra[0]}: unknown field; expected the free joints {', '.join(free)} (each finger's "
+        raise QsplanError(f"start.{field_name(extra[0])}: unknown field; expected the free joints {', '.join(free)} (each finger's "
                           "last joint closes onto the workpiece)")  # fmt: skip
     if not table:
         return None
@@ -309,14 +305,14 @@ def load_task(path) -> Task:
         raise QsplanError(f"task: {str(path)!r} is not valid TOML: {' '.join(str(exc).split())}") from None
     unknown = sorted(set(doc) - _KNOWN)
     if unknown:
-        raise QsplanError(f"{unknown[0]}: unknown task field; expected one of {', '.join(sorted(_KNOWN))}")
+        raise QsplanError(f"{field_name(unknown[0])}: unknown task field; expected one of {', '.join(sorted(_KNOWN))}")
     kw = {}
     motion, friction = _table(doc, "motion"), _table(doc, "friction")
     controller, limits = _table(doc, "controller"), _table(doc, "limits")
-    for key, table in (("motion", motion), ("friction", friction), ("controller", controller), ("limits", limits)):
+    for key, table in (("motion", motion), ("friction", friction), ("controller", controller)):
         extra = sorted(set(table) - _TABLE_KEYS[key])
         if extra:
-            raise QsplanError(f"{key}.{extra[0]}: unknown field; expected some of {', '.join(sorted(_TABLE_KEYS[key]))}")
+            raise QsplanError(f"{key}.{field_name(extra[0])}: unknown field; expected some of {', '.join(sorted(_TABLE_KEYS[key]))}")
     if "start_x" not in motion:
         raise QsplanError("motion.start_x: missing")
     if "goal" in doc:
@@ -331,8 +327,11 @@ def load_task(path) -> Task:
         if not isinstance(friction["shared"], bool):
             raise QsplanError(f"friction.shared: expected true or false; got {short_repr(friction['shared'])}")
         kw["shared_mu"] = friction["shared"]
-    if "left" in limits or "right" in limits:
-        kw["joint_limits"] = (limits.get("left", (0.05, 3.09)), limits.get("right", (0.05, 3.09)))
+    ranges = {k: v for k, v in limits.items() if k not in LIMIT_KEYS}  # joints by name, checked against the hand
+    if ranges:
+        kw["joint_limits"] = ranges
+    if "speed" in limits:
+        kw["joint_speeds"] = limits["speed"]
     kw["base_dir"] = path.parent
     for key in ("joint_speed", "workpiece_speed"):
         if key in limits:
@@ -350,3 +349,11 @@ def demo_task_path() -> Path:
 def task_paths() -> dict:
     """Every bundled task file, ``{stem: Path}``."""
     return {p.stem: p for p in sorted(_DATA.glob("*.toml"))}
+
+
+def task_path(ref) -> Path:
+    """The task file ``ref`` names: an existing path, else a bundled task's name (:func:`task_paths`), else ``ref``
+    as a path (whose loading then names it missing)."""
+    path = Path(ref)
+    bundled = task_paths()
+    return bundled[str(ref)] if str(ref) in bundled and not path.exists() else path

@@ -14,9 +14,10 @@ from __future__ import annotations
 import numpy as np
 
 from qsplan.mechanics.errors import QsplanError
+from qsplan.mechanics.model.fields import in_range, short_repr
 
 __all__ = ["TASK_RANGES", "WORKPIECE_KEYS", "HandChoice", "check_hand", "hand_from_task_table", "in_task_range",
-           "short_repr", "task_number"]
+           "short_repr", "task_number", "field_name"]
 
 #: Plausible physical range ``(lo, hi)`` of every number of a task, with its unit; outside it a value is
 #: a mistake (a unit slip, a typo), not a hand.  Reasons:
@@ -35,6 +36,12 @@ __all__ = ["TASK_RANGES", "WORKPIECE_KEYS", "HandChoice", "check_hand", "hand_fr
 #: * ``workpiece_speed`` (m/s): from 1e-4 (a 4 cm segment then takes 7 minutes; 1e-300 m/s gave joint
 #:   velocities of 1e11 rad/s) to 0.5 (beyond, the inertial forces of a workpiece turning over a 5 cm
 #:   corner, v^2/r, exceed gravity and the quasistatic model no longer holds).
+#: * ``min_normal_force``, ``min_coulomb_slack`` (N): ``[controller]``'s force margin
+#:   (:data:`qsplan.planner.torque.command.PLAN_FORCE_MARGIN`, 0.05 N by default), from 0 (none) to 100 N:
+#:   the margin covers loads the model leaves out (a mass error, the workpiece's inertia), and a
+#:   hand-scale finger presses with tens of newtons (a human fingertip about 50 N), so a margin beyond
+#:   100 N (the weight of 10 kg) asks for contact forces no such finger exerts (1e6 N was planned, with
+#:   a command of 713,407 N m).
 TASK_RANGES = {
     "size": (1e-3, 1.0, "m"),
     "position": (-1.0, 1.0, "m"),
@@ -46,7 +53,16 @@ TASK_RANGES = {
     "joint_limit": (-np.pi, np.pi, "rad"),
     "joint_speed": (1e-3, 10.0, "rad/s"),
     "workpiece_speed": (1e-4, 0.5, "m/s"),
+    "min_normal_force": (0.0, 100.0, "N"),
+    "min_coulomb_slack": (0.0, 100.0, "N"),
 }
+
+
+def field_name(key) -> str:
+    """A key of a task file as an error names it: as written, cut to 40 characters (a 3 MB key is one short line)."""
+    text = str(key)
+    return text if len(text) <= 40 else text[:30] + "..." + text[-7:]
+
 
 def task_number(value, field, unit, positive=False, nonnegative=False) -> float:
     if isinstance(value, (bool, str)):
@@ -64,11 +80,9 @@ def task_number(value, field, unit, positive=False, nonnegative=False) -> float:
 
 
 def in_task_range(x: float, field: str, kind: str) -> float:
+    """``x`` inside ``TASK_RANGES[kind]``; the error names the field, the range and a unit slip (mm, degrees)."""
     lo, hi, unit = TASK_RANGES[kind]
-    if not lo <= x <= hi:
-        raise QsplanError(f"{field}: expected {lo:g} to {hi:g} {unit} (qsplan.planner.planning.task.TASK_RANGES[{kind!r}]); "
-                          f"got {x:g}")  # fmt: skip
-    return x
+    return in_range(x, field, lo, hi, unit, f"qsplan.planner.planning.task.TASK_RANGES[{kind!r}]", QsplanError)
 
 
 def check_hand(hand) -> None:
@@ -110,13 +124,6 @@ def _paper_hand_from_table(table: dict):
         return make_two_finger_hand(**table)
     except QsplanError as exc:
         raise QsplanError(f"hand.{exc}") from None
-
-
-def short_repr(value) -> str:
-    text = repr(value)
-    return text if len(text) <= 40 else text[:20] + "..." + text[-10:]
-
-
 
 
 #: The keys of a ``[hand]`` table that describe the workpiece (and its friction), whatever the hand.

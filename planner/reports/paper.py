@@ -66,21 +66,29 @@ def reproduce_paper(out_dir, n: int = 161, progress=None, force: bool = False) -
         atomically (a temporary name, then renamed).
     force : bool
         Replace existing files of those names (checked before any work; without it an existing
-        one raises :class:`~qsplan.planner.export.files.OutputExistsError`).
+        one raises :class:`~qsplan.planner.export.files.OutputExistsError`).  The folder is held
+        by this run alone (:func:`~qsplan.planner.export.files.locked_out_dir`); one that cannot
+        be created or written raises :class:`~qsplan.mechanics.QsplanError` before any work.
     n : int
         Grid points per mu axis.
     progress : file-like, optional
         Receives one line per step.
     """
+    from qsplan.planner.export.files import check_out_dir, check_outputs, locked_out_dir
+
+    say = (lambda s: print(s, file=progress, flush=True)) if progress else (lambda s: None)
+    with locked_out_dir(check_out_dir(out_dir)) as out:  # created, writable, and written by this run alone
+        check_outputs([out / name for name in PAPER_FILES], force)
+        return _reproduce(out, n, say)
+
+
+def _reproduce(out, n, say) -> str:
+    """The work of :func:`reproduce_paper` into the checked directory ``out``."""
     from qsplan.planner.plotting.muspace import mu_slices_figure, rod_mu_figure
 
-    from qsplan.planner.export.files import atomic_write, check_out_dir, check_outputs
+    from qsplan.planner.export.files import atomic_write
     from qsplan.planner.plotting.style import save_figure
 
-    out = check_out_dir(out_dir)
-    check_outputs([out / name for name in PAPER_FILES], force)
-    out.mkdir(parents=True, exist_ok=True)
-    say = (lambda s: print(s, file=progress, flush=True)) if progress else (lambda s: None)
     results = {}
     t0 = time.perf_counter()
 

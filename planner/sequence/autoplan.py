@@ -4,7 +4,8 @@
 
 1. **Tables.**  Every candidate grasp of the hand (:func:`qsplan.hands.grasps.candidate_grasps`:
    each finger's inner edge on a vertex, or its tip on an edge) judged on a grid of the
-   workpiece's ``x`` through the start and the goal (:func:`qsplan.planner.sequence.tables.band_tables`).
+   workpiece's ``x`` through the start and the goal, where the workpiece rests on the palm
+   (:func:`qsplan.planner.sequence.tables.band_tables`, :func:`qsplan.planner.planning.goal.palm_x_range`).
 2. **Search.**  The route of 4S slides and regrasps whose narrowest guaranteed band is widest,
    then with the fewest regrasps, steps and segments (:mod:`qsplan.planner.sequence.widest`), run
    as an OMPL planner (:func:`qsplan.planner.sequence.ompl_search.search_route`).
@@ -216,7 +217,9 @@ def plan_automatic(task, options=None, progress=None, planner: str = "widest", t
     t_start = time.perf_counter()
     if tables is None:
         grasps = candidate_grasps(task.hand)
-        grid = table_grid(task.start_x, task.goal.x, float(task.hand.palm_halfwidth))
+        from qsplan.planner.planning.goal import palm_x_range
+
+        grid = table_grid(task.start_x, task.goal.x, palm_x_range(task.hand))  # never the workpiece off the palm
         progress(f"band tables: {len(grasps)} candidate grasps x {len(grid)} workpiece positions "
                  f"({grid[0]:.4g} to {grid[-1]:.4g} m)")  # fmt: skip
         tables = band_tables(task, grasps, grid)

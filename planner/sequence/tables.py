@@ -22,6 +22,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from qsplan.mechanics.errors import QsplanError
 from qsplan.planner.sequence.widest import SearchGraph
 
 __all__ = ["BandTables", "band_tables", "table_grid", "GRID_STEP", "OVERLAP", "SEARCH_MARGIN"]
@@ -100,14 +101,26 @@ class BandTables:
         return hit[0].message if hit else "two bodies overlap"
 
 
-def table_grid(start_x: float, goal_x: float, limit: float, step: float = GRID_STEP, margin: float = SEARCH_MARGIN):
+def table_grid(start_x: float, goal_x: float, limit, step: float = GRID_STEP, margin: float = SEARCH_MARGIN):
     """The grid (m), shape (n,): through ``start_x`` and ``goal_x`` exactly, spacing at most ``step``, reaching
-    ``margin`` beyond both and no further than ``|x| <= limit``."""
+    ``margin`` beyond both and no further than ``limit``: ``(lo, hi)`` (the workpiece x on the palm,
+    :func:`qsplan.planner.planning.goal.palm_x_range`), or a number for ``|x| <= limit``.
+
+    Raises
+    ------
+    QsplanError
+        ``start_x`` or ``goal_x`` outside the limits (a task beyond the palm is refused before its tables:
+        :func:`qsplan.planner.planning.failure.palm_report`).
+    """
+    lo_lim, hi_lim = (-float(limit), float(limit)) if np.ndim(limit) == 0 else (float(limit[0]), float(limit[1]))
+    for name, x in (("start_x", start_x), ("goal_x", goal_x)):
+        if not lo_lim <= x <= hi_lim:
+            raise QsplanError(f"{name}: {x:g} m is outside the grid's limits [{lo_lim:g}, {hi_lim:g}] m")
     span = goal_x - start_x
     k = int(np.ceil(abs(span) / step))
     h = abs(span) / k if k else step
-    lo = max(min(start_x, goal_x) - margin, -limit)
-    hi = min(max(start_x, goal_x) + margin, limit)
+    lo = max(min(start_x, goal_x) - margin, lo_lim)
+    hi = min(max(start_x, goal_x) + margin, hi_lim)
     below = int(np.floor((min(start_x, goal_x) - lo) / h + _GRID_ROUNDING))
     above = int(np.floor((hi - max(start_x, goal_x)) / h + _GRID_ROUNDING))
     base = min(start_x, goal_x)
@@ -115,7 +128,7 @@ def table_grid(start_x: float, goal_x: float, limit: float, step: float = GRID_S
     # the start and the goal exactly (no rounding of base + h * k)
     grid[below] = base
     grid[below + k] = max(start_x, goal_x)
-    return grid
+    return np.clip(grid, lo_lim, hi_lim)  # an end point a rounding beyond a limit (_GRID_ROUNDING) is put on it
 
 
 def _no_contact(grasp, finger: int) -> str:

@@ -18,6 +18,7 @@ import numpy as np
 
 from qsplan.mechanics.bands.effort import ForceMargin
 from qsplan.mechanics.errors import NoAnswerError, QsplanError
+from qsplan.planner.planning.task_fields import in_task_range, short_repr
 
 __all__ = ["MAX_MARGIN_RESOLUTIONS", "PLAN_FORCE_MARGIN", "choose_command", "command_rule", "default_safety_margin",
            "plan_force_margin", "segment_command", "with_segment_command"]
@@ -49,7 +50,9 @@ PLAN_FORCE_MARGIN = ForceMargin(normal=0.05, slack=0.05)
 def plan_force_margin(min_normal_force=None, min_coulomb_slack=None, field: str = "controller") -> ForceMargin:
     """A plan's :class:`ForceMargin` (N), :data:`PLAN_FORCE_MARGIN`'s value where one is not given.
 
-    Errors name ``<field>.min_normal_force`` / ``<field>.min_coulomb_slack`` (the task file's keys).
+    Each inside its plausible range (``TASK_RANGES['min_normal_force']``, ``['min_coulomb_slack']`` of
+    :mod:`qsplan.planner.planning.task_fields`, with the reason).  Errors name ``<field>.min_normal_force`` /
+    ``<field>.min_coulomb_slack`` (the task file's keys).
     """
     values = []
     for name, v, default in (("min_normal_force", min_normal_force, PLAN_FORCE_MARGIN.normal),
@@ -62,9 +65,8 @@ def plan_force_margin(min_normal_force=None, min_coulomb_slack=None, field: str 
         except (TypeError, ValueError):
             x = np.nan
         if not (np.isfinite(x) and x >= 0):
-            text = repr(v) if len(repr(v)) <= 40 else repr(v)[:20] + "..."
-            raise QsplanError(f"{field}.{name}: expected a nonnegative finite force (N); got {text}")
-        values.append(x)
+            raise QsplanError(f"{field}.{name}: expected a nonnegative finite force (N); got {short_repr(v)}")
+        values.append(in_task_range(x, f"{field}.{name}", name))
     return ForceMargin(*values)
 
 
@@ -171,8 +173,8 @@ def default_safety_margin(band, resolution=None) -> float:
     so keeping that margin from a finite edge where the band is unbounded asks nothing
     more of it; with ``resolution`` (the controller's, N m) a very wide band keeps no more
     than a few resolutions, so the command stays near the torque the mode needs.  With
-    no bounded point, the largest finite edge (the size of the torque the mode needs),
-    capped alike; with none, :class:`qsplan.mechanics.NoAnswerError` (no band to size it from).
+    no bounded point, the largest finite edge (the size of the torque the mode needs), at least half the
+    resolution and capped alike; with none, :class:`qsplan.mechanics.NoAnswerError` (no band to size it from).
 
     Parameters
     ----------
@@ -189,7 +191,10 @@ def default_safety_margin(band, resolution=None) -> float:
         return min(0.5 * float(np.min(w[bounded])), cap)
     edges = np.abs(np.concatenate([band.lower[np.isfinite(band.lower)], band.upper[np.isfinite(band.upper)]]))
     if edges.size and edges.max() > 0:
-        return min(float(edges.max()), cap)  # no bounded point: the size of the effort the mode needs
+        # no bounded point: the size of the effort the mode needs, but at least half the resolution (a controller
+        # holding the command to within half its resolution stays in the band; the certifier checks it)
+        floor = 0.0 if resolution is None else 0.5 * float(resolution)
+        return min(max(float(edges.max()), floor), cap)
     raise NoAnswerError("safety margin: no bounded band along the segment to size it from; pass one explicitly")
 
 

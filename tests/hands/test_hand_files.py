@@ -159,7 +159,7 @@ def _form_variant(edit):
 @pytest.mark.parametrize("edit", [
     lambda d: d["fingers"][1]["joints"][0].update(origin=[0.08, 0.0, 0.0]),   # not symmetric
     lambda d: d["fingers"][0]["joints"][0].update(origin=[-0.09, 0.01, 0.0]),  # joint above the palm
-    lambda d: d["fingers"][0]["joints"][0].update(type="prismatic"),
+    lambda d: d["fingers"][0]["joints"][0].update(type="prismatic", limits=[0.0, 0.1], speed=0.05),
     lambda d: d["fingers"][0]["joints"][0]["link"].update(polygon=[[0.0, -0.006], [0.15, -0.006], [0.15, 0.006], [0.0, 0.006]]),
     lambda d: d["fingers"][0]["joints"][0]["link"].update(polygon=[[0.0, -0.005], [0.16, -0.006], [0.16, 0.006], [0.0, 0.006]]),
     lambda d: d["fingers"][0]["joints"][0]["link"].update(mass=0.1),
@@ -259,8 +259,8 @@ BAD = [
     ("infinite limit", lambda d: _joint(d, 0, 0).update(limits=[0, float("inf")]),
      r"hand\.fingers\[0\]\.joints\[0\]\.limits\[1\]: expected a finite number"),
     ("negative speed", lambda d: _joint(d, 1, 1).update(speed=-0.5),
-     r"hand\.fingers\[1\]\.joints\[1\]\.speed: expected a positive speed \(rad/s\); got -0\.5"),
-    ("zero speed", lambda d: _joint(d, 1, 1).update(speed=0), r"hand\.fingers\[1\]\.joints\[1\]\.speed: expected a positive speed"),
+     r"hand\.fingers\[1\]\.joints\[1\]\.speed: expected 0\.001 to 10 rad/s \(.*HAND_RANGES\['revolute_speed'\]\); got -0\.5$"),
+    ("zero speed", lambda d: _joint(d, 1, 1).update(speed=0), r"hand\.fingers\[1\]\.joints\[1\]\.speed: expected 0\.001 to 10 rad/s"),
     ("speed not a number", lambda d: _joint(d, 0, 0).update(speed="fast"), r"hand\.fingers\[0\]\.joints\[0\]\.speed: expected a number"),
     ("missing speed", lambda d: _joint(d, 0, 0).pop("speed"), r"hand\.fingers\[0\]\.joints\[0\]\.speed: missing"),
     ("short origin", lambda d: _joint(d, 0, 0).update(origin=[0.0, 0.0]), r"hand\.fingers\[0\]\.joints\[0\]\.origin: expected 3 numbers; got 2"),
@@ -292,13 +292,13 @@ BAD = [
     ("missing link", lambda d: _joint(d, 1, 1).pop("link"), r"hand\.fingers\[1\]\.joints\[1\]\.link: missing"),
     ("link not a table", lambda d: _joint(d, 1, 1).update(link=[1]), r"hand\.fingers\[1\]\.joints\[1\]\.link: expected a table"),
     ("negative mass", lambda d: _joint(d, 0, 1)["link"].update(mass=-1.0),
-     r"hand\.fingers\[0\]\.joints\[1\]\.link\.mass: expected a nonnegative mass \(kg\); got -1"),
+     r"hand\.fingers\[0\]\.joints\[1\]\.link\.mass: expected 0 to 100 kg \(.*HAND_RANGES\['link_mass'\]\); got -1$"),
     ("bad com", lambda d: _joint(d, 0, 1)["link"].update(com=[0.0]), r"hand\.fingers\[0\]\.joints\[1\]\.link\.com: expected 2 numbers"),
     ("duplicate joint names", lambda d: _joint(d, 1, 0).update(name="left_proximal"),
      r"hand\.fingers\[1\]\.joints\[0\]\.name: expected a unique name; 'left_proximal' is also hand\.fingers\[0\]\.joints\[0\]\.name"),
     ("joint named palm", lambda d: _joint(d, 0, 1).update(name="palm"), r"hand\.fingers\[0\]\.joints\[1\]\.name: 'palm' is reserved"),
     ("empty joint name", lambda d: _joint(d, 0, 1).update(name=" "), r"hand\.fingers\[0\]\.joints\[1\]\.name: expected a non-empty string"),
-    ("negative gravity", lambda d: d.update(gravity=-9.81), r"hand\.gravity: expected a nonnegative magnitude"),
+    ("negative gravity", lambda d: d.update(gravity=-9.81), r"hand\.gravity: expected 0 to 100 m/s\^2 .*; got -9\.81$"),
     ("name not a string", lambda d: d.update(name=3), r"hand\.name: expected a non-empty string; got 3"),
 ]  # fmt: skip
 
@@ -318,7 +318,7 @@ def test_prismatic_limits_are_in_metres():
     with pytest.raises(SceneError, match=r"^hand\.fingers\[1\]\.joints\[0\]\.limits: expected \[lo, hi\] with lo < hi \(m\)"):
         hand_from_table(doc)
     _joint(doc, 1, 0)["limits"], _joint(doc, 0, 0)["speed"] = [-0.085, 0.0], -1
-    with pytest.raises(SceneError, match=r"^hand\.fingers\[0\]\.joints\[0\]\.speed: expected a positive speed \(m/s\)"):
+    with pytest.raises(SceneError, match=r"^hand\.fingers\[0\]\.joints\[0\]\.speed: expected 0\.0001 to 0\.5 m/s"):
         hand_from_table(doc)
 
 

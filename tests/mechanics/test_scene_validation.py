@@ -105,7 +105,7 @@ def test_oversized_file_is_refused_unparsed(tmp_path):
 
 @pytest.mark.parametrize(
     "text,toml,depth",
-    [('{"a": "[[[[", "b": [1]}', False, 2), ("a = '[[[[' # [[[[\n[b]\nc = [[1]]", True, 2), ('{"a": "\\"[["}', False, 1),
+    [('{"a": "[[[[", "b": [1]}', False, 2), ("a = '[[[[' # [[[[\n[b]\nc = [[1]]", True, 3), ('{"a": "\\"[["}', False, 1),
      ('a = """ [[[ """', True, 0)],  # fmt: skip
 )
 def test_nesting_depth_ignores_strings_and_comments(text, toml, depth):

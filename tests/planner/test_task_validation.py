@@ -51,6 +51,14 @@ def test_bundled_tasks_load():
         ("motion", "waypoints", [0.01 * (-1) ** k for k in range(MAX_WAYPOINTS + 1)], r"motion\.waypoints: expected a list of 1 to 50"),
         ("motion", "waypoints", [1e-300], r"motion\.waypoints\[0\]: segment 1 moves the workpiece 1e-300 m"),
         ("motion", "start_x", 1e21, r"motion\.start_x: expected -1 to 1 m"),
+        ("controller", "min_normal_force", 1e6,
+         r"^controller\.min_normal_force: expected 0 to 100 N \(.*TASK_RANGES\['min_normal_force'\]\); got 1e\+06$"),
+        ("controller", "min_coulomb_slack", 101.0,
+         r"^controller\.min_coulomb_slack: expected 0 to 100 N \(.*TASK_RANGES\['min_coulomb_slack'\]\); got 101$"),
+        ("controller", "min_normal_force", -0.01, r"^controller\.min_normal_force: expected a nonnegative finite force \(N\)"),
+        ("controller", "min_coulomb_slack", "0.1", r"^controller\.min_coulomb_slack: expected a nonnegative finite force"),
+        ("hand", "finger_length", 160, r"^hand\.finger_length: expected 0\.001 to 1 m .*; got 160: looks like millimetres; "
+                                       r"expected metres$"),
     ],
 )
 def test_bad_task_fields_one_line(tmp_path, demo, table, key, value, match):
@@ -82,3 +90,23 @@ def test_make_task_checks_ranges_of_a_built_hand():
 
     with pytest.raises(QsplanError, match=r"limits\.workpiece_speed"):
         make_task(default_hand(), 0.0, [-0.04], workpiece_speed=1e-300)
+
+
+@pytest.mark.parametrize("key", ["min_normal_force", "min_coulomb_slack"])
+def test_controller_margins_at_their_range_edges_are_kept(tmp_path, demo, key):
+    for value in TASK_RANGES[key][:2]:
+        demo["controller"][key] = value
+        margin = _load(tmp_path, demo).force_margin
+        assert (margin.normal if key == "min_normal_force" else margin.slack) == value
+
+
+def test_a_task_names_its_hand_files_out_of_range_field(tmp_path):
+    from qsplan.hands.description import bundled_hands
+
+    (tmp_path / "big.toml").write_text(bundled_hands()["two_link_hand"].read_text().replace("mass = 0.0", "mass = 1e5", 1))
+    doc = tomllib.loads(task_paths()["two_link_task"].read_text())
+    doc["hand"] = {k: v for k, v in doc["hand"].items() if k in ("workpiece", "workpiece_mass", "mu", "palm_edge")}
+    doc["hand"]["file"] = "big.toml"
+    with pytest.raises(QsplanError, match=r"^hand\.file: .*big\.toml: fingers\[0\]\.joints\[0\]\.link\.mass: expected 0 "
+                                          r"to 100 kg .*; got 100000$"):  # fmt: skip
+        _load(tmp_path, doc)
