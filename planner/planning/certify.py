@@ -36,7 +36,7 @@ import numpy as np
 
 from qsplan.mechanics import QsplanError
 
-from qsplan.planner.planning.certify_bands import BAND_RTOL, band_checks, free_row_cells
+from qsplan.planner.planning.certify_bands import BAND_RTOL, band_checks, free_row_cells, recomputed_bands
 from qsplan.planner.planning.certify_files import META_TOL, agreement_checks, metadata_checks, schema_checks
 from qsplan.planner.planning.certify_inputs import (plan_columns_required, plan_file, plan_sources, read_plan,
                                                     read_plan_file, task_from_metadata)  # fmt: skip
@@ -290,6 +290,7 @@ def certify_plan(plan, task, *, n_random: int = 8, seed: int = 0, force_margin: 
     phase = cols.get("phase", np.full(n, np.nan))  # without phases (nan != nan) no two rows are compared
     found_at = [[] for _ in range(n)]
     verdict_info, slip, ends = [], None, {}  # slip: (row, phase, sliding velocities) of the last in-contact row
+    scenes = {}  # in-contact rows' scenes: their bands recomputed in one batch per mode
     for k in range(n):
         mode = str(cols["mode"][k])
         found = limit_checks(task, cols, k)
@@ -318,7 +319,7 @@ def certify_plan(plan, task, *, n_random: int = 8, seed: int = 0, force_margin: 
                 except QsplanError as exc:
                     found.append(("contact", f"the row's scene cannot be built: {exc}"))
                 else:
-                    found += band_checks(task, cols, k, scene)
+                    scenes[k] = scene
                     more, excluded = mode_checks(task, cols, k, mus, force_margin, _xdot_rows(cols, k), batched, scene)
                     found += more
                     slips = slip_velocities(task, cols, k, scene)
@@ -330,6 +331,8 @@ def certify_plan(plan, task, *, n_random: int = 8, seed: int = 0, force_margin: 
         verdict_info.append((mode, pts, excluded))
         if progress is not None and (k + 1) % 50 == 0:
             progress(f"certified {k + 1} of {n} rows")
+    for k, rb in recomputed_bands(task, cols, scenes).items():
+        found_at[k] += band_checks(task, cols, k, rb)
     if 0 in ends and n - 1 in ends:
         whole += endpoint_checks(task, cols, ends[0], ends[n - 1])
     plan_level = []

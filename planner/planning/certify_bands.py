@@ -1,10 +1,12 @@
 """The certifier's band checks: every exported band is a claim, recomputed from the task (issue 21).
 
 An in-contact row exports the torque-controlled joint's guaranteed band ``[tau_<j>_min, tau_<j>_max]`` and the
-command's ``margin``.  :func:`band_checks` recomputes the band at the row's scene (rebuilt from the task:
-:func:`qsplan.planner.planning.certify_modes.row_scene`) with :func:`qsplan.mechanics.robust_band`, the
-per-scene reference (the planner uses its batched twin): the planned mode feasible for every friction in the
-task's set with the task's force margin, every competitor precluded.  A row is refused when
+command's ``margin``.  :func:`recomputed_bands` recomputes the band at the row's scene (rebuilt from the task:
+:func:`qsplan.planner.planning.certify_modes.row_scene`) with the mechanics' batched
+:func:`~qsplan.mechanics.bands.batched_robust.robust_bands` (the answers of :func:`qsplan.mechanics.robust_band`):
+the planned mode feasible for every friction in the task's set with the task's force margin, every
+competitor precluded (all the modes admissible at the row, not the planner's list); :func:`band_checks`
+compares.  A row is refused when
 
 * ``band``: no such band exists there, or the exported band reaches beyond the recomputed one (by more than
   :data:`BAND_RTOL`; a recomputation that is only conservative proves nothing beyond itself), or the exported
@@ -23,7 +25,7 @@ import math
 
 import numpy as np
 
-__all__ = ["BAND_RTOL", "band_checks", "free_row_cells"]
+__all__ = ["BAND_RTOL", "band_checks", "free_row_cells", "recomputed_bands"]
 
 #: Relative excess (of the larger finite edge, at least 1 N m) tolerated of an exported band edge over the
 #: recomputed one.  Planner and certifier compute the band with the same equations from scenes that agree to
@@ -36,11 +38,29 @@ def _fmt(v) -> str:
     return f"{v:.6g}" if math.isfinite(v) else ("-inf" if v < 0 else "inf")
 
 
-def band_checks(task, cols, k, scene) -> list:
-    """The exported band and margin of in-contact row ``k`` against their recomputation (``scene``: the row's)."""
-    from qsplan.mechanics.bands.robust import robust_band
+def recomputed_bands(task, cols, scenes: dict) -> dict:
+    """``{row: RobustBand}``: the guaranteed band of every in-contact row's scene (``scenes``: ``{row: Scene}``),
+    every competitor precluded, for the task's friction set and force margin.
 
-    e, mode = str(cols["effort_joint"][k]), str(cols["mode"][k])
+    :func:`qsplan.mechanics.bands.batched_robust.robust_bands` batches the rows of one mode (the same answers as
+    :func:`qsplan.mechanics.robust_band` row by row, bit for bit: ``tests/mechanics/test_bands_batched.py``).
+    """
+    from qsplan.mechanics.bands.batched_robust import robust_bands
+
+    groups = {}
+    for k in scenes:
+        groups.setdefault(str(cols["mode"][k]), []).append(k)
+    out = {}
+    for mode, rows in groups.items():
+        bands = robust_bands([scenes[k] for k in rows], mode, task.mu_range, shared=task.shared_mu,
+                             force_margin=task.force_margin)  # fmt: skip
+        out.update(zip(rows, bands))
+    return out
+
+
+def band_checks(task, cols, k, rb) -> list:
+    """The exported band and margin of in-contact row ``k`` against ``rb``, its recomputation (:func:`recomputed_bands`)."""
+    e = str(cols["effort_joint"][k])
     tau, lo, hi = (float(cols[f"tau_{e}{s}"][k]) for s in ("", "_min", "_max"))
     if not (math.isfinite(tau) and not math.isnan(lo) and not math.isnan(hi)):
         return []  # no command or band: the torque check names it
@@ -48,7 +68,6 @@ def band_checks(task, cols, k, scene) -> list:
 
     unit = dict(zip(joint_names(task.hand), joint_units(task.hand, "tau"))).get(e, "N m")
     out = []
-    rb = robust_band(scene, mode, task.mu_range, shared=task.shared_mu, force_margin=task.force_margin)
     if not rb.feasible:
         out.append(("band", f"no guaranteed band exists here (recomputed: {rb.reason}); the file claims "
                             f"[{_fmt(lo)}, {_fmt(hi)}] {unit}"))  # fmt: skip
