@@ -2,7 +2,7 @@
 
 For every task of ``planner/data`` with a ``[goal]``, the band tables are built once (their time is
 shown) and the route searched by each planner of
-:data:`qsplan.planner.sequence.ompl_search.SEQUENCE_PLANNERS` inside OMPL: ours (``widest``, the exact
+:data:`qsplan.planner.search.ompl_search.SEQUENCE_PLANNERS` inside OMPL: ours (``widest``, the exact
 widest-route search on the tables, an ``ob.Planner`` subclass) and OMPL's asymptotically optimal
 sampling planners with the minimax objective (``RRTstar``, ``BITstar``; iteration budget, seed 1).
 The table: time, states evaluated (table look-ups or nodes expanded), the route's narrowest band (N m),
@@ -19,18 +19,18 @@ import argparse
 import time
 
 from qsplan.planner import load_task, plan_task, task_paths
-from qsplan.planner.sequence.autoplan import plan_automatic
-from qsplan.planner.sequence.ompl_search import SEQUENCE_PLANNERS, search_route
-from qsplan.planner.sequence.tables import band_tables, table_grid
+from qsplan.planner.plan.autoplan import plan_automatic
+from qsplan.planner.search.ompl_search import SEQUENCE_PLANNERS, search_route
+from qsplan.planner.search.tables import band_tables, table_grid
 
 
 def search_rows(task, iterations):
     """One row per planner: (planner, seconds, evaluations, width, regrasps) on the task's tables."""
     from qsplan.hands.grasp_geometry import candidate_grasps
-    from qsplan.planner.sequence.autoplan import goal_nodes, start_nodes
+    from qsplan.planner.plan.autoplan import goal_nodes, start_nodes
 
     t0 = time.perf_counter()
-    from qsplan.planner.planning.goal import palm_x_range
+    from qsplan.planner.task.goal import palm_x_range
 
     tables = band_tables(task, candidate_grasps(task.hand), table_grid(task.start_x, task.goal.x, palm_x_range(task.hand)))
     t_tables = time.perf_counter() - t0
@@ -54,7 +54,7 @@ def synthetic_rows(iterations, G=6, n=400, seed=1):
     route's width differs between planners only where regrasps and detours matter."""
     import numpy as np
 
-    from qsplan.planner.sequence.widest import SearchGraph
+    from qsplan.planner.search.widest import SearchGraph
 
     rng = np.random.default_rng(seed)
     valid = rng.random((G, n)) > 0.05

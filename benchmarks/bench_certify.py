@@ -3,11 +3,11 @@
 Plans the demo task once (seeded, deterministic), exports it, then times, best of ``--repeat``
 (the machine is shared: the best run is the least disturbed one):
 
-* the certification (:func:`qsplan.planner.planning.certify.certify_plan`) with every friction
+* the certification (:func:`qsplan.planner.certify.certify.certify_plan`) with every friction
   vector of a row in one batch, and the per-vector reference (``batched=False``, one
   :func:`qsplan.mechanics.solve` per friction vector: the algorithm before issue 13), and
   whether their certificates are the same;
-* the re-simulation at the demo's three friction vectors (:func:`qsplan.planner.planning.replay.replay_plan`)
+* the re-simulation at the demo's three friction vectors (:func:`qsplan.planner.replay.replay.replay_plan`)
   with the scenes shared between the three replays, and without;
 * the plots (:func:`qsplan.planner.plotting.plan.plan_figures` and saving them), the first time
   in the process (imports included, as in the command) and again.
@@ -21,10 +21,10 @@ import time
 from pathlib import Path
 
 from qsplan.planner import export_plan, load_task, plan_task
+from qsplan.planner.certify.certify import certify_plan
 from qsplan.planner.export.plan_files import read_plan_csv
-from qsplan.planner.planning.certify import certify_plan
-from qsplan.planner.planning.replay import friction_samples, replay_plan
-from qsplan.planner.planning.task import demo_task_path
+from qsplan.planner.replay.replay import friction_samples, replay_plan
+from qsplan.planner.task.task import demo_task_path
 
 #: Before issue 13's certifier and replay work (2-core machine shared with other jobs, one ``qsplan
 #: demo`` run timed in-process, the code at the commit before it): certification 16.7 s, the three

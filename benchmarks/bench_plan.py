@@ -40,7 +40,7 @@ def table_rate(repeat):
     """In-contact state checks per second (best of ``repeat``): the demo's band tables, every check a scene and a
     guaranteed band with every competitor precluded (one torque-controlled finger, one direction), batched."""
     from qsplan.hands.grasp_geometry import candidate_grasps
-    from qsplan.planner.sequence.tables import band_tables, table_grid
+    from qsplan.planner.search.tables import band_tables, table_grid
 
     task = load_task(task_paths()["demo_task"])
     grasps, grid = candidate_grasps(task.hand), table_grid(-0.06, 0.06, 0.16, margin=0.0)

@@ -19,8 +19,8 @@ import qsplan.hands.two_finger_scene as scenes
 from qsplan.hands.segments import first_segment
 from qsplan.hands.two_finger import default_hand, finger_angles
 from qsplan.hands.two_finger_analytic import grasp_contacts
-from qsplan.planner.planning.contact_state import check_contact_state
-from qsplan.planner.planning.task import load_task, task_paths
+from qsplan.planner.states.contact import check_contact_state
+from qsplan.planner.task.task import load_task, task_paths
 
 FIELDS = ("Wn", "Wt", "Jn", "Jt", "mu", "g_obj", "g_man", "joint_velocity", "joint_effort")
 

@@ -10,6 +10,12 @@
 * :mod:`qsplan.hands.grasp_geometry` - a grasp's joint angles, contacts and rates along the palm (vectorized).
 * :mod:`qsplan.hands.batch_scenes` - a grasp's scenes at many positions at once.
 * :mod:`qsplan.hands.segments` - manipulation segments of that hand (segment 1: translate left in 4S).
+* :mod:`qsplan.hands.formations` - contact formations (which feature touches which body, the desired mode) as values.
+* :mod:`qsplan.hands.protocol` - the :class:`Hand` protocol the planner sees, its grasp states and scene arrays.
+* :mod:`qsplan.hands.described` - :class:`DescribedHand`, the one hand: any description, batched generic path
+  (:mod:`~qsplan.hands.described_states`, :mod:`~qsplan.hands.described_scenes`,
+  :mod:`~qsplan.hands.described_candidates`, :mod:`~qsplan.hands.closing_batch`, :mod:`~qsplan.hands.chain_arrays`),
+  the paper's closed forms as an accelerator (:mod:`~qsplan.hands.paper_accelerator`).
 
 Submodules are imported on first use so that ``import qsplan.hands`` stays light.
 """
@@ -80,6 +86,23 @@ _LAZY = {
     "sample_segment": "qsplan.hands.segments",
     "flush_angle": "qsplan.hands.segments",
     "FLUSH_CLEARANCE": "qsplan.hands.segments",
+    "BODIES": "qsplan.hands.formations",
+    "ContactSlot": "qsplan.hands.formations",
+    "DEFAULT_FORMATION": "qsplan.hands.formations",
+    "FORMATIONS": "qsplan.hands.formations",
+    "Formation": "qsplan.hands.formations",
+    "formation": "qsplan.hands.formations",
+    "Hand": "qsplan.hands.protocol",
+    "GraspStates": "qsplan.hands.protocol",
+    "GraspSceneArrays": "qsplan.hands.protocol",
+    "ChainGrasp": "qsplan.hands.protocol",
+    "FingerContact": "qsplan.hands.protocol",
+    "STATE_REASONS": "qsplan.hands.protocol",
+    "DescribedHand": "qsplan.hands.described",
+    "make_described_hand": "qsplan.hands.described",
+    "described_from_two_finger": "qsplan.hands.described",
+    "described_from_chain": "qsplan.hands.described",
+    "hand_from_metadata": "qsplan.hands.described",
 }
 
 __all__ = list(_LAZY)

@@ -30,6 +30,8 @@ Public API (this module's ``__all__``): the names below.  Each loads its module 
 * effort bands (eq. 28, Section 5.2): :func:`effort_band`, :func:`guaranteed_band_box`,
   :func:`guaranteed_band_shared`, :func:`sampled_band`
 * all feasible modes, vectorized: :func:`solve`, :class:`SolveResult`, :class:`ModeSolution`
+* every mode's status at many friction vectors (the kinematic stage once): :func:`solve_many`, its
+  per-vector reference :func:`solve_many_reference`, :class:`VectorStatuses`
 * residuals of the full model (eqs. 2-11): :func:`model_residuals`
 * finite motion (Section 5.1): :func:`simulate`, :class:`MotionOptions`, :func:`make_friction`
 * independent checks: :func:`lp_mode_feasible`
@@ -118,6 +120,9 @@ _LAZY = {
     # solver
     "solve": "qsplan.mechanics.solver.all_modes",
     "SolveResult": "qsplan.mechanics.solver.result",
+    "VectorStatuses": "qsplan.mechanics.solver.many",
+    "solve_many": "qsplan.mechanics.solver.many",
+    "solve_many_reference": "qsplan.mechanics.solver.many",
     # the modules that need shapely (geometry, manipulators) or scipy (the simulator, the LP check)
     "LPCheck": "qsplan.mechanics.crosscheck.lp_check",
     "lp_mode_feasible": "qsplan.mechanics.crosscheck.lp_check",
@@ -217,6 +222,9 @@ __all__ = [
     "relative_velocity",
     "SolveResult",
     "solve",
+    "VectorStatuses",
+    "solve_many",
+    "solve_many_reference",
 ]
 __all__ += [name for name in _LAZY if name not in __all__]
 

@@ -1,5 +1,18 @@
 """qsplan.planner: planning two-finger tasks through OMPL with guaranteed torque bands; torque commands, export, plots, the CLI.
 
+Subpackages, in layers (lowest first; a module imports only its own layer and lower ones, above
+:mod:`qsplan.mechanics` and :mod:`qsplan.hands`; ``tests/test_architecture.py`` asserts it):
+
+* :mod:`.task` - the task: what a plan must achieve, its fields and ranges, goals, joint limits
+* :mod:`.torque` - band sweeps along a segment and the torque command rule (Figs. 10-13)
+* :mod:`.states` - judging configurations: in contact (with a guaranteed band) and in free space, collisions
+* :mod:`.search` - band tables, the widest route, the OMPL adapter (the only package importing ``ompl``)
+* :mod:`.plan` - typed plans, :func:`plan_task`, slides and regrasps realised, failure reports
+* :mod:`.export` - plan files (CSV and JSON), their schema, safe writing
+* :mod:`.certify` - the certifier of exported plans; :mod:`.replay` - their re-simulation
+* :mod:`.plotting`, :mod:`.reports` - figures and renderings
+* :mod:`.pipeline` - :func:`run_plan`, the whole run; :mod:`.cli` - the ``qsplan`` command
+
 Public API (loaded on first use, so ``import qsplan.planner`` stays light):
 
 * tasks: :class:`Task`, :func:`load_task`, :func:`make_task`, :func:`demo_task_path`, :func:`task_paths`
@@ -33,56 +46,56 @@ _LAZY = {
     "QsplanError": "qsplan.mechanics.errors",
     "NoAnswerError": "qsplan.mechanics.errors",
     # tasks
-    "Task": "qsplan.planner.planning.task",
-    "load_task": "qsplan.planner.planning.task",
-    "make_task": "qsplan.planner.planning.task",
-    "demo_task_path": "qsplan.planner.planning.task",
-    "task_paths": "qsplan.planner.planning.task",
-    "task_path": "qsplan.planner.planning.task",
+    "Task": "qsplan.planner.task.task",
+    "load_task": "qsplan.planner.task.task",
+    "make_task": "qsplan.planner.task.task",
+    "demo_task_path": "qsplan.planner.task.task",
+    "task_paths": "qsplan.planner.task.task",
+    "task_path": "qsplan.planner.task.task",
     # planning
-    "plan_task": "qsplan.planner.planning.plan",
-    "DEFAULT_OPTIONS": "qsplan.planner.planning.plan",
-    "REGRASP_OPENING": "qsplan.planner.planning.plan",
-    "SWEEP_STEP": "qsplan.planner.planning.plan",
-    "Plan": "qsplan.planner.planning.results",
-    "ContactSegmentPlan": "qsplan.planner.planning.results",
-    "RegraspPlan": "qsplan.planner.planning.results",
-    "PlanFailure": "qsplan.planner.planning.results",
-    "StateCheck": "qsplan.planner.planning.results",
-    "check_contact_state": "qsplan.planner.planning.contact_state",
-    "check_free_state": "qsplan.planner.planning.contact_state",
-    "contact_samples": "qsplan.planner.planning.contact_state",
-    "FailureReport": "qsplan.planner.planning.failure",
-    "ClosedPoint": "qsplan.planner.planning.failure",
-    "failure_report": "qsplan.planner.planning.failure",
-    "PlannerOptions": "qsplan.planner.planning.ompl_bridge",
-    "PlanResult": "qsplan.planner.planning.ompl_bridge",
-    "PLANNERS": "qsplan.planner.planning.ompl_bridge",
-    "plan_path": "qsplan.planner.planning.ompl_bridge",
-    "ompl_available": "qsplan.planner.planning.ompl_bridge",
-    "Goal": "qsplan.planner.planning.goal",
+    "plan_task": "qsplan.planner.plan.scripted",
+    "DEFAULT_OPTIONS": "qsplan.planner.plan.scripted",
+    "REGRASP_OPENING": "qsplan.planner.plan.scripted",
+    "SWEEP_STEP": "qsplan.planner.plan.scripted",
+    "Plan": "qsplan.planner.plan.results",
+    "ContactSegmentPlan": "qsplan.planner.plan.results",
+    "RegraspPlan": "qsplan.planner.plan.results",
+    "PlanFailure": "qsplan.planner.plan.results",
+    "StateCheck": "qsplan.planner.states.contact",
+    "check_contact_state": "qsplan.planner.states.contact",
+    "check_free_state": "qsplan.planner.states.contact",
+    "contact_samples": "qsplan.planner.states.contact",
+    "FailureReport": "qsplan.planner.plan.failure",
+    "ClosedPoint": "qsplan.planner.plan.failure",
+    "failure_report": "qsplan.planner.plan.failure",
+    "PlannerOptions": "qsplan.planner.search.ompl_bridge",
+    "PlanResult": "qsplan.planner.search.ompl_bridge",
+    "PLANNERS": "qsplan.planner.search.ompl_bridge",
+    "plan_path": "qsplan.planner.search.ompl_bridge",
+    "ompl_available": "qsplan.planner.search.ompl_bridge",
+    "Goal": "qsplan.planner.task.goal",
     # automatic planning: the sequence search (issue 14)
-    "plan_automatic": "qsplan.planner.sequence.autoplan",
-    "SEQUENCE_PLANNERS": "qsplan.planner.sequence.ompl_search",
-    "search_route": "qsplan.planner.sequence.ompl_search",
-    "band_tables": "qsplan.planner.sequence.tables",
-    "BandTables": "qsplan.planner.sequence.tables",
-    "widest_route": "qsplan.planner.sequence.widest",
-    "run_plan": "qsplan.planner.planning.pipeline",
+    "plan_automatic": "qsplan.planner.plan.autoplan",
+    "SEQUENCE_PLANNERS": "qsplan.planner.search.ompl_search",
+    "search_route": "qsplan.planner.search.ompl_search",
+    "band_tables": "qsplan.planner.search.tables",
+    "BandTables": "qsplan.planner.search.tables",
+    "widest_route": "qsplan.planner.search.widest",
+    "run_plan": "qsplan.planner.pipeline.run",
     "segment_command": "qsplan.planner.torque.command",
     "with_segment_command": "qsplan.planner.torque.command",
     "command_rule": "qsplan.planner.torque.command",
     "check_schedule_files": "qsplan.planner.export.schema",
-    "PlanRun": "qsplan.planner.planning.pipeline",
-    "certify_plan": "qsplan.planner.planning.certify",
-    "Certificate": "qsplan.planner.planning.certify",
-    "Violation": "qsplan.planner.planning.certify",
-    "plan_outputs": "qsplan.planner.planning.pipeline",
+    "PlanRun": "qsplan.planner.pipeline.run",
+    "certify_plan": "qsplan.planner.certify.certify",
+    "Certificate": "qsplan.planner.certify.certify",
+    "Violation": "qsplan.planner.certify.certify",
+    "plan_outputs": "qsplan.planner.pipeline.run",
     # replay and verification
-    "replay_plan": "qsplan.planner.planning.replay",
-    "friction_samples": "qsplan.planner.planning.replay",
-    "Replay": "qsplan.planner.planning.replay",
-    "SegmentReplay": "qsplan.planner.planning.replay",
+    "replay_plan": "qsplan.planner.replay.replay",
+    "friction_samples": "qsplan.planner.replay.replay",
+    "Replay": "qsplan.planner.replay.replay",
+    "SegmentReplay": "qsplan.planner.replay.replay",
     # export
     "export_plan": "qsplan.planner.export.plan_files",
     "read_plan_csv": "qsplan.planner.export.plan_files",

@@ -367,7 +367,7 @@ def _stub_planning(*args, **kwargs):
 def run_case(case: dict, workdir: Path, timeout: float = 10.0) -> tuple:
     """Run one case in-process; returns ``(outcome, seconds, stderr)``."""
     from qsplan.planner.cli.main import main
-    from qsplan.planner.planning import pipeline
+    from qsplan.planner.pipeline import run as pipeline
 
     workdir.mkdir(parents=True, exist_ok=True)
     argv = list(case["argv"])

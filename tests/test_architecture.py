@@ -4,6 +4,10 @@ An AST walk over the source (no import of the code under test):
 
 * the import graph between the project's modules, *including imports inside functions*, has no cycle
   (a cycle hidden by a function-level import is still a cycle);
+* the subpackages form layers (:data:`LAYERS`, lowest first): a module imports only modules of its own
+  layer or lower ones, imports inside functions counted; ``qsplan``'s and ``qsplan.planner``'s own
+  ``__init__`` (lazy public names, which may point anywhere) are the only modules outside the layers;
+* exactly one package imports ``ompl`` (:data:`OMPL_PACKAGE`);
 * no name starting with ``_`` is imported from another module;
 * no module is longer than :data:`MAX_MODULE_LINES`;
 * code, tests, examples and benchmarks import the project only as ``qsplan.*``, and examples and
@@ -24,6 +28,31 @@ ROOT = Path(__file__).resolve().parent.parent
 FOLDERS = {"mechanics": "qsplan.mechanics", "hands": "qsplan.hands", "planner": "qsplan.planner"}
 #: One concept per module: past this a module is split (STYLE.md, point 10).
 MAX_MODULE_LINES = 400
+#: The layers of the package, lowest first (issue 22's design): the paper's mechanics, hands, then the
+#: planner from the task up to the command line.  A module may import its own layer and lower ones only.
+LAYERS = (
+    "qsplan.mechanics",
+    "qsplan.hands",
+    "qsplan.planner.task",
+    "qsplan.planner.torque",
+    "qsplan.planner.states",
+    "qsplan.planner.search",
+    "qsplan.planner.plan",
+    "qsplan.planner.export",
+    "qsplan.planner.certify",
+    "qsplan.planner.replay",
+    "qsplan.planner.plotting",
+    "qsplan.planner.reports",
+    "qsplan.planner.pipeline",
+    "qsplan.planner.cli",
+)
+#: The two package ``__init__``s outside the layers.  ``qsplan`` holds ``__version__`` and the lazy-import
+#: helper every package ``__init__`` uses: below every layer, it imports nothing of the project.
+#: ``qsplan.planner`` is the public facade whose lazy names reach every layer: above them all, no module
+#: of the package imports it.
+ROOT_MODULE, FACADE = "qsplan", "qsplan.planner"
+#: The one package that talks to OMPL (the adapter and the OMPL search planners).
+OMPL_PACKAGE = "qsplan.planner.search"
 
 
 def _modules() -> dict[str, Path]:
@@ -112,6 +141,50 @@ def _find_cycle(graph: dict[str, set[str]]) -> list[str] | None:
     return None
 
 
+def _layer_of(name: str) -> int | None:
+    """Index in :data:`LAYERS` of the layer holding module ``name``, or None outside every layer."""
+    for i, layer in enumerate(LAYERS):
+        if name == layer or name.startswith(layer + "."):
+            return i
+    return None
+
+
+def _layer_violations(graph: dict[str, set[str]]) -> list[str]:
+    """Every edge of ``graph`` that leaves the layering: upward, out of a layer, or into the facade."""
+    out = []
+    for name in sorted(graph):
+        for target in sorted(graph[name]):
+            if target == FACADE:
+                out.append(f"{name} imports the facade {FACADE} (import the defining module)")
+            elif name == ROOT_MODULE:
+                out.append(f"{ROOT_MODULE} imports {target}")
+            elif target == ROOT_MODULE or name == FACADE:
+                continue
+            elif _layer_of(name) is None or _layer_of(target) is None:
+                out.append(f"{name} -> {target}: a module outside {LAYERS}")
+            elif (low := _layer_of(name)) < (high := _layer_of(target)):
+                out.append(f"{name} ({LAYERS[low]}) imports {target} ({LAYERS[high]}), a higher layer")
+    return out
+
+
+def _ompl_importers(modules: dict[str, Path] = MODULES) -> dict[str, list[str]]:
+    """Package -> its modules with an ``import ompl`` / ``from ompl ...`` (inside functions too)."""
+    out = {}
+    for name, path in modules.items():
+        for node in ast.walk(ast.parse(path.read_text())):
+            if isinstance(node, ast.Import):
+                hit = any(a.name.split(".")[0] == "ompl" for a in node.names)
+            elif isinstance(node, ast.ImportFrom):
+                hit = not node.level and (node.module or "").split(".")[0] == "ompl"
+            else:
+                continue
+            if hit:
+                package = name if path.name == "__init__.py" else name.rpartition(".")[0]
+                out.setdefault(package, []).append(name)
+                break
+    return out
+
+
 def test_every_module_found():
     assert len(MODULES) > 60
     assert "qsplan.mechanics.solver" in MODULES and "qsplan.planner.cli" in MODULES
@@ -131,6 +204,55 @@ def test_import_graph_has_no_cycle():
 def test_the_cycle_check_finds_cycles():
     assert _find_cycle({"a": {"b"}, "b": {"c"}, "c": {"a"}}) == ["a", "b", "c", "a"]
     assert _find_cycle({"a": {"b"}, "b": set()}) is None
+
+
+def test_every_module_is_in_a_layer():
+    assert [name for name in MODULES if _layer_of(name) is None] == [ROOT_MODULE, FACADE]
+    assert all(layer in MODULES for layer in LAYERS)  # each layer is a package of the tree
+
+
+def test_imports_go_down_the_layers():
+    # imports inside functions count, and so do the lazy maps of package __init__s, but those of
+    # qsplan's and qsplan.planner's (the public names, which may point anywhere)
+    graph = _graph()
+    for name, path in MODULES.items():
+        if path.name == "__init__.py" and name not in (ROOT_MODULE, FACADE):
+            graph[name] |= {t for t in _lazy_targets(name, path) if t in MODULES}
+    assert _layer_violations(graph) == []
+
+
+def test_the_layer_check_finds_violations():
+    graph = {
+        "qsplan.planner.task.task": {"qsplan.planner.torque.command", "qsplan.mechanics.errors", ROOT_MODULE},
+        "qsplan.planner.cli.verify": {FACADE, "qsplan.planner.task.task"},
+        "qsplan.planner.plan.scripted": {"qsplan.planner.states.contact", "qsplan.planner.plan.results"},
+        "qsplan.planner.extra": {"qsplan.mechanics.errors"},
+        ROOT_MODULE: {"qsplan.mechanics"},
+    }
+    assert _layer_violations(graph) == [
+        f"{ROOT_MODULE} imports qsplan.mechanics",
+        "qsplan.planner.cli.verify imports the facade qsplan.planner (import the defining module)",
+        f"qsplan.planner.extra -> qsplan.mechanics.errors: a module outside {LAYERS}",
+        "qsplan.planner.task.task (qsplan.planner.task) imports qsplan.planner.torque.command "
+        "(qsplan.planner.torque), a higher layer",
+    ]
+
+
+def test_one_package_imports_ompl():
+    importers = _ompl_importers()
+    assert list(importers) == [OMPL_PACKAGE], importers
+
+
+def test_the_ompl_check_finds_importers(tmp_path):
+    sources = {"qsplan.planner.plan.a": "def f():\n    from ompl import base\n",
+               "qsplan.planner.search.b": "import ompl.geometric as og\n",
+               "qsplan.planner.search.c": "import numpy\n"}  # fmt: skip
+    modules = {}
+    for name, text in sources.items():
+        modules[name] = tmp_path / f"{name}.py"
+        modules[name].write_text(text)
+    assert _ompl_importers(modules) == {"qsplan.planner.plan": ["qsplan.planner.plan.a"],
+                                        "qsplan.planner.search": ["qsplan.planner.search.b"]}  # fmt: skip
 
 
 def test_no_private_name_crosses_a_module_boundary():

@@ -50,7 +50,7 @@ PALM_TOP_TOL = 1e-12
 #: Plausible range ``(lo, hi, unit)`` of every number of a hand; outside it a value is a mistake (a unit
 #: slip, a typo), not a hand (100 t links were planned at -35,140 N m, 1e5 rad limits drawn).  Where the
 #: paper hand's parameter form has the quantity, the numbers are ``TASK_RANGES``'
-#: (:mod:`qsplan.planner.planning.task_fields`): a file may not allow what a task's ``[hand]`` refuses.
+#: (:mod:`qsplan.planner.task.fields`): a file may not allow what a task's ``[hand]`` refuses.
 HAND_RANGES = {
     # the parameter form's palm [-P, P] x [-T, 0], P and T from a millimetre to a metre (TASK_RANGES' size)
     "palm_vertex": (-1.0, 1.0, "m"),

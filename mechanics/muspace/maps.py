@@ -6,10 +6,10 @@ all kinematically admissible modes and all mu points together, in bounded
 batches.  The answer at every point is exactly what :func:`qsplan.mechanics.solve`
 gives for the scene with that mu.
 
-Two paths give that answer: :func:`feasibility_map` repeats the solver's
-equilibrium stage (an LU solve per mode and point), :func:`polynomial_map`
-evaluates each mode's multilinear form of ``c_A`` (Sections 4.4-4.6) and is
-much faster.  2-D slices with the modes' exact regions are in
+Two paths give that answer: :func:`feasibility_map` is the solver's
+:func:`~qsplan.mechanics.solver.many.solve_many` (an LU solve per mode and point),
+:func:`polynomial_map` evaluates each mode's multilinear form of ``c_A`` (Sections
+4.4-4.6) and is much faster.  2-D slices with the modes' exact regions are in
 :mod:`qsplan.mechanics.muspace.slices`.
 """
 
@@ -19,16 +19,15 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from qsplan.mechanics.errors import SceneError
-from qsplan.mechanics.model.friction import check_friction
 from qsplan.mechanics.modes.contact_mode import ContactMode, codes_to_letters, count_modes, iter_mode_batches
-from qsplan.mechanics.numerics import DEFAULT_TOLERANCES, Status, Tolerances
+from qsplan.mechanics.numerics import DEFAULT_TOLERANCES, Status, StatusCode, Tolerances
 from qsplan.mechanics.model.scene import Scene
 from qsplan.mechanics.muspace.multilinear import monomials, restrict_coef
 from qsplan.mechanics.parallel import chunk_count, map_chunks, split_range
 from qsplan.mechanics.muspace.regions import empty_region, polynomials_from_kinematics, region_from_polynomials
-from qsplan.mechanics.modes.equilibrium import coulomb_slacks, equilibrium_stage
+from qsplan.mechanics.modes.equilibrium import coulomb_slacks
 from qsplan.mechanics.modes.kinematics import ScenePool, kinematics_stage, velocity_scale
+from qsplan.mechanics.solver.many import check_mu_vectors, solve_many
 
 __all__ = [
     "MuMap",
@@ -111,14 +110,6 @@ def _kinematics_all(scene: Scene, tol: Tolerances):
     return pool, modes, kstatus, kins
 
 
-def _check_mu_points(scene: Scene, mu_points) -> np.ndarray:
-    mu_points = check_friction(mu_points, "mu_points")
-    n_c = scene.n_contacts
-    if mu_points.ndim != 2 or mu_points.shape[1] != n_c:
-        raise SceneError(f"mu_points: expected shape (N, {n_c}); got {mu_points.shape}")
-    return mu_points
-
-
 def feasibility_map(scene: Scene, mu_points, tol: Tolerances = DEFAULT_TOLERANCES, batch: int = MAP_BATCH, *,
                     workers=None, scheduler=None) -> MuMap:  # fmt: skip
     """Feasible modes of ``scene`` at every row of ``mu_points``.
@@ -144,7 +135,7 @@ def feasibility_map(scene: Scene, mu_points, tol: Tolerances = DEFAULT_TOLERANCE
     MuMap
         The same (bit for bit) however it was split: every row is computed alone.
     """
-    mu_points = _check_mu_points(scene, mu_points)
+    mu_points = check_mu_vectors(scene, mu_points, "mu_points")
     N = mu_points.shape[0]
     n_chunks = chunk_count(N * count_modes(scene.n_contacts, scene.dof), MIN_CHUNK_ROWS, workers=workers,
                            scheduler=scheduler)  # fmt: skip
@@ -155,28 +146,9 @@ def feasibility_map(scene: Scene, mu_points, tol: Tolerances = DEFAULT_TOLERANCE
         first = parts[0]
         return MuMap(first.modes, first.kinematic_status, mu_points, stack("feasible"), stack("degenerate"),
                      stack("boundary"))  # fmt: skip
-    pool, modes, kstatus, kins = _kinematics_all(scene, tol)
-    feasible = np.zeros((N, len(modes)), dtype=bool)
-    degenerate = np.zeros_like(feasible)
-    boundary = np.zeros_like(feasible)
-    tau_e = np.nan_to_num(scene.joint_effort)[pool.E]
-    for mode_cols, kin in kins:
-        if mode_cols.size == 0:
-            continue
-        step = max(1, batch // mode_cols.size)
-        for lo in range(0, N, step):
-            pts = np.arange(lo, min(lo + step, N))
-            rows_mode = np.tile(np.arange(mode_cols.size), pts.size)
-            rows_pt = np.repeat(pts, mode_cols.size)
-            st, _, _, _, bnd = equilibrium_stage(
-                scene, pool, kin.take(rows_mode), mu_points[rows_pt],
-                np.broadcast_to(tau_e, (rows_pt.size, tau_e.size)), tol,
-            )  # fmt: skip
-            cols = mode_cols[rows_mode]
-            feasible[rows_pt, cols] = st == 0
-            degenerate[rows_pt, cols] = st == Status.ORDER.index(Status.EQUILIBRIUM_SINGULAR)
-            boundary[rows_pt, cols] = (st == 0) & bnd
-    return MuMap(tuple(modes), tuple(kstatus), mu_points, feasible, degenerate, boundary)
+    sv = solve_many(scene, mu_points, tol, forces=False, batch=batch)
+    return MuMap(tuple(ContactMode(m) for m in sv.letters), tuple(Status.ORDER[c] for c in sv.kinematic), mu_points,
+                 sv.codes == StatusCode.FEASIBLE, sv.codes == StatusCode.EQUILIBRIUM_SINGULAR, sv.boundary)  # fmt: skip
 
 
 def _feasibility_chunk(job) -> MuMap:
@@ -346,4 +318,4 @@ def polynomial_map(scene: Scene, mu_points, tol: Tolerances = DEFAULT_TOLERANCES
     -------
     MuMap
     """
-    return polynomial_pass(scene, _check_mu_points(scene, mu_points), tol, batch)[0]
+    return polynomial_pass(scene, check_mu_vectors(scene, mu_points, "mu_points"), tol, batch)[0]

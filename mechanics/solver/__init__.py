@@ -6,4 +6,6 @@
 * :mod:`.breaking_sets` - breaking sets that admit equilibrium (eqs. 17, 26, 28 relaxed), one LP each
 * :mod:`.search` - the exact pruned search over those breaking sets
 * :mod:`.all_modes` - the public :func:`solve`, choosing among the three
+* :mod:`.many` - every mode's status at many friction vectors of one scene (the kinematic stage once):
+  :func:`~.many.solve_many` and its per-vector reference; mu-space maps and the plan certifier use it
 """

@@ -4,7 +4,7 @@
 
     qsplan demo [--out DIR] [--seed S] [--planner NAME] [--force] [--quiet] [--no-plots]
 
-Plans :func:`qsplan.planner.planning.task.demo_task_path` (three 4S segments of the default hand:
+Plans :func:`qsplan.planner.task.task.demo_task_path` (three 4S segments of the default hand:
 slide left until the left finger nearly meets the longest edge, right, left to
 the middle, regrasping between them) exactly as ``qsplan plan`` does, and writes
 the torque trajectory and the plots into DIR (default ``out/demo``).
@@ -25,6 +25,6 @@ def add_parser(subparsers):
 
 
 def run(args, out) -> int:
-    from qsplan.planner.planning.task import demo_task_path, load_task
+    from qsplan.planner.task.task import demo_task_path, load_task
 
     return run_task(load_task(demo_task_path()), args, out, inputs=(demo_task_path(),))

@@ -18,7 +18,7 @@ exits with status 2; so does valid input without an answer (no plan, no band).
 Ctrl-C prints ``qsplan: interrupted`` and exits 130; every output is written to a
 temporary name and renamed (:func:`qsplan.planner.export.files.atomic_write`), so an
 interrupted run leaves no half-written file; ``plan`` and ``demo`` stage their outputs and
-publish them only once the plan is certified (:mod:`qsplan.planner.planning.pipeline`), so it
+publish them only once the plan is certified (:mod:`qsplan.planner.pipeline.run`), so it
 leaves no uncertified plan either.  A second run into a directory that ``plan``, ``demo`` or
 ``paper`` is writing fails at once (exit 2, naming the first run's pid).
 Library messages name library fields; they are printed with this command's

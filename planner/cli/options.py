@@ -128,7 +128,7 @@ def parallel_options(args) -> dict:
 
 def add_plan_options(p, default_out):
     """The options of ``qsplan plan`` and ``qsplan demo``."""
-    from qsplan.planner.planning.ompl_bridge import PLANNERS
+    from qsplan.planner.search.ompl_bridge import PLANNERS
 
     p.add_argument("--out", default=default_out, metavar="DIR", help=f"output directory (default {default_out})")
     p.add_argument("--seed", type=int, default=1, metavar="S", help="OMPL's random seed (default 1)")

@@ -5,11 +5,11 @@
     qsplan plan TASK.toml|BUNDLED_TASK [--out DIR] [--seed S] [--planner NAME] [--sequence-planner NAME] [--time-limit SECONDS]
                           [--force] [--quiet] [--no-plots] [--verify N]
 
-Reads the task (:mod:`qsplan.planner.planning.task`; a bundled task by its name, e.g. ``two_link_task``)
+Reads the task (:mod:`qsplan.planner.task.task`; a bundled task by its name, e.g. ``two_link_task``)
 and runs the pipeline
-(:func:`qsplan.planner.planning.pipeline.run_plan`): plans it (a task with a ``[goal]``
+(:func:`qsplan.planner.pipeline.run.run_plan`): plans it (a task with a ``[goal]``
 automatically: band tables of every grasp and the widest route through them, searched in OMPL,
-:mod:`qsplan.planner.sequence`; a task with ``waypoints`` as scripted; in-contact segments
+:mod:`qsplan.planner.search`; a task with ``waypoints`` as scripted; in-contact segments
 judged by their dense sweeps, regrasps planned in joint space by OMPL), and writes
 into DIR (default ``out/plan``) ``plan.csv`` and ``plan.json`` (the torque
 trajectory), ``replay.json`` (the exported file re-simulated at ``--verify``
@@ -34,13 +34,13 @@ from qsplan.planner.cli.options import EXIT_FAILED, add_plan_options
 
 __all__ = ["FLAGS", "add_parser", "run", "run_task"]
 
-#: Library fields of :func:`qsplan.planner.planning.pipeline.run_plan` and this command's options.
+#: Library fields of :func:`qsplan.planner.pipeline.run.run_plan` and this command's options.
 FLAGS = {"verify": "--verify", "time_limit": "--time-limit"}
 
 
 def add_parser(subparsers):
     p = subparsers.add_parser("plan", help="plan a two-finger task (TOML) through OMPL with guaranteed torque bands")
-    p.add_argument("task", help="task file (.toml; see qsplan.planner.planning.task), or a bundled task's name "
+    p.add_argument("task", help="task file (.toml; see qsplan.planner.task.task), or a bundled task's name "
                                 "(demo_task, two_link_task, ...: qsplan.planner.task_paths())")
     add_plan_options(p, "out/plan")
     return p
@@ -49,7 +49,7 @@ def add_parser(subparsers):
 def run_task(task, args, out, inputs=()) -> int:
     """Run the pipeline on ``task`` as ``args`` ask and print the summary (shared by ``qsplan demo``); ``inputs``: the
     files read (the task file), never replaced."""
-    from qsplan.planner.planning.pipeline import run_plan
+    from qsplan.planner.pipeline.run import run_plan
     from qsplan.planner.plotting.style import torque_text
 
     err = sys.stderr
@@ -96,7 +96,7 @@ def run_task(task, args, out, inputs=()) -> int:
 def run(args, out) -> int:
     from pathlib import Path
 
-    from qsplan.planner.planning.task import load_task, task_paths
+    from qsplan.planner.task.task import load_task, task_paths
 
     bundled = task_paths()
     path = bundled[args.task] if args.task in bundled and not Path(args.task).exists() else args.task

@@ -5,7 +5,7 @@
     qsplan verify PLAN_DIR [--task TASK.toml] [--json] [--random N] [--seed S] [--force-margin N]
 
 Checks every fact ``PLAN_DIR``'s ``plan.csv`` and ``plan.json`` state (a file path works too: it and the other
-file beside it) from the task alone (:func:`qsplan.planner.planning.certify.certify_plan`; its ``CHECKS`` say
+file beside it) from the task alone (:func:`qsplan.planner.certify.certify.certify_plan`; its ``CHECKS`` say
 what each kind covers): both files hold the same cells and the metadata states the task; the start and the
 goal (or the waypoints) reached; no overlap between fingers, palm and workpiece, at every row and along the
 free motions; the workpiece resting on the palm while regrasped; joint and speed limits; continuity; the
@@ -28,7 +28,7 @@ from qsplan.planner.cli.options import EXIT_FAILED, EXIT_USAGE, cli_message
 
 __all__ = ["FLAGS", "MAX_LINES", "add_parser", "run"]
 
-#: Library fields of :func:`qsplan.planner.planning.certify.certify_plan` and this command's options.
+#: Library fields of :func:`qsplan.planner.certify.certify.certify_plan` and this command's options.
 FLAGS = {"n_random": "--random", "seed": "--seed", "force_margin": "--force-margin", "plan": "PLAN_DIR", "task": "--task"}
 
 #: Violations listed one per line before the rest are counted.
@@ -51,11 +51,11 @@ def add_parser(subparsers):
 
 
 def _task(args):
-    from qsplan.planner.planning.certify import read_plan, task_from_metadata
-    from qsplan.planner import load_task
+    from qsplan.planner.certify.certify import read_plan, task_from_metadata
+    from qsplan.planner.task.task import load_task
 
     if args.task is not None:
-        from qsplan.planner.planning.task import task_path
+        from qsplan.planner.task.task import task_path
 
         path = task_path(args.task)
         return load_task(path), f"task {path}"
@@ -71,7 +71,7 @@ def _task(args):
 def run(args, out) -> int:
     from qsplan.mechanics import QsplanError
 
-    from qsplan.planner.planning.certify import certify_plan
+    from qsplan.planner.certify.certify import certify_plan
 
     try:
         task, source = _task(args)

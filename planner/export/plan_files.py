@@ -122,11 +122,11 @@ def plan_columns(plan) -> tuple:
     """The plan as ordered columns ``{name: list}`` and units ``{name: str or None}`` (:data:`PLAN_COLUMNS`).
 
     Reads the plan's public fields only (``phases``; a phase that is not a
-    :class:`~qsplan.planner.planning.results.ContactSegmentPlan` is a free motion of every joint); one group of
+    :class:`~qsplan.planner.plan.results.ContactSegmentPlan` is a free motion of every joint); one group of
     columns per joint of ``plan.task.hand``, in its order, with its kind's units.
     """
     from qsplan.hands.interface import JOINT_UNITS, joint_kinds
-    from qsplan.planner.planning.results import ContactSegmentPlan
+    from qsplan.planner.plan.results import ContactSegmentPlan
 
     joints = plan_joints(plan.task.hand)
     kinds = dict(zip(joints, joint_kinds(plan.task.hand)))
@@ -183,7 +183,7 @@ def plan_metadata(plan) -> dict:
     Reads ``Plan``'s public fields; ``sequence`` (the planned sequence, a tuple of plain dicts) is
     written under ``"sequence"`` when the plan has one.
     """
-    from qsplan.planner.planning.results import ContactSegmentPlan
+    from qsplan.planner.plan.results import ContactSegmentPlan
     from qsplan.planner.torque.command import MAX_MARGIN_RESOLUTIONS
 
     from qsplan.hands.interface import hand_metadata, is_chain_hand

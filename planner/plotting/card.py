@@ -48,8 +48,8 @@ def verdict(certificate=None, replays=()) -> tuple:
 
     Parameters
     ----------
-    certificate : qsplan.planner.planning.certify.Certificate, optional
-    replays : sequence of qsplan.planner.planning.replay.Replay
+    certificate : qsplan.planner.certify.certify.Certificate, optional
+    replays : sequence of qsplan.planner.replay.replay.Replay
     """
     parts, ok = [], True
     if certificate is None:
@@ -151,10 +151,10 @@ def plan_card(plan, certificate=None, replays=(), snapshots: int = MAX_SNAPSHOTS
 
     Parameters
     ----------
-    plan : qsplan.planner.planning.results.Plan
-    certificate : qsplan.planner.planning.certify.Certificate, optional
-        The exported plan's certificate (:func:`qsplan.planner.planning.certify.certify_plan`).
-    replays : sequence of qsplan.planner.planning.replay.Replay
+    plan : qsplan.planner.plan.results.Plan
+    certificate : qsplan.planner.certify.certify.Certificate, optional
+        The exported plan's certificate (:func:`qsplan.planner.certify.certify.certify_plan`).
+    replays : sequence of qsplan.planner.replay.replay.Replay
         The exported plan re-simulated.
     snapshots : int
         Hand snapshots, at most.

@@ -2,7 +2,7 @@
 
 Each function takes a :class:`qsplan.planner.Plan`, draws into ``ax`` (or a new figure) and returns
 the axes or the figure; matplotlib is imported inside.  Only the plan's public fields are read
-(``Plan.phases``, :class:`~qsplan.planner.planning.results.ContactSegmentPlan`; every other phase is
+(``Plan.phases``, :class:`~qsplan.planner.plan.results.ContactSegmentPlan`; every other phase is
 drawn as a free motion of the fingers), so plans with more phases or fields draw too.
 :func:`plan_figures` gives them all, the plan card (:mod:`qsplan.planner.plotting.card`) included,
 for ``qsplan demo`` / ``qsplan plan``.
@@ -40,7 +40,7 @@ def plot_plan_bands(plan, axes=None, sharey=False):
 
     Parameters
     ----------
-    plan : qsplan.planner.planning.results.Plan
+    plan : qsplan.planner.plan.results.Plan
     axes : sequence of matplotlib Axes, optional
         One per segment; default a new figure with one row each.
     sharey : bool

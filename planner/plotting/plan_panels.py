@@ -2,7 +2,7 @@
 
 Shared by :mod:`qsplan.planner.plotting.plan` (one figure per view) and
 :mod:`qsplan.planner.plotting.card` (the plan card).  Only the plan's public fields are read
-(``Plan.phases``, :class:`~qsplan.planner.planning.results.ContactSegmentPlan`; any other phase is
+(``Plan.phases``, :class:`~qsplan.planner.plan.results.ContactSegmentPlan`; any other phase is
 drawn as a free motion of the fingers), so plans with more phases or fields draw too.
 matplotlib is imported inside the functions.
 """
@@ -33,7 +33,7 @@ __all__ = ["draw_band", "effort_words", "is_contact", "joint_math", "joint_title
 
 def is_contact(phase) -> bool:
     """Whether ``phase`` is an in-contact segment (a torque-controlled finger and a guaranteed band)."""
-    from qsplan.planner.planning.results import ContactSegmentPlan
+    from qsplan.planner.plan.results import ContactSegmentPlan
 
     return isinstance(phase, ContactSegmentPlan)
 

@@ -8,20 +8,18 @@ midpoint where it is not, so the command is continuous and close to the torque t
 needs.  ``m`` is half the segment's narrowest band (the largest margin that holds
 everywhere), at most :data:`MAX_MARGIN_RESOLUTIONS` torque resolutions
 (:func:`default_safety_margin`): a very wide band buys no more than that.
-:data:`PLAN_FORCE_MARGIN` keeps the band itself away from the brink of eq. (28) for
-what the torque does not cover.
+:data:`qsplan.planner.task.fields.PLAN_FORCE_MARGIN` keeps the band itself away from the brink of
+eq. (28) for what the torque does not cover.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-from qsplan.mechanics.bands.effort import ForceMargin
 from qsplan.mechanics.errors import NoAnswerError, QsplanError
-from qsplan.planner.planning.task_fields import in_task_range, short_repr
 
-__all__ = ["MAX_MARGIN_RESOLUTIONS", "PLAN_FORCE_MARGIN", "choose_command", "command_rule", "default_safety_margin",
-           "plan_force_margin", "segment_command", "with_segment_command"]
+__all__ = ["MAX_MARGIN_RESOLUTIONS", "choose_command", "command_rule", "default_safety_margin", "segment_command",
+           "with_segment_command"]
 
 #: The largest margin (in torque resolutions) a command keeps from its band's edges.  A plan
 #: accepts a band one resolution wide (the command mid-band, half a resolution from each
@@ -30,45 +28,6 @@ __all__ = ["MAX_MARGIN_RESOLUTIONS", "PLAN_FORCE_MARGIN", "choose_command", "com
 #: far above the torque the mode needs: the demo's third segment, whose narrowest band is
 #: 1.76 N m wide, would command ~0.93 N m where its lower edge asks ~0.05 N m.
 MAX_MARGIN_RESOLUTIONS = 2.0
-
-#: The force margin of plans (task files' ``[controller] min_normal_force`` and
-#: ``min_coulomb_slack``), N.  At a band edge of eq. (28) some normal force or cone slack is
-#: zero, and near steep edges the model's normal forces are a few mN: any load the model
-#: leaves out lifts that contact.  The torque error is covered by the band's width (the
-#: command sits mid-band, at least the torque resolution wide); the margin covers the
-#: rest.  0.05 N is 2.5 % of the demo workpiece's weight (0.2 kg, 1.96 N): the weight of
-#: a 5 g mass error, or the inertial force of the workpiece accelerating at 0.25 m/s^2
-#: (reaching the 0.01 m/s default speed limit in 40 ms), and ten times the few mN seen
-#: near steep edges.  It costs the demo little: its narrowest guaranteed band goes from
-#: 0.164 to 0.139 N m (normal forces change by ~2-4 N per N m of finger torque there),
-#: still seven times the 0.02 N m torque resolution.
-#: The slack margin binds only rolling contacts (the planner's 4S mode has none: a sliding
-#: contact is on its cone's edge by definition, eq. 17).
-PLAN_FORCE_MARGIN = ForceMargin(normal=0.05, slack=0.05)
-
-
-def plan_force_margin(min_normal_force=None, min_coulomb_slack=None, field: str = "controller") -> ForceMargin:
-    """A plan's :class:`ForceMargin` (N), :data:`PLAN_FORCE_MARGIN`'s value where one is not given.
-
-    Each inside its plausible range (``TASK_RANGES['min_normal_force']``, ``['min_coulomb_slack']`` of
-    :mod:`qsplan.planner.planning.task_fields`, with the reason).  Errors name ``<field>.min_normal_force`` /
-    ``<field>.min_coulomb_slack`` (the task file's keys).
-    """
-    values = []
-    for name, v, default in (("min_normal_force", min_normal_force, PLAN_FORCE_MARGIN.normal),
-                             ("min_coulomb_slack", min_coulomb_slack, PLAN_FORCE_MARGIN.slack)):  # fmt: skip
-        v = default if v is None else v
-        try:
-            x = float(v) if not isinstance(v, (bool, str)) else np.nan
-        except OverflowError:  # an integer of hundreds of digits
-            x = np.inf
-        except (TypeError, ValueError):
-            x = np.nan
-        if not (np.isfinite(x) and x >= 0):
-            raise QsplanError(f"{field}.{name}: expected a nonnegative finite force (N); got {short_repr(v)}")
-        values.append(in_task_range(x, f"{field}.{name}", name))
-    return ForceMargin(*values)
-
 
 def choose_command(lower, upper, safety_margin, max_margin=None):
     """The effort with the largest margin inside each band.

@@ -16,7 +16,7 @@ from qsplan.hands.two_finger import default_hand, finger_angles, make_two_finger
 from qsplan.hands.two_finger_analytic import analytic_hand_scene, grasp_contacts, scene_from_arrays
 from qsplan.hands.two_finger_scene import hand_scene
 from qsplan.mechanics import SceneError
-from qsplan.planner.planning.task import load_task, task_paths
+from qsplan.planner.task.task import load_task, task_paths
 
 from tests.hands.scenes import assert_same_scene
 

@@ -16,7 +16,7 @@ from qsplan.hands.two_finger import DEFAULT_WORKPIECE, default_hand, finger_angl
 from qsplan.hands.two_finger_analytic import grasp_contacts
 from qsplan.hands.two_finger_scene import hand_scene
 from qsplan.mechanics import SceneError
-from qsplan.planner.planning.collision import find_collisions
+from qsplan.hands.collision import find_collisions
 
 from tests.hands.scenes import assert_same_scene
 

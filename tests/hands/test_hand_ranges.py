@@ -17,7 +17,7 @@ from qsplan.hands.description.model import HAND_RANGES
 from qsplan.hands.two_finger import default_hand
 from qsplan.mechanics import QsplanError, SceneError
 from qsplan.mechanics.model.fields import UNIT_SLIPS, in_range
-from qsplan.planner.planning.task_fields import TASK_RANGES
+from qsplan.planner.task.fields import TASK_RANGES
 
 
 def _table(name="two_link_hand") -> dict:

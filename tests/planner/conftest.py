@@ -20,8 +20,8 @@ torque_resolution = 0.02
 @pytest.fixture(scope="session")
 def small_run(tmp_path_factory):
     """``run_plan`` of :data:`SMALL_TASK` with the plots and one re-simulation (a PlanRun; files in ``out_dir``)."""
-    from qsplan.planner.planning.pipeline import run_plan
-    from qsplan.planner.planning.task import load_task
+    from qsplan.planner.pipeline.run import run_plan
+    from qsplan.planner.task.task import load_task
 
     root = tmp_path_factory.mktemp("small")
     path = root / "small.toml"

@@ -4,7 +4,7 @@ Rebuilds every body of a row of ``plan.csv`` from the hand's dimensions alone (f
 rectangles from the joint axes, lengths and widths; the palm slab; the workpiece from
 :func:`qsplan.hands.two_finger.workpiece_world` at the row's pose) and measures each
 pair's overlap with shapely, so that a bug in
-:mod:`qsplan.planner.planning.collision` cannot hide itself.  A described hand's bodies
+:mod:`qsplan.hands.collision` cannot hide itself.  A described hand's bodies
 (:class:`qsplan.hands.chain_hand.ChainHand`) come from its description: the palm polygon and
 each link's polygon placed by :func:`qsplan.mechanics.model.manipulator.link_polygons`.
 """
@@ -114,8 +114,8 @@ def plan_overlaps(hand, cols) -> list:
 def plan_or_refuse(task, out, **kw):
     """Run the pipeline: ``("plan", plan.csv columns)`` or ``("refused", failure.json)``."""
     from qsplan.planner.export.plan_files import read_plan_csv
-    from qsplan.planner.planning.pipeline import run_plan
-    from qsplan.planner.planning.plan import PlanFailure
+    from qsplan.planner.pipeline.run import run_plan
+    from qsplan.planner.plan.scripted import PlanFailure
 
     try:
         run_plan(task, out, verify=0, plots=False, time_limit=10.0, **kw)

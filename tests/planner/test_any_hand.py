@@ -19,14 +19,14 @@ from qsplan.hands.description import load_hand, make_hand_description
 from qsplan.hands.two_finger import DEFAULT_WORKPIECE
 from qsplan.mechanics import QsplanError
 from qsplan.mechanics.bands.batched_robust import robust_bands
+from qsplan.planner.certify.certify import certify_plan, read_plan, task_from_metadata
 from qsplan.planner.export.plan_files import export_plan, plan_columns, read_plan_csv
 from qsplan.planner.export.schema import check_schedule_document, check_schedule_files
-from qsplan.planner.planning.certify import certify_plan, read_plan, task_from_metadata
-from qsplan.planner.planning.collision import find_collisions, find_collisions_batch, shapely_collisions
-from qsplan.planner.planning.ompl_bridge import PlanResult
-from qsplan.planner.planning.replay import replay_plan
-from qsplan.planner.planning.results import ContactSegmentPlan, Plan, RegraspPlan
-from qsplan.planner.planning.task import make_task
+from qsplan.planner.plan.results import ContactSegmentPlan, Plan, RegraspPlan
+from qsplan.planner.replay.replay import replay_plan
+from qsplan.planner.search.ompl_bridge import PlanResult
+from qsplan.hands.collision import find_collisions, find_collisions_batch, shapely_collisions
+from qsplan.planner.task.task import make_task
 from qsplan.planner.torque.command import MAX_MARGIN_RESOLUTIONS, segment_command
 
 #: The hexagon the parallel-jaw gripper holds by its side corners (m, as written).

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from qsplan.mechanics.errors import QsplanError
-from qsplan.planner.planning.task import demo_task_path, load_task, make_task, task_paths
+from qsplan.planner.task.task import demo_task_path, load_task, make_task, task_paths
 
 pytestmark = pytest.mark.ompl
 
@@ -61,7 +61,7 @@ def test_waypoints_and_goal_together_are_refused():
 @pytest.mark.parametrize("goal_x", [-0.03, 0.03])
 def test_demo_start_to_goals_left_and_right_certified(tmp_path, goal_x):
     """The acceptance's tasks: the demo's start, goals left and right; a certified plan whose export re-simulates."""
-    from qsplan.planner.planning.pipeline import run_plan
+    from qsplan.planner.pipeline.run import run_plan
 
     task = load_task(goal_task(tmp_path, {"x": goal_x}))
     run = run_plan(task, tmp_path / "out", verify=2, plots=False)
@@ -73,7 +73,7 @@ def test_demo_start_to_goals_left_and_right_certified(tmp_path, goal_x):
 
 
 def test_planner_is_deterministic(tmp_path):
-    from qsplan.planner.planning.pipeline import run_plan
+    from qsplan.planner.pipeline.run import run_plan
 
     task = load_task(demo_task_path())
     a = run_plan(task, tmp_path / "a", verify=0, plots=False)
@@ -85,8 +85,8 @@ def test_planner_is_deterministic(tmp_path):
 @pytest.mark.parametrize("stem", sorted(s for s, p in task_paths().items() if "[goal]" in p.read_text()))
 def test_bundled_goal_tasks(tmp_path, stem):
     """Each bundled automatic task is planned, certified and re-simulated; the infeasible one says why."""
-    from qsplan.planner.planning.pipeline import run_plan
-    from qsplan.planner.planning.results import PlanFailure
+    from qsplan.planner.pipeline.run import run_plan
+    from qsplan.planner.plan.results import PlanFailure
 
     task = load_task(task_paths()[stem])
     if stem == "friction_closes_task":
@@ -106,8 +106,8 @@ def test_bundled_goal_tasks(tmp_path, stem):
 
 
 def test_goal_on_a_vertex_the_finger_cannot_touch_is_named(tmp_path):
-    from qsplan.planner.planning.plan import plan_task
-    from qsplan.planner.planning.results import PlanFailure
+    from qsplan.planner.plan.results import PlanFailure
+    from qsplan.planner.plan.scripted import plan_task
 
     task = load_task(goal_task(tmp_path, {"x": -0.03, "left": "vertex:0"}))
     with pytest.raises(PlanFailure, match=r"the goal is unreachable on this palm.*left finger's inner edge on vertex 3"):
@@ -117,8 +117,8 @@ def test_goal_on_a_vertex_the_finger_cannot_touch_is_named(tmp_path):
 def test_tables_agree_with_the_per_state_check():
     """The batched tables against check_contact_state (the per-state validity checker), state by state."""
     from qsplan.hands.grasp_geometry import candidate_grasps
-    from qsplan.planner.planning.contact_state import check_contact_state
-    from qsplan.planner.sequence.tables import band_tables, table_grid
+    from qsplan.planner.search.tables import band_tables, table_grid
+    from qsplan.planner.states.contact import check_contact_state
 
     for stem in ("demo_task", "pentagon_roof_task"):
         task = load_task(task_paths()[stem])
@@ -161,7 +161,7 @@ def test_single_link_fingers_have_one_grasp_at_each_x():
     axis meets a convex workpiece on the palm in one configuration only, so at each workpiece x at most one
     candidate grasp is valid (checked on every bundled hand, 1 mm apart over the whole palm)."""
     from qsplan.hands.grasp_geometry import candidate_grasps
-    from qsplan.planner.sequence.tables import band_tables, table_grid
+    from qsplan.planner.search.tables import band_tables, table_grid
 
     seen = set()
     for path in task_paths().values():
@@ -186,8 +186,8 @@ def test_random_goal_tasks_plan_or_say_why(seed):
 
     from qsplan.hands.grasp_geometry import candidate_grasps, grasp_configurations
     from qsplan.hands.grasps import OnVertex
-    from qsplan.planner.planning.plan import plan_task
-    from qsplan.planner.planning.results import PlanFailure
+    from qsplan.planner.plan.results import PlanFailure
+    from qsplan.planner.plan.scripted import plan_task
 
     rng = np.random.default_rng(seed)
     for _ in range(8):

@@ -12,9 +12,9 @@ import pytest
 from qsplan.hands.two_finger import default_hand
 from qsplan.mechanics import QsplanError
 from qsplan.planner import export_plan, load_task, make_task, ompl_available, plan_task, task_paths
+from qsplan.planner.certify.certify import certify_plan, read_plan, task_from_metadata
 from qsplan.planner.cli import verify
 from qsplan.planner.cli.options import Parser
-from qsplan.planner.planning.certify import certify_plan, read_plan, task_from_metadata
 
 @pytest.fixture(scope="module")
 def short_plan(tmp_path_factory):
@@ -244,36 +244,10 @@ def test_batched_certificate_is_the_per_vector_one(short_plan, tmp_path, edit, k
     assert kinds <= {v.kind for v in fast.violations}
 
 
-def test_all_vectors_match_the_solver_per_vector():
-    """Statuses, feasible modes, c_n and qdot of the batched path are the solver's, bit for bit,
-    on seeded hand scenes, with and without degenerate modes, at default and machine-precision tolerances."""
-    from qsplan.hands import hand_scene
-    from qsplan.mechanics import Status
-    from qsplan.planner.planning.certify_modes import EXACT_TOLERANCES, solve_all_vectors, solve_per_vector
-
-    task = make_task(default_hand(), 0.0, [0.01])
-    hand = task.hand
-    rng = np.random.default_rng(11)
-    seen_degenerate = False
-    for _ in range(12):
-        pose = task.pose(rng.uniform(-0.02, 0.02))
-        e = str(rng.choice(["left", "right"]))
-        scene = hand_scene(hand, pose, None, e, velocity=rng.uniform(-0.3, 0.3), effort=rng.uniform(-1.0, 1.0))
-        mus = np.vstack([np.zeros(4), np.full(4, 0.2), rng.uniform(0.0, 0.6, (6, 4))])
-        for tol in (None, EXACT_TOLERANCES):
-            args = () if tol is None else (tol,)
-            fast, ref = solve_all_vectors(scene, mus, *args), solve_per_vector(scene, mus, *args)
-            assert fast.letters == ref.letters
-            for name in ("codes", "c_n", "qdot"):
-                assert np.array_equal(getattr(fast, name), getattr(ref, name)), name
-            seen_degenerate |= bool(np.isin(fast.codes, [Status.ORDER.index(s) for s in Status.DEGENERATE]).any())
-    assert seen_degenerate
-
-
 @pytest.mark.slow
 @pytest.mark.ompl
 def test_demo_plan_batched_certificate_is_the_per_vector_one(tmp_path):
-    from qsplan.planner.planning.task import demo_task_path
+    from qsplan.planner.task.task import demo_task_path
 
     task = load_task(demo_task_path())
     export_plan(plan_task(task), tmp_path)

@@ -1,4 +1,4 @@
-"""Plans of described hands (qsplan.planner.manifold): slides planned on the contact manifold by OMPL.
+"""Plans of described hands (qsplan.planner.plan.chain_plan): slides planned on the contact manifold by OMPL.
 
 Each plan is checked independently of the planner: shapely measures every body pair and each finger's
 contact at every row, the joint and speed limits are checked by finite differences of the rows, and
@@ -10,7 +10,7 @@ from shapely.geometry import Polygon
 
 from qsplan.hands.chain_hand import chain_polygons
 from qsplan.planner import load_task, plan_task, task_paths
-from qsplan.planner.planning.task import make_task
+from qsplan.planner.task.task import make_task
 
 #: Overlap (m^2) and gap (m) tolerated by the checks: the contact finder's micron, squared for areas.
 GAP = 1e-6
@@ -93,7 +93,7 @@ def test_a_regrasp_onto_another_feature_is_planned():
     """The two-link fingers choose where they touch: the left one regrasps from a corner onto the left side."""
     from qsplan.hands.chain_hand import close_grasp
     from qsplan.hands.grasps import internal_edge
-    from qsplan.planner.planning.results import RegraspPlan
+    from qsplan.planner.plan.results import RegraspPlan
 
     task = load_task(task_paths()["two_link_regrasp_task"])
     plan = plan_task(task)
@@ -118,8 +118,8 @@ def test_a_regrasp_onto_another_feature_is_planned():
 def test_a_goal_feature_no_finger_can_touch_is_reported():
     from dataclasses import replace
 
-    from qsplan.planner.planning.goal import Goal
-    from qsplan.planner.planning.results import PlanFailure
+    from qsplan.planner.plan.results import PlanFailure
+    from qsplan.planner.task.goal import Goal
 
     task = load_task(task_paths()["two_link_task"])
     with pytest.raises(PlanFailure, match="no valid grasp of the free joints' grid touches the goal's features"):
@@ -176,7 +176,7 @@ def test_the_two_link_hands_exported_commands_drive_the_simulator_through_the_pl
     instant, eqs. 13-28): the workpiece follows the planned x and all four contacts slide, at the friction interval's
     extremes and seeded random points."""
     from qsplan.planner.export.plan_files import export_plan, read_plan_csv
-    from qsplan.planner.planning.replay import friction_samples, replay_plan
+    from qsplan.planner.replay.replay import friction_samples, replay_plan
 
     export_plan(two_link_plan, tmp_path)
     columns = read_plan_csv(tmp_path / "plan.csv")

@@ -86,8 +86,8 @@ TASK = ("[hand]\nworkpiece = [[0,0],[0.08,0],[0.085,0.08],[0.008,0.1]]\n[motion]
 
 
 def test_task_force_margin_defaults_and_fields(tmp_path):
-    from qsplan.planner.planning.task import load_task
-    from qsplan.planner.torque.command import PLAN_FORCE_MARGIN
+    from qsplan.planner.task.fields import PLAN_FORCE_MARGIN
+    from qsplan.planner.task.task import load_task
 
     p = tmp_path / "t.toml"
     p.write_text(TASK)
@@ -106,7 +106,7 @@ def test_task_force_margin_defaults_and_fields(tmp_path):
 ])  # fmt: skip
 def test_task_force_margin_validation(tmp_path, line, match):
     from qsplan.mechanics import QsplanError
-    from qsplan.planner.planning.task import load_task
+    from qsplan.planner.task.task import load_task
 
     p = tmp_path / "t.toml"
     p.write_text(TASK + line + "\n")
@@ -123,8 +123,8 @@ def test_planned_bands_keep_the_margin_at_their_edges(tmp_path):
     from qsplan.hands import hand_scene
     from qsplan.mechanics import solve
     from qsplan.planner.export.plan_files import export_plan, read_plan_csv
-    from qsplan.planner.planning.plan import plan_task
-    from qsplan.planner.planning.task import load_task
+    from qsplan.planner.plan.scripted import plan_task
+    from qsplan.planner.task.task import load_task
 
     p = tmp_path / "t.toml"
     p.write_text(TASK + "min_normal_force = 0.08\n")

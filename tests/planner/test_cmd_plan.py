@@ -71,7 +71,7 @@ def test_ctrl_c_during_planning_exits_130_and_leaves_nothing(tmp_path):
     import sys
     import time
 
-    from qsplan.planner.planning.task import task_paths
+    from qsplan.planner.task.task import task_paths
 
     out = tmp_path / "plan"
     # a described hand's regrasp and slide: seconds of planning after the grasps are found (the paper hand's tasks

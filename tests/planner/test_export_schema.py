@@ -21,7 +21,7 @@ from qsplan.planner.export.schema import (
     schedule_schema,
     validate,
 )
-from qsplan.planner.planning.replay import replay_segments
+from qsplan.planner.replay.replay import replay_segments
 from qsplan.planner.reports.segment import sweep_segment
 
 ROOT = Path(__file__).resolve().parents[2]

@@ -137,9 +137,9 @@ class _Report:
 
 
 def test_failing_forced_plan_leaves_no_old_plan_beside_failure_json(tmp_path, monkeypatch):
-    from qsplan.planner.planning import pipeline
-    from qsplan.planner.planning.results import PlanFailure
-    from qsplan.planner.planning.task import demo_task_path, load_task
+    from qsplan.planner.pipeline import run as pipeline
+    from qsplan.planner.plan.results import PlanFailure
+    from qsplan.planner.task.task import demo_task_path, load_task
 
     def fail(*args, **kwargs):
         raise PlanFailure(_Report())

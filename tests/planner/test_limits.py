@@ -8,8 +8,8 @@ import pytest
 from qsplan.hands.description.files import bundled_hands
 from qsplan.mechanics import QsplanError
 from qsplan.planner import load_task, ompl_available, task_paths
-from qsplan.planner.planning.certify import certify_plan
-from qsplan.planner.planning.limits import PAPER_DEFAULTS, resolve_limits
+from qsplan.planner.certify.certify import certify_plan
+from qsplan.planner.task.limits import PAPER_DEFAULTS, resolve_limits
 
 NAMES, KINDS = ("a", "b", "c"), ("revolute", "revolute", "prismatic")
 HAND_RANGES = [[0.0, 3.0], [-1.0, 1.0], [0.0, 0.05]]
@@ -96,7 +96,7 @@ def test_certifier_holds_a_chain_plan_to_the_task_speed(tmp_path):
     """A plan made under the hand's 0.5 rad/s is refused under a task limit of 0.002 rad/s (it was certified)."""
     if not ompl_available():
         pytest.skip("OMPL bindings not installed")
-    from qsplan.planner.planning.pipeline import run_plan
+    from qsplan.planner.pipeline.run import run_plan
 
     fast = load_task(task_paths()["parallel_jaw_task"])
     run = run_plan(fast, tmp_path / "out", verify=0, plots=False)

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from qsplan.mechanics import QsplanError
-from qsplan.planner.planning.ompl_bridge import PlannerOptions, ompl_available, plan_path
+from qsplan.planner.search.ompl_bridge import PlannerOptions, ompl_available, plan_path
 
 pytestmark = [pytest.mark.ompl, pytest.mark.skipif(not ompl_available(), reason="OMPL bindings not installed")]
 

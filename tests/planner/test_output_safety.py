@@ -15,7 +15,7 @@ from qsplan.planner.cli.main import main
 from qsplan.planner.export import manifest
 from qsplan.planner.export.files import LOCK_NAME, STAGE_PREFIX, OutDirLockedError, locked_out_dir
 from qsplan.planner.export.manifest import MANIFEST, own_outputs, publish_outputs
-from qsplan.planner.planning.task import demo_task_path, task_paths
+from qsplan.planner.task.task import demo_task_path, task_paths
 
 #: The demo's plan without plots or re-simulations: planned, exported and certified in a second or two.
 FAST = ["--no-plots", "--verify", "0", "--quiet"]
@@ -145,7 +145,7 @@ def test_ctrl_c_while_certifying_leaves_no_plan(tmp_path):
 
 @pytest.mark.ompl
 def test_an_interrupted_rerun_keeps_the_earlier_results(tmp_path, capsys, monkeypatch):
-    from qsplan.planner.planning import pipeline
+    from qsplan.planner.pipeline import run as pipeline
 
     out = tmp_path / "out"
     assert run(["demo", "--out", str(out), *FAST], capsys)[0] == 0
@@ -216,8 +216,8 @@ def test_force_never_replaces_the_task_file(tmp_path, capsys, name, extra):
 
 def test_the_lock_file_is_never_an_input(tmp_path):
     from qsplan.mechanics import QsplanError
-    from qsplan.planner.planning.pipeline import run_plan
-    from qsplan.planner.planning.task import load_task
+    from qsplan.planner.pipeline.run import run_plan
+    from qsplan.planner.task.task import load_task
 
     (tmp_path / LOCK_NAME).write_text("a task under the lock file's name")
     with pytest.raises(QsplanError, match="is an input of this run"):  # it would be unlinked after the run

@@ -14,11 +14,11 @@ from shapely.geometry import Polygon
 
 from qsplan.mechanics import QsplanError
 from qsplan.planner.cli.main import main
-from qsplan.planner.planning.failure import PalmReport, palm_report
-from qsplan.planner.planning.goal import palm_x_range
-from qsplan.planner.planning.results import PlanFailure
-from qsplan.planner.planning.task import load_task, make_task, task_paths
-from qsplan.planner.sequence.tables import table_grid
+from qsplan.planner.plan.failure import PalmReport, palm_report
+from qsplan.planner.plan.results import PlanFailure
+from qsplan.planner.search.tables import table_grid
+from qsplan.planner.task.goal import palm_x_range
+from qsplan.planner.task.task import load_task, make_task, task_paths
 
 #: The bundled tasks' workpiece (all but the jaw's hexagon) and the palm's top of every bundled hand (m).
 QUAD = [[0.0, 0.0], [0.080, 0.0], [0.085, 0.080], [0.008, 0.100]]
@@ -62,9 +62,7 @@ def bundled_variant(tmp_path, name, field, x):
     ("parallel_jaw_task", "start", 0.17, "right", HEXAGON),
 ])  # fmt: skip
 def test_beyond_the_palm_is_refused_from_the_geometry(tmp_path, capsys, monkeypatch, name, field, x, side, polygon):
-    from qsplan.planner.manifold import plan as manifold
-    from qsplan.planner.planning import plan
-    from qsplan.planner.sequence import autoplan
+    from qsplan.planner.plan import autoplan, chain_plan as manifold, scripted as plan
 
     def never(*args, **kwargs):
         raise AssertionError("planned a task whose start or goal is beyond the palm")
@@ -132,7 +130,7 @@ SHORT_PALM = {"workpiece": QUAD, "palm_halfwidth": 0.06}
 def test_no_crash_near_the_palms_ends(tmp_path, kind):
     """Start or goal on the palm near its ends (ends included): a certified plan or a named failure, nothing else;
     a hair beyond an end: refused from the geometry."""
-    from qsplan.planner.planning.pipeline import run_plan
+    from qsplan.planner.pipeline.run import run_plan
 
     lo, hi = palm_x_range(make_task(SHORT_PALM, 0.0, waypoints=[0.01]).hand)
     assert (lo, hi) == pytest.approx(expected_range(QUAD, -0.06, 0.06), abs=1e-12)
@@ -158,7 +156,7 @@ def test_no_crash_near_the_palms_ends(tmp_path, kind):
 @pytest.mark.filterwarnings("error")
 def test_no_crash_at_the_ends_of_a_chain_hands_palm(tmp_path):
     """A described two-link hand on a short palm: start at the palm's left end, goal at its right end."""
-    from qsplan.planner.planning.pipeline import run_plan
+    from qsplan.planner.pipeline.run import run_plan
 
     hand_file = (task_paths()["two_link_task"].parent.parent.parent / "hands" / "data" / "two_link_hand.toml")
     (tmp_path / "short.toml").write_text(hand_file.read_text().replace("[[-0.16, -0.02], [0.16, -0.02], [0.16, 0.0], "
@@ -187,7 +185,7 @@ def test_chain_goal_at_its_start_is_one_line_without_warnings(tmp_path):
 @pytest.mark.filterwarnings("error")
 def test_jaw_goal_at_its_start_is_refused_before_planning(tmp_path):
     task = load_task(bundled_variant(tmp_path, "parallel_jaw_task", "goal", 0.0))
-    from qsplan.planner.manifold.plan import plan_chain_task
+    from qsplan.planner.plan.chain_plan import plan_chain_task
 
     with pytest.raises(QsplanError, match="goal.x: a described hand's plan slides the workpiece"):
         plan_chain_task(task)

@@ -10,11 +10,11 @@ from qsplan.hands.two_finger_scene import hand_scene
 from qsplan.mechanics import QsplanError
 from qsplan.mechanics.bands.guaranteed import guaranteed_band_box
 from qsplan.mechanics.modes.contact_mode import ContactMode
-from qsplan.planner.export.plan_files import export_plan, read_plan_csv
 from qsplan.mechanics.solver.all_modes import solve
-from qsplan.planner.planning.plan import check_free_state
-from qsplan.planner.planning.replay import friction_samples, replay_plan
-from qsplan.planner.planning.task import load_task, make_task, task_paths
+from qsplan.planner.export.plan_files import export_plan, read_plan_csv
+from qsplan.planner.plan.scripted import check_free_state
+from qsplan.planner.replay.replay import friction_samples, replay_plan
+from qsplan.planner.task.task import load_task, make_task, task_paths
 
 
 def test_bundled_tasks_load():
@@ -47,7 +47,7 @@ def test_task_validation_names_the_field(tmp_path, text, match):
 def demo_files(tmp_path_factory):
     """The bundled scripted task (the demo before automatic planning: three segments, two regrasps) planned once,
     exported, and read back from the file."""
-    from qsplan.planner.planning.plan import plan_task
+    from qsplan.planner.plan.scripted import plan_task
 
     plan = plan_task(load_task(task_paths()["scripted_regrasp_task"]))
     out = tmp_path_factory.mktemp("demo")
@@ -150,7 +150,7 @@ def test_plan_counts_and_checks(demo_files):
 
 @pytest.mark.ompl
 def test_too_wide_friction_fails_with_a_report():
-    from qsplan.planner.planning.plan import PlanFailure, plan_task
+    from qsplan.planner.plan.scripted import PlanFailure, plan_task
 
     task = make_task(default_hand(), 0.0, [-0.04], mu_range=(0.0, 0.5), torque_resolution=0.05)
     with pytest.raises(PlanFailure, match="band closes at x in") as info:
@@ -164,7 +164,7 @@ def test_too_wide_friction_fails_with_a_report():
 
 @pytest.mark.ompl
 def test_degenerate_closure_is_named_without_meaningless_edge_corners():
-    from qsplan.planner.planning.plan import PlanFailure, plan_task
+    from qsplan.planner.plan.scripted import PlanFailure, plan_task
 
     task = load_task(task_paths()["pentagon_task"])
     task = make_task(replace(task.hand, finger_length=0.16), 0.0, [0.02])  # the demo hand's fingers: they cross

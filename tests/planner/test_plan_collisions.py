@@ -8,10 +8,10 @@ import pytest
 
 from qsplan.hands.two_finger import default_hand, finger_angles
 from qsplan.planner.cli.main import main
-from qsplan.planner.planning.collision import LINK_DEPTH_TOL, find_collisions, overlap_depth
-from qsplan.planner.planning.contact_state import check_contact_state, check_free_state, configuration_problem
-from qsplan.planner.planning.plan import PlanFailure, check_configurations
-from qsplan.planner.planning.task import load_task, make_task, task_paths
+from qsplan.planner.plan.scripted import PlanFailure, check_configurations
+from qsplan.hands.collision import LINK_DEPTH_TOL, find_collisions, overlap_depth
+from qsplan.planner.states.contact import check_contact_state, check_free_state, configuration_problem
+from qsplan.planner.task.task import load_task, make_task, task_paths
 
 from tests.planner.overlaps import row_overlaps
 

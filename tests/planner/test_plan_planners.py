@@ -6,7 +6,7 @@ import time
 
 import pytest
 
-from qsplan.planner.planning.ompl_bridge import PLANNERS, TIMED_PLANNERS, PlannerOptions, plan_path
+from qsplan.planner.search.ompl_bridge import PLANNERS, TIMED_PLANNERS, PlannerOptions, plan_path
 
 pytestmark = pytest.mark.ompl
 

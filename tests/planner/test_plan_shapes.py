@@ -6,7 +6,7 @@ from the exported ``plan.csv`` and the hand's dimensions, measured with shapely)
 
 import pytest
 
-from qsplan.planner.planning.task import make_task
+from qsplan.planner.task.task import make_task
 
 from tests.planner.overlaps import plan_or_refuse, plan_overlaps
 

@@ -9,9 +9,9 @@ import numpy as np
 import pytest
 
 from qsplan.hands import default_hand
-from qsplan.planner.planning.contact_state import check_contact_state, contact_samples
-from qsplan.planner.planning.plan import sweep_contact_segment
-from qsplan.planner.planning.task import make_task
+from qsplan.planner.plan.scripted import sweep_contact_segment
+from qsplan.planner.states.contact import check_contact_state, contact_samples
+from qsplan.planner.task.task import make_task
 from qsplan.planner.torque.sweep import competing_modes
 
 #: Seeded cases (each 25 configurations, compared one by one).

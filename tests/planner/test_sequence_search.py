@@ -5,7 +5,7 @@ from collections import deque
 import numpy as np
 import pytest
 
-from qsplan.planner.sequence.widest import SearchGraph, slide_widths, widest_route
+from qsplan.planner.search.widest import SearchGraph, slide_widths, widest_route
 
 
 def random_graph(seed, G=3, n=14, resolution=0.2):
@@ -100,7 +100,7 @@ def test_forbidden_regrasps_are_avoided():
 
 def test_ompl_planners_on_the_tables():
     pytest.importorskip("ompl")
-    from qsplan.planner.sequence.ompl_search import search_route
+    from qsplan.planner.search.ompl_search import search_route
 
     graph = random_graph(3)
     G, n = graph.shape

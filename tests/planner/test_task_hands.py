@@ -1,5 +1,5 @@
 """A task's ``[hand]``: the paper hand's parameters, a hand file (bundled or a path), or a description inline
-(qsplan.planner.planning.task_fields); bad hands are refused in one line naming the field."""
+(qsplan.planner.task.fields); bad hands are refused in one line naming the field."""
 
 import numpy as np
 import pytest
@@ -9,7 +9,7 @@ from qsplan.hands.description import bundled_hands
 from qsplan.hands.two_finger import TwoFingerHand
 from qsplan.mechanics.errors import QsplanError
 from qsplan.planner.cli.main import main
-from qsplan.planner.planning.task import load_task, make_task
+from qsplan.planner.task.task import load_task, make_task
 
 WORKPIECE = "workpiece = [[0.0, 0.0], [0.080, 0.0], [0.085, 0.080], [0.008, 0.100]]\n"
 REST = "[motion]\nstart_x = 0.0\n[goal]\nx = -0.02\n[controller]\ntorque_resolution = 0.02\n"

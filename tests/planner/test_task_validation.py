@@ -5,7 +5,7 @@ import tomllib
 import pytest
 
 from qsplan.mechanics import QsplanError
-from qsplan.planner.planning.task import MAX_WAYPOINTS, TASK_RANGES, demo_task_path, load_task, make_task, task_paths
+from qsplan.planner.task.task import MAX_WAYPOINTS, TASK_RANGES, demo_task_path, load_task, make_task, task_paths
 
 from tests.fuzzing import toml_text
 

@@ -1,0 +1,383 @@
+"""The one hand: a :class:`~qsplan.hands.description.HandDescription` holding a workpiece (issue 22).
+
+:class:`DescribedHand` implements :class:`qsplan.hands.protocol.Hand` for any palm and two serial fingers
+of revolute and prismatic joints.  Its *generic path* answers every question from the description,
+batched over states: the closing (:mod:`qsplan.hands.described_states`), the contacts checked against the
+polygon search and the scenes' arrays (:mod:`qsplan.hands.described_scenes`), collisions.  Where the
+description is of the paper's form (two single-link revolute fingers, Fig. 9;
+:func:`~qsplan.hands.description.two_finger_form.two_finger_parameters`), the paper's closed forms answer
+instead (:mod:`qsplan.hands.paper_accelerator`): decided once at construction, ``accelerated=False``
+forces the generic path (the tests compare the two).
+
+Build one with :func:`make_described_hand` (a description and a workpiece), or convert today's hands:
+:func:`described_from_two_finger` (the paper's :class:`~qsplan.hands.two_finger.TwoFingerHand`, given by
+its parameters), :func:`described_from_chain` (a :class:`~qsplan.hands.chain_hand.ChainHand`).
+:meth:`DescribedHand.metadata` and :func:`hand_from_metadata` round-trip (the paper hand by today's
+keys).  Units SI (m, kg, rad, N, N m).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from functools import lru_cache
+
+import numpy as np
+
+from qsplan.hands.formations import FORMATIONS, Formation, formation as registered_formation
+from qsplan.mechanics.errors import QsplanError
+
+__all__ = ["DescribedHand", "described_from_chain", "described_from_two_finger", "hand_from_metadata",
+           "make_described_hand"]
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class DescribedHand:
+    """A described hand and its workpiece (:class:`qsplan.hands.protocol.Hand`); build it with :func:`make_described_hand`.
+
+    Attributes
+    ----------
+    description : qsplan.hands.description.HandDescription
+    workpiece : ndarray, shape (k, 2)
+        Counter-clockwise about the centroid (m); vertex 0 the left end of the bottom edge.
+    workpiece_mass, mu : float
+        kg; friction coefficient of every contact.
+    vertex_order, vertex_of_user : tuple of int
+        Internal and user vertex numbering.
+    own_limits : (ndarray (n_j, 2), ndarray (n_j,)) or None
+        The description's joint ranges and speeds; None for the paper hand given by its parameters.
+    accelerated : bool
+        The paper's closed forms answer (its form, and not switched off).
+    chain : qsplan.hands.chain_hand.ChainHand
+        The same hand as today's chain record (the polygon search's reference path).
+    paper : qsplan.hands.two_finger.TwoFingerHand or None
+        The accelerator's parameter record, where the description is of the paper's form.
+    contact_view : qsplan.hands.described_scenes.ContactView or None
+    user_vertices, user_edges : ndarray of int, shape (k,)
+        The user's number of each internal vertex and edge.
+    closings : dict
+        The last closings (:func:`qsplan.hands.described_states.close_states`), shared by the grasps closed at the same
+        states; a cache, not part of the hand.
+    """
+
+    description: object
+    workpiece: np.ndarray
+    workpiece_mass: float
+    mu: float
+    vertex_order: tuple
+    vertex_of_user: tuple
+    own_limits: tuple | None
+    accelerated: bool
+    chain: object
+    paper: object
+    contact_view: object
+    user_vertices: np.ndarray
+    user_edges: np.ndarray
+    closings: dict = field(default_factory=dict, repr=False)
+
+    @property
+    def name(self) -> str:
+        return self.description.name
+
+    @property
+    def manipulator(self):
+        return self.description.manipulator
+
+    @property
+    def joint_names(self) -> tuple:
+        return tuple(self.description.joint_names)
+
+    @property
+    def joint_kinds(self) -> tuple:
+        return tuple(self.description.joint_kinds)
+
+    @property
+    def finger_joints(self) -> tuple:
+        """``((left joints...), (right joints...))``: joint indices, base to tip."""
+        return tuple(tuple(int(j) for j in f.joints) for f in self.description.fingers)
+
+    @property
+    def closing_joints(self) -> tuple:
+        """Each finger's last joint (left, right)."""
+        return tuple(f[-1] for f in self.finger_joints)
+
+    @property
+    def free_joints(self) -> tuple:
+        """Every joint but the closing ones, in joint order."""
+        return tuple(j for j in range(len(self.joint_names)) if j not in self.closing_joints)
+
+    @property
+    def rest_height(self) -> float:
+        """Height (m) of the centre of mass when the bottom edge lies on the palm (its top is ``y = 0``)."""
+        return float(-self.workpiece[:, 1].min())
+
+    @property
+    def gravity(self) -> float:
+        return float(self.manipulator.gravity)
+
+    @property
+    def palm(self) -> np.ndarray:
+        return self.description.palm
+
+    @property
+    def paper_form(self) -> bool:
+        """Whether the description is of the paper's form (the accelerator may answer)."""
+        return self.paper is not None
+
+    @property
+    def palm_range(self) -> tuple:
+        """The workpiece x (m) over which its bottom edge lies on the palm's top: ``(lo, hi)``."""
+        lo, hi = self.description.palm_top
+        return float(lo - self.workpiece[0, 0]), float(hi - self.workpiece[1, 0])
+
+    def _closed_forms(self, formation) -> bool:
+        return self.accelerated and formation == FORMATIONS["palm_edge"]
+
+    def pose(self, x) -> np.ndarray:
+        """Workpiece pose ``(x, rest_height, 0)`` (m, m, rad), shape (3,)."""
+        return np.array([float(x), self.rest_height, 0.0])
+
+    def body_polygons(self, pose, q) -> dict:
+        """World polygons (m): ``{"palm", "workpiece", <joint name>...}`` -> (k, 2), at ``pose`` (3,) and ``q`` (n_j,)."""
+        from qsplan.hands.interface import hand_body_polygons
+
+        return hand_body_polygons(self.paper if self.accelerated else self.chain, pose, q)
+
+    def grasp_candidates(self, formation="palm_edge", free=None) -> tuple:
+        """The grasps the planner's tables consider.
+
+        The paper's closed forms: :func:`qsplan.hands.grasp_geometry.candidate_grasps`.  The generic path
+        (:func:`qsplan.hands.described_candidates.chain_candidates`): along the palm, from each row of ``free``
+        (m, n_free; default the free joints mid-range), the distinct contact pairs the closing gives (both fingers
+        touching, neither flush), as :class:`~qsplan.hands.protocol.ChainGrasp`, by ``free``'s rows then contact keys.
+        """
+        from qsplan.hands.described_candidates import chain_candidates
+
+        formation = _formation(formation)
+        if self._closed_forms(formation) and (free is None or not self.free_joints):
+            from qsplan.hands.grasp_geometry import candidate_grasps
+
+            return candidate_grasps(self.paper)
+        return chain_candidates(self, formation, free)
+
+    def grasp_states(self, formation, grasp, xs, free=None):
+        """The grasp at workpiece ``xs`` (n,) (m): :class:`qsplan.hands.protocol.GraspStates`.
+
+        ``free`` (n, n_free): each state's free joints (rad or m), default the grasp's.  A paper
+        :class:`~qsplan.hands.grasps.Grasp` goes to the closed forms when accelerated, else to the generic closing
+        (:func:`qsplan.hands.described_states.requirement` reads its placements as contact keys).
+        """
+        from qsplan.hands.described_states import generic_states
+        from qsplan.hands.grasps import Grasp
+
+        formation = _formation(formation)
+        xs = _positions(xs)
+        if free is not None and not self.free_joints and np.shape(free) in ((len(xs), 0), (0,)):
+            free = None  # no free joints to give
+        if self._closed_forms(formation) and isinstance(grasp, Grasp) and free is None:
+            from qsplan.hands.paper_accelerator import paper_states
+
+            return paper_states(self.paper, formation, grasp, xs)
+        return generic_states(self, formation, grasp, xs, free)
+
+    def scene_arrays(self, formation, states, idx=None):
+        """The scene arrays (eqs. 1-5) of ``states`` at ``idx`` (default: where ok), batched:
+        :class:`qsplan.hands.protocol.GraspSceneArrays`."""
+        from qsplan.hands.grasps import Grasp
+
+        formation = _formation(formation)
+        if self._closed_forms(formation) and isinstance(states.grasp, Grasp):
+            from qsplan.hands.paper_accelerator import paper_scene_arrays
+
+            return paper_scene_arrays(self.paper, states, idx)
+        from qsplan.hands.described_scenes import generic_scene_arrays
+
+        return generic_scene_arrays(self, formation, states, idx)
+
+    def state_scene(self, arrays, s: int, effort_controlled, velocity, effort=None, mu=None):
+        """The :class:`qsplan.mechanics.Scene` of state ``s`` of ``arrays`` (:meth:`scene_arrays`) under the joint
+        inputs: ``effort_controlled`` (n_j,) bool, ``velocity`` and ``effort`` (n_j,) (rad/s or m/s; N m or N)."""
+        if arrays.closed_form:
+            from qsplan.hands.paper_accelerator import paper_state_scene
+
+            return paper_state_scene(self.paper, arrays, s, effort_controlled, velocity, effort, mu)
+        from qsplan.hands.described_scenes import state_scene_of
+
+        return state_scene_of(self, arrays, s, effort_controlled, velocity, effort, mu)
+
+    def scene(self, pose, q, effort_controlled, velocity, effort=None, mu=None, method: str = "auto"):
+        """One :class:`qsplan.mechanics.Scene` (contacts palm, palm, left, right) at ``pose`` (3,) and ``q`` (n_j,).
+
+        ``method``: ``"generic"`` finds the contacts in the polygons (the reference, the certifier's); ``"auto"`` lets
+        the paper's closed form find them where it can.  Parameters as :func:`qsplan.hands.interface.scene_at`.
+        """
+        from qsplan.hands.interface import scene_at
+
+        if method not in ("auto", "generic"):
+            raise QsplanError(f"method: expected 'auto' or 'generic'; got {method!r}")
+        return scene_at(self.paper if self.accelerated else self.chain, pose, q, effort_controlled, velocity, effort,
+                        mu, method)  # fmt: skip
+
+    def collide(self, poses, q) -> np.ndarray:
+        """Whether any two bodies overlap beyond their tolerance at each state (housings respected): ``poses`` (n, 3),
+        ``q`` (n, n_j) -> bool (n,) (:func:`qsplan.hands.collision.find_collisions_batch`)."""
+        from qsplan.hands.collision import find_collisions_batch
+
+        return find_collisions_batch(self.paper if self.accelerated else self.chain, poses, q)
+
+    def collisions(self, pose, q, first: bool = False) -> list:
+        """The overlapping body pairs at ``pose`` (3,), ``q`` (n_j,), named
+        (:func:`qsplan.hands.collision.find_collisions`)."""
+        from qsplan.hands.collision import find_collisions
+
+        return find_collisions(self.paper if self.accelerated else self.chain, pose, q, first)
+
+    def opening(self, grasp, x, q) -> np.ndarray:
+        """Each joint's opening direction (-1, 0, +1), shape (n_j,), releasing ``grasp`` with the workpiece at ``x`` (m)
+        and the joints at ``q`` (n_j,): the closing joints against their closing direction, the free joints 0.
+
+        The paper's closed forms: the sign that moves the contact point out of the workpiece (eq. 5).
+        """
+        from qsplan.hands.grasps import Grasp
+
+        if self.accelerated and isinstance(grasp, Grasp):
+            from qsplan.hands.paper_accelerator import paper_opening
+
+            return paper_opening(self.paper, grasp, float(x))
+        from qsplan.hands.closing import closing_direction
+
+        lim = self.description.joint_limits
+        out = np.zeros(len(self.joint_names))
+        for side, k in zip((1.0, -1.0), self.closing_joints):
+            qm = np.array(q, dtype=float)
+            qm[k] = 0.5 * (lim[k, 0] + lim[k, 1])
+            out[k] = -closing_direction(self.manipulator, qm, k, side)
+        return out
+
+    def metadata(self) -> dict:
+        """The hand as an exported plan's metadata records it (:func:`qsplan.hands.interface.hand_metadata`): the paper's
+        form by its parameters (today's keys), any other hand by its description and workpiece."""
+        from qsplan.hands.interface import hand_metadata
+
+        return hand_metadata(self.paper if self.paper is not None else self.chain)
+
+
+def _formation(value) -> Formation:
+    """A :class:`Formation`, or the registered one named ``value``."""
+    return value if isinstance(value, Formation) else registered_formation(value)
+
+
+def _positions(xs) -> np.ndarray:
+    xs = np.atleast_1d(np.asarray(xs, dtype=float))
+    if xs.ndim != 1 or not np.all(np.isfinite(xs)):
+        raise QsplanError(f"xs: expected a finite 1-D array of workpiece x (m); got shape {xs.shape}")
+    return xs
+
+
+def _user_maps(chain) -> tuple:
+    from qsplan.hands.grasps import user_edge, user_vertex
+
+    k = len(chain.workpiece)
+    return (np.array([user_vertex(chain, i) for i in range(k)], dtype=int),
+            np.array([user_edge(chain, i) for i in range(k)], dtype=int))  # fmt: skip
+
+
+def described_from_chain(chain, accelerated: bool = True, own_limits="description") -> DescribedHand:
+    """A :class:`~qsplan.hands.chain_hand.ChainHand` as a :class:`DescribedHand` (the paper's closed forms where its
+    description has the paper's form and ``accelerated``).  ``own_limits``: the description's by default."""
+    from qsplan.hands.described_scenes import contact_view
+    from qsplan.hands.description.two_finger_form import two_finger_parameters
+    from qsplan.hands.two_finger import TwoFingerHand
+
+    desc = chain.description
+    params = two_finger_parameters(desc)
+    paper = None if params is None else TwoFingerHand(chain.workpiece, chain.workpiece_mass, mu=chain.mu,
+                                                      vertex_order=chain.vertex_order,
+                                                      vertex_of_user=chain.vertex_of_user, **params)  # fmt: skip
+    limits = (desc.joint_limits, desc.joint_speeds) if own_limits == "description" else own_limits
+    return DescribedHand(desc, chain.workpiece, chain.workpiece_mass, chain.mu, chain.vertex_order, chain.vertex_of_user,
+                         limits, bool(accelerated and paper is not None), chain, paper, contact_view(desc),
+                         *_user_maps(chain))  # fmt: skip
+
+
+def make_described_hand(description, workpiece, workpiece_mass=0.2, mu=0.2, palm_edge=None,
+                        accelerated: bool = True) -> DescribedHand:  # fmt: skip
+    """Validate and build a :class:`DescribedHand`.
+
+    Parameters
+    ----------
+    description : qsplan.hands.description.HandDescription
+    workpiece : array-like, shape (k, 2)
+        Convex polygon (m) (:func:`qsplan.hands.workpiece.prepare_workpiece`).
+    workpiece_mass : float
+        kg, positive.
+    mu : float
+        Friction coefficient, nonnegative.
+    palm_edge : int, optional
+        The edge, as written, that rests on the palm.
+    accelerated : bool
+        Let the paper's closed forms answer where the description has the paper's form.
+
+    Raises
+    ------
+    SceneError
+        Naming the field.
+    """
+    from qsplan.hands.chain_hand import make_chain_hand
+
+    return described_from_chain(make_chain_hand(description, workpiece, workpiece_mass, mu, palm_edge), accelerated)
+
+
+@lru_cache(maxsize=1)
+def _paper_file_limits() -> tuple:
+    """The bundled paper hand file's joint range (rad) and speed (rad/s) (``hands/data/paper_hand.toml``)."""
+    from qsplan.hands.description.files import load_hand
+
+    desc = load_hand("paper_hand")
+    return tuple(float(v) for v in desc.joint_limits[0]), float(desc.joint_speeds[0])
+
+
+def described_from_two_finger(hand, joint_limits=None, joint_speed=None, accelerated: bool = True) -> DescribedHand:
+    """The paper's :class:`~qsplan.hands.two_finger.TwoFingerHand` (its parameters) as a :class:`DescribedHand`.
+
+    Parameters
+    ----------
+    hand : TwoFingerHand
+    joint_limits : array-like, shape (2,) or (2, 2), optional
+        The fingers' ranges (rad) the generic closing closes within; default the bundled paper hand file's.
+    joint_speed : float or array-like, shape (2,), optional
+        rad/s; default the bundled paper hand file's.
+    accelerated : bool
+
+    Notes
+    -----
+    ``own_limits`` is None: a hand given by its parameters has none (a task's ``[limits]`` give them).
+    """
+    from qsplan.hands.chain_hand import ChainHand
+    from qsplan.hands.described_scenes import contact_view
+    from qsplan.hands.description.two_finger_form import describe_two_finger_hand
+
+    lim, speed = _paper_file_limits()
+    desc = describe_two_finger_hand(hand, lim if joint_limits is None else joint_limits,
+                                    speed if joint_speed is None else joint_speed, name="paper hand")  # fmt: skip
+    k = len(hand.workpiece)
+    order = hand.vertex_order if hand.vertex_order is not None else tuple(range(k))
+    of_user = hand.vertex_of_user if hand.vertex_of_user is not None else tuple(range(k))
+    chain = ChainHand(desc, hand.workpiece, hand.workpiece_mass, hand.mu, order, of_user)
+    return DescribedHand(desc, hand.workpiece, hand.workpiece_mass, hand.mu, order, of_user, None, bool(accelerated),
+                         chain, hand, contact_view(desc), *_user_maps(chain))  # fmt: skip
+
+
+def hand_from_metadata(meta, accelerated: bool = True) -> DescribedHand:
+    """The hand a plan's ``metadata["hand"]`` records (:meth:`DescribedHand.metadata`).
+
+    Raises
+    ------
+    QsplanError
+        Naming the field (:func:`qsplan.hands.interface.hand_from_metadata`).
+    """
+    from qsplan.hands.interface import hand_from_metadata as recorded, is_chain_hand
+
+    hand = recorded(meta)
+    if is_chain_hand(hand):
+        return described_from_chain(hand, accelerated)
+    return described_from_two_finger(hand, accelerated=accelerated)

@@ -1,0 +1,347 @@
+"""The row checks of the plan certifier (:mod:`qsplan.planner.certify.certify`), each rebuilt from the task alone.
+
+Every function here takes the task, the plan's columns (``{name: ndarray}`` as
+:func:`qsplan.planner.export.plan_files.read_plan_csv` returns them) and a row
+index, and returns ``(kind, message)`` pairs: nothing of the planner's own
+validity checker or band computation is used.  The geometry comes from the
+hand's polygons (:func:`qsplan.hands.interface.hand_body_polygons`: the paper's hand or any
+described chain hand, every joint of it); the mechanics of a row (the mode check) is in
+:mod:`qsplan.planner.certify.modes`.  Units SI (m, rad, s, N, N m; a prismatic joint's
+positions, speeds and efforts in m, m/s and N).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+__all__ = [
+    "OVERLAP_DEPTH_TOL",
+    "CONTACT_GAP_TOL",
+    "JOINT_HOUSING",
+    "LIMIT_TOL",
+    "SPEED_RTOL",
+    "JUMP_TOL",
+    "COMMAND_RTOL",
+    "row_pose",
+    "row_q",
+    "joint_speeds",
+    "overlap_pairs",
+    "joint_housings",
+    "row_bodies",
+    "bodies_at",
+    "body_overlaps",
+    "overlap_checks",
+    "contact_checks",
+    "limit_checks",
+    "step_checks",
+    "command_step_checks",
+    "friction_points",
+]
+
+#: Penetration (m) tolerated between two bodies: the depth (the narrowest width) of
+#: their intersection.  The fingers touch the workpiece by tangency and the workpiece
+#: rests on the palm, so touching bodies compute as overlapping by ~1e-15 m per metre of
+#: scene; one micron is :data:`qsplan.mechanics.CONTACT_TOL`, the distance the contact
+#: finder itself treats as touching, far below any overlap a planar hand could tolerate.
+OVERLAP_DEPTH_TOL = 1e-6
+
+#: Distance (m) within which a contact the mode lists counts as present (the same micron).
+CONTACT_GAP_TOL = 1e-6
+
+#: Radius of a revolute joint's housing in link widths: a link's root turns inside the body
+#: that carries it (the palm, or the parent link: its rectangle is centred on the joint axis),
+#: so the link is checked against its carrier only outside a disk this many widths about its
+#: joint.  1.12 is the disk through the corners of one link width of root (hypot(1, 1/2)).  A
+#: prismatic joint's link never turns inside its carrier: no housing.
+JOINT_HOUSING = float(np.hypot(1.0, 0.5))
+
+#: Joint positions (rad or m) beyond a limit by less than this are inside: the CSV holds full
+#: double precision (repr round trip), so only the planner's own rounding is forgiven.
+LIMIT_TOL = 1e-9
+
+#: Relative excess tolerated on a speed limit (finite differences and exported commands).
+#: A finite difference of a path that respects the limit never exceeds it (mean value
+#: theorem), so this only absorbs rounding of ``dt`` (decimal times) and of the angles.
+SPEED_RTOL = 1e-6
+
+#: Jump (rad or m) tolerated between two rows at the same time (a phase switch): rounding.
+JUMP_TOL = 1e-9
+
+#: Relative difference tolerated between an in-contact step of a velocity-controlled joint and the trapezoid of
+#: its velocity commands: the commands sample the closed-form rate of a smooth path at 0.5 mm of workpiece
+#: travel, whose trapezoid errs by about dt^3 (d3q/dt3) / 12, well under 1 % of a step on the bundled plans.
+COMMAND_RTOL = 1e-2
+
+def row_pose(cols, k) -> np.ndarray:
+    """Workpiece ``(x, y, theta)`` of row ``k`` (m, m, rad), shape (3,)."""
+    return np.array([cols["x_workpiece"][k], cols["y_workpiece"][k], cols["theta_workpiece"][k]], dtype=float)
+
+
+def row_q(cols, k, names=("left", "right")) -> np.ndarray:
+    """Joint positions of row ``k`` over the joints ``names`` (the hand's, in its order) (rad or m), shape (n_j,)."""
+    return np.array([cols[f"q_{n}"][k] for n in names], dtype=float)
+
+
+def joint_speeds(task) -> np.ndarray:
+    """Speed limit of each joint (rad/s or m/s), shape (n_j,): :attr:`Task.joint_speeds`."""
+    return np.asarray(task.joint_speeds, dtype=float)
+
+
+def joint_housings(hand) -> dict:
+    """``{link: (carrier, joint index, radius (m), disk or None)}`` for every revolute joint's link: the disk (shapely)
+    about the joint's axis inside which the link may overlap its carrier (``"palm"`` or the parent link's name).
+
+    The disk is built here when the axis cannot move (a joint on the palm), else per row (:func:`row_bodies`).
+    """
+    from shapely.geometry import Point
+
+    from qsplan.hands.interface import is_chain_hand, joint_axes, manipulator_of
+
+    if not is_chain_hand(hand):
+        housing = JOINT_HOUSING * hand.finger_width
+        return {side: ("palm", j, housing, Point(p).buffer(housing, 64))
+                for j, (side, p) in enumerate(zip(("left", "right"), hand.pivots))}  # fmt: skip
+    man = manipulator_of(hand)
+    axes = joint_axes(hand, np.zeros(man.n_joints))
+    out = {}
+    for j, joint in enumerate(man.joints):
+        if joint.kind != "revolute" or joint.link_shape is None:
+            continue
+        y = np.asarray(joint.link_shape, dtype=float)[:, 1]
+        radius = JOINT_HOUSING * float(y.max() - y.min())  # the link's width across its axis
+        fixed = joint.parent < 0
+        carrier = "palm" if fixed else man.joints[joint.parent].name
+        out[joint.name] = (carrier, j, radius, Point(axes[j]).buffer(radius, 64) if fixed else None)
+    return out
+
+
+def row_bodies(task, cols, k, roots=None) -> dict:
+    """The bodies of row ``k`` as shapely geometry: ``{"polys": {name: Polygon}, "roots": {link: (carrier, disk)}}``.
+
+    Built once per row and passed to :func:`overlap_checks` and :func:`contact_checks`;
+    ``roots``: :func:`joint_housings` of the task's hand, when already built (a joint on a moving link gets its
+    disk about its axis at the row's joint positions).
+    """
+    from qsplan.hands.interface import joint_names
+
+    return bodies_at(task, row_pose(cols, k), row_q(cols, k, joint_names(task.hand)), roots)
+
+
+def bodies_at(task, pose, q, roots=None) -> dict:
+    """:func:`row_bodies` at workpiece pose ``pose`` (3,) and joint positions ``q`` (n_j,) (m, rad)."""
+    from shapely.geometry import Point, Polygon
+
+    from qsplan.hands.interface import hand_body_polygons, joint_axes
+
+    polys = {name: Polygon(v) for name, v in hand_body_polygons(task.hand, pose, q).items()}
+    housings = joint_housings(task.hand) if roots is None else roots
+    axes = None
+    disks = {}
+    for link, (carrier, j, radius, disk) in housings.items():
+        if disk is None:
+            axes = joint_axes(task.hand, q) if axes is None else axes
+            disk = Point(axes[j]).buffer(radius, 64)
+        disks[link] = (carrier, disk)
+    return {"polys": polys, "roots": disks}
+
+
+def _depth(inter) -> float:
+    """Narrowest width (m) of an intersection: per part, its convex hull's smallest extent across one of the
+    hull's edges (the penetration depth of a vertex or an edge pushed in); the largest over parts."""
+    best = 0.0
+    for part in getattr(inter, "geoms", (inter,)):
+        if part.is_empty or part.area == 0.0:
+            continue
+        hull = np.asarray(part.convex_hull.exterior.coords)[:-1]
+        edges = np.roll(hull, -1, axis=0) - hull
+        lengths = np.hypot(edges[:, 0], edges[:, 1])
+        normals = np.stack([-edges[:, 1], edges[:, 0]], axis=1)[lengths > 0] / lengths[lengths > 0, None]
+        widths = hull @ normals.T
+        best = max(best, float((widths.max(axis=0) - widths.min(axis=0)).min()))
+    return best
+
+
+def _label(name: str) -> str:
+    """A body in words: the paper's fingers ``"left finger"``, a chain hand's links ``"left_distal link"``."""
+    if name in ("palm", "workpiece"):
+        return name
+    return f"{name} finger" if name in ("left", "right") else f"{name} link"
+
+
+def overlap_pairs(hand) -> tuple:
+    """The pairs :func:`overlap_checks` tests, in order: every two links, each link and the workpiece, the workpiece
+    and the palm, each link and the palm (the paper's hand: left/right, left/workpiece, right/workpiece,
+    workpiece/palm, left/palm, right/palm)."""
+    from itertools import combinations
+
+    from qsplan.hands.interface import joint_names
+
+    links = joint_names(hand)
+    return (tuple(combinations(links, 2)) + tuple((n, "workpiece") for n in links) + (("workpiece", "palm"),)
+            + tuple((n, "palm") for n in links))  # fmt: skip
+
+
+def overlap_checks(task, cols, k, bodies=None) -> list:
+    """Check 1: no two bodies (links, palm, workpiece) overlap deeper than :data:`OVERLAP_DEPTH_TOL`; a link and its
+    carrier outside the link's joint housing.
+
+    ``bodies``: :func:`row_bodies` of the row, when already built.
+    """
+    return body_overlaps(task, row_bodies(task, cols, k) if bodies is None else bodies)
+
+
+def body_overlaps(task, bodies) -> list:
+    """:func:`overlap_checks` of bodies built by :func:`bodies_at`."""
+    polys, roots, out = bodies["polys"], bodies["roots"], []
+    for a, c in overlap_pairs(task.hand):
+        A, C = polys[a], polys[c]
+        if a in roots and roots[a][0] == c:  # the link first, clipped, as its housing allows
+            A = A.difference(roots[a][1])
+        elif c in roots and roots[c][0] == a:
+            C = C.difference(roots[c][1])
+        inter = A.intersection(C)
+        depth = _depth(inter)
+        if depth > OVERLAP_DEPTH_TOL:
+            out.append(("overlap", f"{_label(a)} / {_label(c)} overlap {inter.area * 1e6:.3g} mm^2, "
+                                   f"{depth * 1e3:.3g} mm deep"))  # fmt: skip
+    return out
+
+
+def contact_checks(task, cols, k, bodies=None) -> list:
+    """Check 3: every contact of the row's mode is present (palm:0, palm:1, left finger, right finger; a finger's
+    contact on any of its links).
+
+    ``bodies``: :func:`row_bodies` of the row, when already built.
+    """
+    from shapely.geometry import Point
+
+    from qsplan.hands.interface import finger_joint_names
+
+    polys = (row_bodies(task, cols, k) if bodies is None else bodies)["polys"]
+    mode = str(cols["mode"][k])
+    if len(mode) != 4 or set(mode) - set("RSB"):
+        return [("contact", f"mode {mode!r}: expected four letters of R, S, B (palm:0, palm:1, left, right)")]
+    V = np.asarray(polys["workpiece"].exterior.coords)[:-1]
+    left, right = (min(polys[n].distance(polys["workpiece"]) for n in names) for names in finger_joint_names(task.hand))
+    gaps = [("palm:0 (workpiece's bottom-left vertex on the palm)", Point(V[0]).distance(polys["palm"])),
+            ("palm:1 (workpiece's bottom-right vertex on the palm)", Point(V[1]).distance(polys["palm"])),
+            ("left finger on the workpiece", left), ("right finger on the workpiece", right)]  # fmt: skip
+    return [("contact", f"contact {name} of mode {mode} is missing: gap {gap * 1e3:.3g} mm")
+            for name, gap in gaps if gap > CONTACT_GAP_TOL]  # fmt: skip
+
+
+def limit_checks(task, cols, k) -> list:
+    """Check 2 (one row): joint limits, exported joint-speed commands, the effort inside its band, one command per
+    joint (a torque for the row's ``effort_joint``, a velocity for every other joint)."""
+    from qsplan.hands.interface import joint_names, joint_units
+
+    names = joint_names(task.hand)
+    units, speeds = joint_units(task.hand), joint_speeds(task)
+    out = []
+    q = row_q(cols, k, names)
+    if not np.all(np.isfinite(q)) or not np.all(np.isfinite(row_pose(cols, k))):
+        return [("input", "a joint angle or the workpiece pose is not a finite number")]
+    for j, side in enumerate(names):
+        lo, hi = task.joint_limits[j]
+        u = units[j]
+        if q[j] < lo - LIMIT_TOL or q[j] > hi + LIMIT_TOL:
+            out.append(("joint limit", f"{side} joint at {q[j]:.6g} {u}, outside its limits [{lo:g}, {hi:g}] {u}"))
+        qd = cols[f"qd_{side}"][k]
+        if np.isfinite(qd) and abs(qd) > speeds[j] * (1 + SPEED_RTOL):
+            out.append(("speed", f"{side} joint speed command {qd:.6g} {u}/s beyond the limit {speeds[j]:g} {u}/s"))
+    if cols["mode"][k] == "free":
+        return out
+    e = str(cols["effort_joint"][k])
+    if e not in names:
+        listed = " or ".join(repr(n) for n in names)
+        return out + [("input", f"effort_joint {e!r}: expected {listed} on an in-contact row")]
+    revolute = units[names.index(e)] == "rad"
+    unit, what, symbol = ("N m", "torque", "tau") if revolute else ("N", "force", "f")
+    tau, lo, hi = (float(cols[f"tau_{e}{s}"][k]) for s in ("", "_min", "_max"))
+    if not np.isfinite(tau) or np.isnan(lo) or np.isnan(hi):
+        out.append(("torque", f"{e} joint: no {what} command or band ({symbol} = {tau}, band [{lo}, {hi}])"))
+    elif not lo <= tau <= hi:
+        edge = lo if tau < lo else hi
+        out.append(("torque", f"{e} joint {what} {tau:.6g} {unit} outside its band [{lo:.6g}, {hi:.6g}] {unit} "
+                              f"({abs(tau - edge):.3g} {unit} past the edge)"))  # fmt: skip
+    if not np.isnan(cols[f"qd_{e}"][k]):
+        out.append(("input", f"{e} joint (torque-controlled): a velocity command {cols[f'qd_{e}'][k]!r} beside its "
+                             f"{what}; one command per joint"))  # fmt: skip
+    for v in names:
+        if v == e:
+            continue
+        if not np.isfinite(cols[f"qd_{v}"][k]):
+            out.append(("input", f"{v} joint (velocity-controlled): no velocity command"))
+        if any(not np.isnan(cols[f"tau_{v}{s}"][k]) for s in ("", "_min", "_max")):
+            out.append(("input", f"{v} joint: a torque command or band on a row whose effort_joint is {e}"))
+    return out
+
+
+def step_checks(task, cols, k) -> list:
+    """Check 2 (rows ``k`` and ``k + 1``): time order, speed limits over the step, no jump at a switch."""
+    from qsplan.hands.interface import joint_names, joint_units
+
+    names, units, speeds = joint_names(task.hand), joint_units(task.hand), joint_speeds(task)
+    t0, t1 = cols["t"][k], cols["t"][k + 1]
+    dt = t1 - t0
+    if not (np.isfinite(dt) and dt >= 0):
+        return [("time", f"time goes from {t0:.6g} s to {t1:.6g} s at the next row")]
+    dq = row_q(cols, k + 1, names) - row_q(cols, k, names)
+    p0, p1 = row_pose(cols, k), row_pose(cols, k + 1)
+    dx = float(np.hypot(*(p1[:2] - p0[:2])))
+    dth = abs(p1[2] - p0[2])
+    if dt == 0.0:
+        jumps = [f"{s} joint {abs(d):.3g} {u}" for s, u, d in zip(names, units, dq) if abs(d) > JUMP_TOL]
+        jumps += [f"workpiece {dx * 1e3:.3g} mm"] if dx > JUMP_TOL else []
+        jumps += [f"workpiece {dth:.3g} rad"] if dth > JUMP_TOL else []
+        return [("continuity", f"jump at t = {t0:.6g} s to the next row: " + ", ".join(jumps))] if jumps else []
+    out = command_step_checks(cols, k, names, units, dq, dt)
+    for side, u, limit, d in zip(names, units, speeds, dq):
+        if abs(d) > limit * dt * (1 + SPEED_RTOL) + JUMP_TOL:
+            out.append(("speed", f"{side} joint moves {abs(d):.4g} {u} in {dt:.4g} s to the next row: "
+                                 f"{abs(d) / dt:.4g} {u}/s > limit {limit:g} {u}/s"))  # fmt: skip
+    if dx > task.workpiece_speed * dt * (1 + SPEED_RTOL) + JUMP_TOL:
+        out.append(("speed", f"workpiece moves {dx * 1e3:.4g} mm in {dt:.4g} s to the next row: "
+                             f"{dx / dt:.4g} m/s > limit {task.workpiece_speed:g} m/s"))  # fmt: skip
+    return out
+
+
+def command_step_checks(cols, k, names, units, dq, dt) -> list:
+    """The velocity commands reach the next row: a controller that follows them arrives where the rows say.
+
+    A regrasp row's ``qd`` holds until the next row (zero-order hold): ``q[k+1] - q[k] = qd[k] dt`` to
+    :data:`JUMP_TOL`.  In contact, ``qd`` samples the velocity of a smooth path: the trapezoid
+    ``(qd[k] + qd[k+1]) dt / 2`` matches the step to :data:`COMMAND_RTOL` of the step (and :data:`JUMP_TOL`).
+    """
+    free = str(cols["mode"][k]) == "free"
+    if "phase" in cols and cols["phase"][k] != cols["phase"][k + 1]:
+        return []
+    out = []
+    for j, (n, u) in enumerate(zip(names, units)):
+        a, b = cols[f"qd_{n}"][k], cols[f"qd_{n}"][k + 1]
+        if np.isnan(a):
+            continue  # torque-controlled: its motion follows from the contacts
+        step = a * dt if free else (0.5 * (a + b) * dt if np.isfinite(b) else np.nan)
+        if np.isnan(step):
+            continue
+        tol = JUMP_TOL + (0.0 if free else COMMAND_RTOL * abs(dq[j]))
+        if abs(step - dq[j]) > tol:
+            rule = "qd held over the step" if free else "the trapezoid of qd"
+            out.append(("motion", f"{n} joint's velocity command moves it {step:.6g} {u} to the next row ({rule}); "
+                                  f"the rows move it {dq[j]:.6g} {u}"))  # fmt: skip
+    return out
+
+
+def friction_points(task, n_random, rng) -> np.ndarray:
+    """Friction vectors (4,) to test, shape (m, 4): every vertex of the friction set, then ``n_random`` seeded draws.
+
+    Box (independent coefficients): the 16 corners of ``[lo, hi]^4``; shared: ``lo`` and ``hi``.
+    """
+    lo, hi = task.mu_range
+    if task.shared_mu:
+        vertices = np.array([[lo] * 4, [hi] * 4], dtype=float)
+        draws = np.repeat(rng.uniform(lo, hi, (n_random, 1)), 4, axis=1)
+    else:
+        vertices = np.array(np.meshgrid(*[[lo, hi]] * 4, indexing="ij")).reshape(4, -1).T.astype(float)
+        draws = rng.uniform(lo, hi, (n_random, 4))
+    return np.unique(np.vstack([vertices, draws]), axis=0) if lo == hi else np.vstack([vertices, draws])

@@ -1,0 +1,1 @@
+"""The planning pipeline in one call (:func:`~.run.run_plan`): plan, export, certify, re-simulate, plot, publish."""

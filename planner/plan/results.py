@@ -1,0 +1,167 @@
+"""What a plan is: in-contact segments, regrasps, the plan and the failure (Section 5.2).
+
+Data only: :func:`qsplan.planner.plan.scripted.plan_task` builds these; the export, plots and
+replay read them.  Units SI (m, rad, s, N m).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from qsplan.mechanics.errors import NoAnswerError, QsplanError
+
+from qsplan.planner.search.ompl_bridge import PlannerOptions
+from qsplan.planner.task.task import Task
+
+__all__ = ["ContactSegmentPlan", "Plan", "PlanFailure", "RegraspPlan"]
+
+
+class PlanFailure(NoAnswerError):
+    """No plan exists: ``report`` (a :class:`qsplan.planner.plan.failure.FailureReport`) says where and why.
+
+    A :class:`qsplan.mechanics.NoAnswerError`, not a ``ValueError``: the task is valid, it has no plan.
+    """
+
+    def __init__(self, report, report_path=None):
+        super().__init__(report.message)
+        self.report = report
+        #: Where the report was written as JSON (by :func:`qsplan.planner.pipeline.run.run_plan`), or None.
+        self.report_path = report_path
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class ContactSegmentPlan:
+    """An in-contact segment of a plan.
+
+    Attributes
+    ----------
+    name : str
+    effort_joint : str
+        The torque-controlled finger; the other is velocity-controlled.
+    mode : str
+    x_path : ndarray, shape (m,)
+        The path of the workpiece's x (m): the straight line, start and goal.
+    t, x : ndarray, shape (n,)
+        Dense samples: time from the plan's start (s) and workpiece x (m).
+    q, qd : ndarray, shape (n, 2)
+        Joint angles (rad) and velocities (rad/s).
+    lower, upper, command, margin : ndarray, shape (n,)
+        Guaranteed band, command and its margin (N m) of the effort-controlled joint.
+    competitors : tuple of str
+        Modes precluded along the segment.
+    speed : float
+        Workpiece speed (m/s).
+    planning : qsplan.planner.search.ompl_bridge.PlanResult
+        The dense sweep's outcome (no OMPL query: the path is the straight line).
+    """
+
+    name: str
+    effort_joint: str
+    mode: str
+    x_path: np.ndarray
+    t: np.ndarray
+    x: np.ndarray
+    q: np.ndarray
+    qd: np.ndarray
+    lower: np.ndarray
+    upper: np.ndarray
+    command: np.ndarray
+    margin: np.ndarray
+    competitors: tuple
+    speed: float
+    planning: object
+
+    @property
+    def width(self) -> np.ndarray:
+        return self.upper - self.lower
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class RegraspPlan:
+    """A free-space finger motion: release and regrasp at a fixed workpiece x.
+
+    Attributes
+    ----------
+    name : str
+    x : float
+        Workpiece x (m) meanwhile.
+    t : ndarray, shape (n,)
+        Times (s) from the plan's start.
+    q, qd : ndarray, shape (n, 2)
+        Joint angles (rad) and velocities (rad/s), both joints velocity-controlled.
+    planning : tuple of qsplan.planner.search.ompl_bridge.PlanResult
+        Opening and closing.
+    """
+
+    name: str
+    x: float
+    t: np.ndarray
+    q: np.ndarray
+    qd: np.ndarray
+    planning: tuple
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class Plan:
+    """A task's plan: in-contact segments and regrasps, in order.
+
+    Attributes
+    ----------
+    task : qsplan.planner.task.task.Task
+    phases : tuple of (ContactSegmentPlan or RegraspPlan)
+    seconds : float
+        Wall-clock planning time (s), OMPL and sweeps.
+    validity_checks : int
+        States judged: the in-contact segments' dense-sweep samples (each once) plus OMPL's
+        validity-checker calls on the regrasps.
+    ompl_seconds : float
+        Time judging them (s): the in-contact dense sweeps (scenes, overlaps, guaranteed bands)
+        plus the regrasps' OMPL queries; ``checks_per_second`` is their ratio.
+    options : PlannerOptions
+    sequence : tuple of dict
+        The sequence the planner chose (automatic planning, :mod:`qsplan.planner.search`): one plain dict per
+        phase (``kind`` "slide" or "regrasp", the grasp's features, ``x`` from and to (m), the effort-controlled
+        finger, the narrowest band (N m)), and the search's figures; empty for a scripted task.
+    """
+
+    task: Task
+    phases: tuple
+    seconds: float
+    validity_checks: int
+    ompl_seconds: float
+    options: PlannerOptions = field(default_factory=PlannerOptions)
+    sequence: tuple = ()
+
+    @property
+    def segments(self) -> tuple:
+        return tuple(p for p in self.phases if isinstance(p, ContactSegmentPlan))
+
+    @property
+    def duration(self) -> float:
+        return float(self.phases[-1].t[-1])
+
+    @property
+    def checks_per_second(self) -> float:
+        return self.validity_checks / self.ompl_seconds if self.ompl_seconds > 0 else float("nan")
+
+    def narrowest(self):
+        """``(segment name, t, width)`` of the narrowest guaranteed band of the plan (s, N m; width inf when
+        every band is unbounded)."""
+        best = None
+        for s in self.segments:
+            k = int(np.argmin(s.width))
+            if best is None or s.width[k] < best[2]:
+                best = (s.name, float(s.t[k]), float(s.width[k]))
+        return best or (None, np.nan, np.inf)
+
+    def check(self) -> None:
+        """Raise :class:`qsplan.mechanics.QsplanError` unless every command lies in its band with a positive margin."""
+        for s in self.segments:
+            bad = ~((s.command > s.lower) & (s.command < s.upper) & (s.margin > 0))
+            if bad.any():
+                k = int(np.flatnonzero(bad)[0])
+                raise QsplanError(f"plan: {s.name}: command {s.command[k]:.6g} N m outside its band "
+                                  f"[{s.lower[k]:.6g}, {s.upper[k]:.6g}] at t = {s.t[k]:.4g} s")  # fmt: skip
+

@@ -1,0 +1,252 @@
+"""Two-finger manipulation plans with guaranteed torque bands, regrasps through OMPL (Section 5.2, Figs. 9-13).
+
+:func:`plan_task` turns a :class:`qsplan.planner.task.task.Task` into a :class:`Plan`:
+
+1. **In-contact segments.**  Segment ``i`` slides the workpiece along the palm from
+   the previous waypoint to the next in mode 4S (``"SSSS"``); its configuration
+   variable is the workpiece's ``x`` alone (the fingers follow by tangency,
+   :func:`qsplan.hands.two_finger.finger_angles`), so the only path is the straight line
+   and there is nothing to search: no OMPL here.  The line is swept every
+   :data:`SWEEP_STEP` and every sample judged once with the validity conditions of
+   :func:`check_contact_state`: no two bodies overlapping (every pair of fingers, palm
+   and workpiece: :mod:`qsplan.hands.collision`), the same four contacts as at
+   the segment's start and the 4S kinematics possible (eqs. 24-25), joints inside their
+   limits, and a guaranteed band (desired mode feasible for the whole friction set, every
+   competing mode precluded: :func:`qsplan.planner.torque.pointwise.guaranteed_sweep`) at
+   least ``torque_resolution`` wide; the first invalid sample ends the segment with a
+   :class:`qsplan.planner.plan.failure.FailureReport`.  The effort-controlled finger is
+   derived: among the joint sets the control-mode partitioner admits for 4S (eq. 32), the
+   one whose narrowest band along the straight line is widest.
+2. **Regrasps.**  Between segments both fingers open by :data:`REGRASP_OPENING` and
+   close again on the workpiece, planned by OMPL in joint space (two variables: the search that
+   ``--planner`` and ``--time-limit`` choose), collision-free
+   (:func:`check_free_state`: the fingers clear the workpiece, the palm and each
+   other; the straight lines between OMPL's states checked again every :data:`SWEEP_STEP`
+   at the fingertips).  Assumed: the workpiece rests on the palm meanwhile (its centre of
+   mass lies over its bottom edge, checked by :func:`qsplan.planner.task.task.make_task`) and
+   a quasistatic release leaves it where it is.
+3. **From path to plan.**  Each segment's dense sweep is
+   time-parameterized at the largest constant speed within the workpiece and joint
+   speed limits, and each command is chosen in the guaranteed band with the largest
+   margin that can be kept along the whole segment: half its narrowest band, from
+   both edges (:func:`qsplan.planner.torque.command.choose_command` with ``max_margin`` = that
+   half-width).  So the command is the midpoint where the band is narrowest and
+   ``lower + margin`` elsewhere: continuous, and close to the torque the mode needs
+   (the pointwise midpoint runs to many times that torque where the upper edge
+   blows up, and jumps where it becomes infinite).  A command outside its band is
+   never emitted (:func:`Plan.check` raises).
+
+Before any of this the fixed configurations are checked (:func:`check_configurations`: the
+grasps at the start and every waypoint, the opened fingers of every regrasp), so an invalid
+start or goal is refused at once with a report naming the colliding bodies or the joint.
+When a segment has no path, :class:`PlanFailure` carries a
+:class:`qsplan.planner.plan.failure.FailureReport`: where the band closes, which
+competitor closes it, the friction at which it does.  Units SI (m, rad, s, N m).
+"""
+
+from __future__ import annotations
+
+import time
+
+import numpy as np
+
+from qsplan.mechanics.errors import QsplanError
+
+from qsplan.planner.plan.failure import configuration_report, failure_report
+from qsplan.planner.plan.phases import (DEFAULT_OPTIONS, REGRASP_OPENING, SWEEP_STEP, regrasp_phase, slide_phase,
+                                        sweep_contact_segment)
+from qsplan.planner.plan.results import ContactSegmentPlan, Plan, PlanFailure, RegraspPlan
+from qsplan.planner.search.ompl_bridge import PlannerOptions
+from qsplan.planner.states.contact import (
+    MODE,
+    TOUCH_AREA,
+    StateCheck,
+    check_contact_state,
+    check_free_state,
+    configuration_problem,
+    contact_samples,
+    free_state_problem,
+    hand_scene_at,
+)
+from qsplan.planner.task.task import Task
+
+__all__ = [
+    "DEFAULT_OPTIONS",
+    "MODE",
+    "REGRASP_OPENING",
+    "SWEEP_STEP",
+    "TOUCH_AREA",
+    "ContactSegmentPlan",
+    "Plan",
+    "PlanFailure",
+    "RegraspPlan",
+    "StateCheck",
+    "check_configurations",
+    "check_contact_state",
+    "check_free_state",
+    "contact_samples",
+    "plan_task",
+    "sweep_contact_segment",
+]
+
+
+
+
+# ---------------------------------------------------------------------------------------------- planning
+
+
+def _segment_name(i, x0, x1):
+    return f"segment {i + 1}: slide the workpiece {'left' if x1 < x0 else 'right'} from x = {x0:.4g} to {x1:.4g} m"
+
+
+def check_configurations(task: Task) -> None:
+    """Check the task's fixed configurations before planning (milliseconds): the grasp at the start and at
+    every waypoint (joint limits, no two bodies overlapping) and the opened fingers of every regrasp.
+
+    Raises
+    ------
+    PlanFailure
+        With a :class:`qsplan.planner.plan.failure.ConfigurationReport` naming the configuration, the
+        colliding bodies and their overlap, or the joint beyond its limit.
+    """
+    from qsplan.hands.two_finger import finger_angles
+
+    xs = [task.start_x, *task.waypoints.tolist()]
+    last = len(xs) - 1
+    for i, x in enumerate(xs):
+        seg = _segment_name(max(i - 1, 0), xs[max(i - 1, 0)], xs[max(i - 1, 0) + 1])
+        where = "the start" if i == 0 else ("the goal" if i == last else f"the end of segment {i}")
+        try:
+            q = finger_angles(task.hand, task.pose(x))[0]
+        except QsplanError as exc:
+            report = configuration_report(task, seg, where, x, None, f"no four-contact grasp: {exc}")
+            raise PlanFailure(report) from None
+        if configuration_problem(task, task.pose(x), q):
+            raise PlanFailure(configuration_report(task, seg, where, x, q))
+        if 0 < i < last:
+            q_open = q + np.array([REGRASP_OPENING, -REGRASP_OPENING])
+            if free_state_problem(task, x, q_open):
+                name = f"regrasp {i}: both fingers release and regrasp at x = {x:.4g} m"
+                raise PlanFailure(configuration_report(task, name, f"the opened fingers of regrasp {i}", x, q_open))
+
+
+def _effort_joint(task, x0, x1, progress):
+    """The effort-controlled finger of a segment: admitted by the partitioner (eq. 32), widest narrowest band."""
+    from qsplan.hands.two_finger import JOINT_NAMES
+    from qsplan.mechanics.modes.contact_mode import ContactMode
+    from qsplan.mechanics.modes.partition import effort_partitions
+
+    d = np.sign(x1 - x0)
+    xs = np.linspace(x0, x1, 7)
+    try:
+        scene = hand_scene_at(task, x0, "right", 0.0)[3]
+        admitted = {JOINT_NAMES[p.effort_joints[0]] for p in effort_partitions(scene, ContactMode(MODE))
+                    if len(p.effort_joints) == 1}  # fmt: skip
+    except QsplanError:
+        admitted = set(JOINT_NAMES)
+    best, best_w = None, -np.inf
+    for joint in JOINT_NAMES:
+        if joint not in admitted:
+            continue
+        w = [check_contact_state(task, x, joint, d) for x in xs]
+        worst = min((c.width if np.isfinite(c.width) else -np.inf) for c in w)
+        if worst > best_w:
+            best, best_w = joint, worst
+    return best or "right"
+
+
+def _segment(task, i, x0, x1, t0, options, progress, counters):
+    from qsplan.hands.two_finger import finger_angles
+    from qsplan.planner.torque.sweep import competing_modes
+
+    name = _segment_name(i, x0, x1)
+    direction = float(np.sign(x1 - x0))
+    effort = _effort_joint(task, x0, x1, progress)
+    progress(f"{name}: effort-controlled finger {effort}; one configuration variable: checking the straight line "
+             f"every {SWEEP_STEP * 1e3:g} mm (no search)")  # fmt: skip
+    try:
+        line = contact_samples(task, np.linspace(x0, x1, 9), effort, direction * task.workpiece_speed)
+    except QsplanError as exc:
+        raise PlanFailure(configuration_report(task, name, "the straight line of the segment", x0, None,
+                                               f"no four-contact grasp: {exc}")) from None  # fmt: skip
+    comps = competing_modes(line)
+    touching = line.touching[0]
+    for x_end, where in ((x0, "the start of the segment"), (x1, "its goal")):
+        c = check_contact_state(task, x_end, effort, direction, touching, comps)
+        if c.ok:
+            continue
+        if not c.reason.startswith(("band", "no guaranteed band")):  # refused for its geometry: named here
+            try:
+                q_end = finger_angles(task.hand, task.pose(x_end))[0]
+            except QsplanError:
+                q_end = None
+            raise PlanFailure(configuration_report(task, name, where, x_end, q_end, c.reason))
+        raise PlanFailure(failure_report(task, name, x0, x1, effort, direction, comps, None))  # for its band
+    return slide_phase(task, name, x0, x1, effort, direction, touching, comps, t0, options, progress, counters)
+
+
+def _regrasp(task, i, x, q, t0, options, progress, counters):
+    name = f"regrasp {i + 1}: both fingers release and regrasp at x = {x:.4g} m"
+    return regrasp_phase(task, name, x, q, q, t0, options, progress, counters)
+
+
+def plan_task(task: Task, options: PlannerOptions | None = None, progress=None, sequence_planner: str = "widest") -> Plan:
+    """Plan ``task``: in-contact segments through OMPL with guaranteed bands, and regrasps between them.
+
+    Parameters
+    ----------
+    task : qsplan.planner.task.task.Task
+    options : PlannerOptions, optional
+        Default :data:`DEFAULT_OPTIONS`.
+    progress : callable, optional
+        ``progress(line)`` for progress messages.
+    sequence_planner : str
+        For a task with a ``goal``: the search of the sequence (:func:`qsplan.planner.plan.autoplan.plan_automatic`).
+
+    Returns
+    -------
+    Plan
+        Checked: every command inside its band.
+
+    Raises
+    ------
+    PlanFailure
+        When a segment has no plan, with the report of where and why (a :class:`qsplan.mechanics.NoAnswerError`);
+        when a start, goal or regrasp configuration is not valid (checked first, before OMPL runs: two bodies
+        overlap, a joint beyond its limit), or no collision-free regrasp is found, with a
+        :class:`qsplan.planner.plan.failure.ConfigurationReport` naming it.
+    """
+    if options is None:
+        options = DEFAULT_OPTIONS
+    from qsplan.hands.chain_hand import ChainHand
+    from qsplan.planner.plan.failure import palm_report
+
+    beyond = palm_report(task)  # from the task's geometry alone, before any table or grid is built
+    if beyond is not None:
+        raise PlanFailure(beyond)
+
+    if isinstance(task.hand, ChainHand):  # a described hand: slides planned on the contact manifold
+        from qsplan.planner.plan.chain_plan import plan_chain_task
+
+        return plan_chain_task(task, options, progress)
+    if task.goal is not None:  # the planner finds the sequence
+        from qsplan.planner.plan.autoplan import plan_automatic
+
+        return plan_automatic(task, options, progress, planner=sequence_planner)
+    progress = progress or (lambda line: None)
+    t_start = time.perf_counter()
+    check_configurations(task)
+    counters = [0, 0.0]
+    phases, t0 = [], 0.0
+    xs = [task.start_x, *task.waypoints.tolist()]
+    for i, (x0, x1) in enumerate(zip(xs[:-1], xs[1:])):
+        if i:
+            prev = phases[-1]
+            phases.append(_regrasp(task, i - 1, x0, prev.q[-1], t0, options, progress, counters))
+            t0 = float(phases[-1].t[-1])
+        seg = _segment(task, i, x0, x1, t0, options, progress, counters)
+        phases.append(seg)
+        t0 = float(seg.t[-1])
+    plan = Plan(task, tuple(phases), time.perf_counter() - t_start, counters[0], counters[1], options)
+    plan.check()
+    return plan

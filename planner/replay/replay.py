@@ -1,0 +1,367 @@
+"""Re-simulate an exported plan of any two-finger hand with the finite-motion simulator (Section 5.1).
+
+A plan promises that, for every friction coefficient in the task's interval, the
+commands of its torque file make the workpiece slide in the planned mode (4S) along
+each in-contact segment.  :func:`replay_plan` checks the promise the hard way: it
+reads the commands back from the exported columns (:func:`qsplan.planner.export.plan_files.read_plan_csv`),
+drives the hand with them through :func:`qsplan.mechanics.motion.simulator.simulate` at a friction
+vector, and compares the simulated mode sequence and workpiece path with the plan's.
+
+Nothing of the planner's band computation is used: the simulator chooses the mode
+at every instant from the full model (every mode checked, eqs. 13-28), locates
+mode changes as events and stops when the mode becomes ambiguous or jams.
+
+The simulated system (:class:`ReplaySystem`) has the state
+``[x, y, theta, q_0, ..., q_{n_j - 1}, t]`` (m, m, rad, the joints in the hand's order in
+rad or m, s): the workpiece pose, the joint positions and the plan's clock, which indexes
+the commands.  Every velocity-controlled joint follows its joint-velocity column and the
+effort-controlled joint its torque column, both interpolated linearly in time between rows;
+scenes come from :func:`qsplan.hands.interface.scene_at`.  Between segments the plan's regrasp
+puts both fingers back on the workpiece where it is, so each segment starts from the simulated
+end of the previous one (errors carry over): the paper's fingers by tangency with the planned
+grasp (:func:`grasp_angles`), a described chain hand's by closing each finger's last joint onto
+the workpiece from the plan's free joints (:func:`qsplan.hands.chain_hand.close_grasp`).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from qsplan.mechanics.errors import QsplanError
+from qsplan.planner.replay.grasp import chain_grasp, grasp_angles
+
+__all__ = ["ReplaySystem", "SegmentReplay", "Replay", "chain_grasp", "grasp_angles", "replay_plan", "replay_segments",
+           "friction_samples", "CHAIN_REPLAY_TRAVEL", "REPLAY_STEP"]
+
+#: Step of the replay (s).  Mode changes are located by root finding, not by the step; 0.05 s is
+#: 0.5 mm of workpiece travel at the default 1 cm/s, the spacing of the plan's rows (its band sweep),
+#: so each step spans about one row of the linearly interpolated commands.
+REPLAY_STEP = 0.05
+
+
+#: Scenes a replay keeps (:attr:`ReplaySystem.scenes`), a few kB each: ~40 MB at most.
+MAX_CACHED_SCENES = 10_000
+
+
+#: Largest workpiece travel (m) per step when replaying a described chain hand.  Its scenes find the contacts in
+#: the polygons at every stage of the RK4 step, and refuse a penetration beyond the contact tolerance (1e-6 m); a
+#: stage is an Euler-like prediction, off the contact constraint by about travel^2 / (2 R) for a contact path of
+#: radius R.  The two-link hand's fingertip contacts (R ~ 0.1 m) penetrate 1.3e-6 m at REPLAY_STEP's 0.5 mm; at
+#: 0.1 mm, 25 times less (5e-8 m), and still within the tolerance for radii down to 5 mm.  The paper's hand builds
+#: its scenes from the grasp's closed form and keeps REPLAY_STEP.
+CHAIN_REPLAY_TRAVEL = 1e-4
+
+
+def _default_options(max_step=REPLAY_STEP):
+    from qsplan.mechanics.motion.simulator import MotionOptions
+
+    # max_switches = 0: the first mode change already leaves the plan, so the run stops there
+    # (all four contacts are still touching at that instant; nothing beyond it is modelled).
+    return MotionOptions(max_step=max_step, max_switches=0)
+
+
+def _chain_step(t, x) -> float:
+    """A chain hand's replay step (s) for a segment's rows (times ``t`` s, workpiece ``x`` m): at most
+    :data:`CHAIN_REPLAY_TRAVEL` of workpiece travel, at most :data:`REPLAY_STEP`."""
+    dt, dx = np.diff(t), np.abs(np.diff(x))
+    speed = float(np.max(dx[dt > 0] / dt[dt > 0], initial=0.0))
+    return min(REPLAY_STEP, CHAIN_REPLAY_TRAVEL / speed) if speed > 0 else REPLAY_STEP
+
+
+def _stop_message(motion, planned) -> str | None:
+    s = motion.stopped
+    if s is None:
+        return None
+    if s.kind == "max_switches":
+        return f"at t = {s.time:.6g} s the mode changes from {planned} to {s.candidates[0]}"
+    return s.message
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class ReplaySystem:
+    """A hand driven by one in-contact segment's commands (a :class:`qsplan.mechanics.motion.system.MotionSystem`).
+
+    Attributes
+    ----------
+    hand : qsplan.hands.two_finger.TwoFingerHand or qsplan.hands.chain_hand.ChainHand
+    effort_controlled : ndarray of bool, shape (n_j,)
+        The torque-controlled joint(s); every other joint is velocity-controlled.
+    t : ndarray, shape (n,)
+        Command rows' times (s).
+    velocity, effort : ndarray, shape (n, n_j)
+        Each velocity-controlled joint's speed (rad/s or m/s), each effort-controlled joint's effort (N m or N);
+        the other entries are not read.
+    friction : qsplan.mechanics.motion.system.Friction
+        Of the four potential contacts (palm, palm, left finger, right finger).
+    scenes : dict
+        Scenes already built, by the state's bytes (a scene depends on the state alone): the
+        integrator asks again for the scene at the end of every step (its event functions, then
+        the next step's first stage), and replays of one segment at other friction vectors pass
+        through the same states when the mode's motion does not depend on friction (eqs. 23-25).
+        Cleared past :data:`MAX_CACHED_SCENES`.
+    """
+
+    hand: object
+    effort_controlled: np.ndarray
+    t: np.ndarray
+    velocity: np.ndarray
+    effort: np.ndarray
+    friction: object
+    scenes: dict = field(default_factory=dict, repr=False)
+
+    contact_names = ("palm:0", "palm:1", "left", "right")
+
+    @property
+    def state_names(self) -> tuple:
+        from qsplan.hands.interface import joint_names, joint_units
+
+        joints = tuple(f"q_{n} ({u})" for n, u in zip(joint_names(self.hand), joint_units(self.hand)))
+        return ("x (m)", "y (m)", "theta (rad)") + joints + ("t (s)",)
+
+    def commands(self, t) -> tuple:
+        """``(velocity (n_j,), effort (n_j,))`` at plan time ``t`` (s), linear between rows, held beyond the ends."""
+        velocity = np.array([np.interp(t, self.t, self.velocity[:, j]) for j in range(self.velocity.shape[1])])
+        effort = np.array([np.interp(t, self.t, self.effort[:, j]) for j in range(self.effort.shape[1])])
+        return velocity, effort
+
+    def scene(self, x, contacts):
+        from qsplan.hands.interface import scene_at
+
+        if tuple(contacts) != (0, 1, 2, 3):
+            raise QsplanError(f"contacts: the replay keeps all four contacts; got {tuple(contacts)}")
+        key = np.asarray(x, dtype=float).tobytes()
+        scene = self.scenes.get(key)
+        if scene is None:
+            velocity, effort = self.commands(x[-1])
+            scene = scene_at(self.hand, x[:3], x[3:-1], self.effort_controlled, velocity, effort=effort)
+            if len(self.scenes) >= MAX_CACHED_SCENES:
+                self.scenes.clear()
+            self.scenes[key] = scene
+        return scene
+
+    def rates(self, x, qdot, thetadot) -> np.ndarray:
+        from qsplan.mechanics.motion.system import pose_rate
+
+        return np.concatenate([pose_rate(x[:3], qdot), np.asarray(thetadot, float), [1.0]])
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class SegmentReplay:
+    """One in-contact segment re-simulated.
+
+    Attributes
+    ----------
+    phase : int
+        The plan's phase index (the ``phase`` column).
+    planned_mode : str
+    labels : tuple of str
+        Mode labels of the simulated stretches, in order (``("SSSS",)`` when followed).
+    stop : str or None
+        The simulator's stop message, None when it reached the segment's end.
+    x_error : float
+        Largest distance (m) between the simulated and the planned workpiece x at the plan's rows.
+    x_end : float
+        Simulated workpiece x at the end (m).
+    motion : qsplan.mechanics.motion.trajectory.Motion or None
+        None when the segment could not start in its planned mode.
+    """
+
+    phase: int
+    planned_mode: str
+    labels: tuple
+    stop: str | None
+    x_error: float
+    x_end: float
+    motion: object
+
+    @property
+    def followed(self) -> bool:
+        """The simulated motion stayed in the planned mode for the whole segment."""
+        return self.stop is None and self.labels == (self.planned_mode,)
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class Replay:
+    """A plan re-simulated at one friction vector.
+
+    Attributes
+    ----------
+    mu : ndarray, shape (4,)
+        Coefficients of the contacts palm:0, palm:1, left, right.
+    segments : tuple of SegmentReplay
+        Up to and including the first segment that left the plan.
+    """
+
+    mu: np.ndarray
+    segments: tuple
+
+    @property
+    def followed(self) -> bool:
+        return all(s.followed for s in self.segments)
+
+    @property
+    def x_error(self) -> float:
+        return max((s.x_error for s in self.segments), default=0.0)
+
+    def summary(self) -> str:
+        """One line: friction, followed or where it left the plan."""
+        mu = ", ".join(f"{m:.3g}" for m in self.mu)
+        if self.followed:
+            return f"mu = ({mu}): followed {' '.join(s.planned_mode for s in self.segments)}; x error {self.x_error:.2g} m"
+        bad = next(s for s in self.segments if not s.followed)
+        why = bad.stop or f"modes {' -> '.join(bad.labels)}"
+        return f"mu = ({mu}): left the plan in phase {bad.phase} ({bad.planned_mode} planned): {why}"
+
+    def as_dict(self) -> dict:
+        """The ``replay.json`` entry (JSON has no NaN: ``null``)."""
+
+        def num(v):
+            return float(v) if np.isfinite(v) else None
+
+        return {"mu": [float(m) for m in self.mu], "followed": self.followed, "x_error_m": num(self.x_error),
+                "segments": [{"phase": s.phase, "planned_mode": s.planned_mode, "modes": list(s.labels), "stop": s.stop,
+                              "x_error_m": num(s.x_error), "x_end_m": num(s.x_end)} for s in self.segments]}  # fmt: skip
+
+
+def _start_modes(system, x0, mu) -> tuple:
+    """Letters of every mode feasible at ``x0`` (the full solver, eqs. 13-28): the planned one alone, or the plan fails."""
+    from dataclasses import replace
+
+    from qsplan.mechanics.solver.all_modes import solve
+
+    scene = replace(system.scene(x0, (0, 1, 2, 3)), mu=np.asarray(mu, float))
+    return tuple(solve(scene, residuals=False).feasible_modes)
+
+
+def friction_samples(mu_range, n, seed=1, shared=False) -> list:
+    """``n`` friction vectors (4,) from ``mu_range``: all at ``lo``, all at ``hi``, then seeded uniform draws
+    (one value for all four contacts when ``shared``)."""
+    lo, hi = mu_range
+    rng = np.random.default_rng(seed)
+    draws = [np.full(4, rng.uniform(lo, hi)) if shared else rng.uniform(lo, hi, 4) for _ in range(max(n - 2, 0))]
+    return ([np.full(4, float(lo)), np.full(4, float(hi))] + draws)[:n]
+
+
+def replay_segments(columns) -> list:
+    """Split plan columns (:func:`qsplan.planner.export.plan_files.read_plan_csv`) into in-contact segments.
+
+    ``phase`` is the phase's integer index (``0``, ``1``, ...; files before issue 16 wrote ``0.0``,
+    ``1.0``, ...: both read alike).
+
+    Returns
+    -------
+    list of dict
+        Per segment: ``phase``, ``rows`` (indices), ``mode``, ``effort_joint``.
+    """
+    for key in ("t", "phase", "mode", "effort_joint", "x_workpiece"):
+        if key not in columns:
+            raise QsplanError(f"plan: column {key!r} missing; expected the columns of qsplan.planner.export.plan_files")
+    if not any(str(key).startswith("q_") for key in columns):
+        raise QsplanError("plan: no column 'q_<joint>'; expected the columns of qsplan.planner.export.plan_files")
+    try:
+        values = np.asarray(columns["phase"], float)
+    except (TypeError, ValueError):
+        values = np.array([np.nan])
+    if not (np.all(np.isfinite(values)) and np.all(values == np.round(values)) and np.all(values >= 0)):
+        raise QsplanError("plan: column 'phase' holds a value that is not a phase index (0, 1, 2, ...)")
+    phases = values.astype(int)
+    out = []
+    for p in np.unique(phases):
+        rows = np.flatnonzero(phases == p)
+        mode = str(columns["mode"][rows[0]])
+        if mode == "free":
+            continue
+        out.append(dict(phase=int(p), rows=rows, mode=mode, effort_joint=str(columns["effort_joint"][rows[0]])))
+    return out
+
+
+def rows_pose(columns, k) -> np.ndarray:
+    """The planned workpiece pose at row ``k`` (m, m, rad), shape (3,)."""
+    return np.array([columns["x_workpiece"][k], columns["y_workpiece"][k], columns["theta_workpiece"][k]], float)
+
+
+def replay_plan(columns, hand, mu, options=None, scenes=None) -> Replay:
+    """Re-simulate every in-contact segment of an exported plan at the friction vector ``mu``.
+
+    Parameters
+    ----------
+    columns : dict
+        The plan's columns as read by :func:`qsplan.planner.export.plan_files.read_plan_csv`.
+    hand : qsplan.hands.two_finger.TwoFingerHand or qsplan.hands.chain_hand.ChainHand
+        The task's hand.
+    mu : float or array-like, shape (4,)
+        Friction of the contacts palm:0, palm:1, left, right (static = kinetic).
+    options : qsplan.mechanics.motion.simulator.MotionOptions, optional
+        Default ``max_step`` :data:`REPLAY_STEP` (a chain hand's: at most :data:`CHAIN_REPLAY_TRAVEL` of workpiece
+        travel per step) and ``max_switches = 0`` (stop at the first mode change).
+    scenes : dict, optional
+        A cache of the scenes built, to pass again to the replays of the same ``columns`` and
+        ``hand`` at other friction vectors (the scenes do not depend on friction); same results.
+
+    Returns
+    -------
+    Replay
+    """
+    from qsplan.hands.interface import is_chain_hand, joint_names
+    from qsplan.mechanics.motion.simulator import simulate
+    from qsplan.mechanics.motion.system import make_friction
+
+    names = joint_names(hand)
+    chain = is_chain_hand(hand)
+    missing = [f"{c}_{n}" for n in names for c in ("q", "qd", "tau") if f"{c}_{n}" not in columns]
+    if missing:
+        raise QsplanError(f"plan: column {missing[0]!r} missing; expected the columns of every joint of the hand")
+    given = options
+    options = options or _default_options()
+    mu = np.broadcast_to(np.asarray(mu, float), (4,)).copy()
+    if np.any(~np.isfinite(mu)) or np.any(mu < 0):
+        raise QsplanError(f"mu: expected four nonnegative friction coefficients; got {mu.tolist()}")
+    friction = make_friction(mu, mu)
+    scenes = {} if scenes is None else scenes
+    out, x_prev = [], None
+    for seg in replay_segments(columns):
+        rows, e = seg["rows"], seg["effort_joint"]
+        if e not in names:
+            raise QsplanError(f"plan: effort_joint {e!r} in phase {seg['phase']} is no joint of the hand {names}")
+        t = np.asarray(columns["t"], float)[rows]
+        tau = np.column_stack([np.asarray(columns[f"tau_{n}"], float)[rows] for n in names])
+        effort = np.isfinite(tau).any(axis=0) | (np.array(names) == e)  # effort joints: those with a torque command
+        velocity = np.column_stack([np.asarray(columns[f"qd_{n}"], float)[rows] for n in names])
+        system = ReplaySystem(hand, effort, t, velocity, tau, friction, scenes.setdefault(seg["phase"], {}))
+        k = rows[0]
+        pose = rows_pose(columns, k)
+        if x_prev is not None:
+            pose = x_prev[:3]  # the regrasp leaves the workpiece where the simulation put it
+        q_planned = np.array([columns[f"q_{n}"][k] for n in names], float)
+        close = chain_grasp if chain else grasp_angles
+        q = close(hand, pose, q_planned, rows_pose(columns, k))
+        x0 = np.concatenate([pose, q, [t[0]]])
+        if chain and given is None:
+            options = _default_options(_chain_step(t, np.asarray(columns["x_workpiece"], float)[rows]))
+        start = _start_modes(system, x0, mu)
+        if start != (seg["mode"],):
+            why = f"at t = {t[0]:.6g} s the feasible modes are {', '.join(start) or 'none (jam)'}"
+            out.append(SegmentReplay(seg["phase"], seg["mode"], start, why, np.nan, float(pose[0]), None))
+            break
+        try:
+            motion = simulate(system, x0, float(t[-1] - t[0]), options)
+        except QsplanError as exc:  # the geometry left the four-contact grasp between events
+            out.append(SegmentReplay(seg["phase"], seg["mode"], (), f"the simulation failed: {exc}", np.nan,
+                                     float(pose[0]), None))  # fmt: skip
+            break
+        states = motion.states
+        planned = np.asarray(columns["x_workpiece"], float)[rows]
+        if states.shape[0]:
+            reached = t <= states[-1, -1]
+            err = float(np.max(np.abs(np.interp(t[reached], states[:, -1], states[:, 0]) - planned[reached])))
+            end = states[-1]
+        else:  # stopped at the segment's start
+            err, end = np.nan, np.concatenate([pose, q, [t[0]]])
+        stop = _stop_message(motion, seg["mode"])
+        out.append(SegmentReplay(seg["phase"], seg["mode"], tuple(motion.labels), stop, err, float(end[0]), motion))
+        if not out[-1].followed:
+            break  # the rest of the plan starts from a state the plan did not foresee
+        x_prev = end
+    return Replay(mu, tuple(out))

@@ -1,0 +1,214 @@
+"""The widest-band sequence of slides and regrasps over band tables: exact at the tables' resolution.
+
+The search graph (issue 14, Section 5.2): a node is a grasp ``g`` (which feature each finger
+touches) and a grid index ``i`` of the workpiece's ``x``.  Two kinds of edge:
+
+* **slide** ``(g, i) -> (g, i +- 1)`` in mode 4S, with effort-controlled finger ``e``: allowed where
+  both ends are valid configurations touching the same features and the guaranteed band of
+  ``(g, e, direction)`` (every competitor precluded, :func:`qsplan.mechanics.robust_band`) is at
+  least the torque resolution wide at both; its *width* is the narrower of the two;
+* **regrasp** ``(g, i) -> (g', i)``: both fingers release and close on other features, the
+  workpiece resting on the palm; width unbounded (no band is needed), allowed unless
+  ``forbidden`` (a regrasp the motion planner could not realise).
+
+A route's width is its narrowest edge.  :func:`widest_route` finds the route from the start node
+to a goal node whose width is largest (a max-min Dijkstra), then, among the routes at least that
+wide, the one with the fewest regrasps, then the fewest slide steps (time at the constant
+speeds of the plan), then the fewest segments (changes of finger, direction or grasp): a
+lexicographic Dijkstra on the graph restricted to edges at least that wide.  Both stages are
+exact on the graph, so the route is optimal at the tables' resolution; the plan built from it is
+checked again sample by sample (:func:`qsplan.planner.plan.scripted.sweep_contact_segment`).
+
+Plain Python and numpy, no OMPL: :mod:`qsplan.planner.search.ompl_search` runs this search as an
+OMPL planner.  Units SI (m, N m).
+"""
+
+from __future__ import annotations
+
+import heapq
+from dataclasses import dataclass
+
+import numpy as np
+
+__all__ = ["Route", "RouteStep", "SearchGraph", "widest_route", "slide_widths"]
+
+
+@dataclass(frozen=True, slots=True)
+class RouteStep:
+    """One edge of a route: a slide step or a regrasp.
+
+    Attributes
+    ----------
+    kind : {"slide", "regrasp"}
+    grasp, i : int
+        The node the edge leaves (grasp index, grid index).
+    to_grasp, to_i : int
+        The node it reaches.
+    effort : int
+        Slides: the effort-controlled finger (0 left, 1 right); regrasps: -1.
+    width : float
+        The edge's width (N m; ``inf`` for regrasps).
+    """
+
+    kind: str
+    grasp: int
+    i: int
+    to_grasp: int
+    to_i: int
+    effort: int
+    width: float
+
+
+@dataclass(frozen=True, slots=True)
+class Route:
+    """A route from the start node to a goal node.
+
+    Attributes
+    ----------
+    steps : tuple of RouteStep
+    width : float
+        Its narrowest edge (N m); ``inf`` for a route without slides.
+    regrasps : int
+    nodes_expanded : int
+        Nodes popped by both stages of the search (the work done).
+    """
+
+    steps: tuple
+    width: float
+    regrasps: int
+    nodes_expanded: int
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class SearchGraph:
+    """The band tables the search reads.
+
+    Attributes
+    ----------
+    valid : ndarray of bool, shape (G, n)
+        Grasp ``g`` is a valid configuration at grid point ``i`` (contacts found, joint limits, no overlap).
+    touched : ndarray of int, shape (G, n, 2)
+        The feature each finger touches (a change between neighbours ends a slide).
+    width : ndarray, shape (G, 2, 2, n)
+        Guaranteed band width (N m) for grasp, effort finger (0 left, 1 right), direction (0: -x, 1: +x);
+        ``-inf`` where there is none (or the configuration is invalid).
+    resolution : float
+        The torque resolution (N m): narrower bands do not count.
+    """
+
+    valid: np.ndarray
+    touched: np.ndarray
+    width: np.ndarray
+    resolution: float
+
+    @property
+    def shape(self) -> tuple:
+        return self.valid.shape
+
+
+def slide_widths(graph: SearchGraph) -> np.ndarray:
+    """Width of each slide edge, shape (G, 2, 2, n - 1) [grasp, effort, direction, i -> i + 1 (direction 1) or
+    i + 1 -> i (direction 0)]: the narrower end's band, ``-inf`` where the edge is not allowed."""
+    w = np.where(graph.width >= graph.resolution, graph.width, -np.inf)
+    same = np.all(graph.touched[:, 1:] == graph.touched[:, :-1], axis=-1) & graph.valid[:, 1:] & graph.valid[:, :-1]
+    edge = np.minimum(w[..., 1:], w[..., :-1])
+    return np.where(same[:, None, None, :], edge, -np.inf)
+
+
+def _neighbours(graph, edges, g, i, forbidden):
+    """Edges out of node (g, i): ``(width, to_g, to_i, effort, kind)``."""
+    G, n = graph.shape
+    out = []
+    for e in range(2):
+        if i + 1 < n and edges[g, e, 1, i] > -np.inf:
+            out.append((edges[g, e, 1, i], g, i + 1, e, "slide"))
+        if i > 0 and edges[g, e, 0, i - 1] > -np.inf:
+            out.append((edges[g, e, 0, i - 1], g, i - 1, e, "slide"))
+    for h in range(G):
+        if h != g and graph.valid[h, i] and (g, h, i) not in forbidden:
+            out.append((np.inf, h, i, -1, "regrasp"))
+    return out
+
+
+def widest_route(graph: SearchGraph, start: tuple, goals, forbidden=frozenset()) -> Route | None:
+    """The widest route from ``start`` to any node of ``goals``, fewest regrasps, steps and segments among them.
+
+    Parameters
+    ----------
+    graph : SearchGraph
+    start : (int, int)
+        ``(grasp, i)``.
+    goals : iterable of (int, int)
+    forbidden : set of (int, int, int)
+        Regrasps ``(from grasp, to grasp, i)`` not to use.
+
+    Returns
+    -------
+    Route or None
+        None when no goal is reachable.
+    """
+    G, n = graph.shape
+    goals = {tuple(map(int, g)) for g in goals}
+    edges = slide_widths(graph)
+    start = (int(start[0]), int(start[1]))
+    if not graph.valid[start] or not goals:
+        return None
+    # stage 1: max-min Dijkstra (the largest bottleneck from the start to every node)
+    best = np.full((G, n), -np.inf)
+    best[start] = np.inf
+    heap = [(-np.inf, start)]
+    expanded = 0
+    while heap:
+        negw, (g, i) = heapq.heappop(heap)
+        w = -negw
+        if w < best[g, i]:
+            continue
+        expanded += 1
+        for ew, h, j, _, _ in _neighbours(graph, edges, g, i, forbidden):
+            nw = min(w, ew)
+            if nw > best[h, j]:
+                best[h, j] = nw
+                heapq.heappush(heap, (-nw, (h, j)))
+    reached = [best[gl] for gl in goals if best[gl] > -np.inf]
+    if not reached:
+        return None
+    width = max(reached)
+    # stage 2: lexicographic Dijkstra (regrasps, steps, segments) on edges at least `width` wide
+    # node = (grasp, i, effort, direction) of the last slide (-1, -1 after a regrasp or at the start)
+    s0 = (start[0], start[1], -1, -1)
+    cost = {s0: (0, 0, 0)}
+    parent = {s0: None}
+    heap = [((0, 0, 0), s0)]
+    done = None
+    while heap:
+        c, node = heapq.heappop(heap)
+        if cost.get(node) != c:
+            continue
+        expanded += 1
+        g, i, e0, d0 = node
+        if (g, i) in goals:
+            done = node
+            break
+        for ew, h, j, e, kind in _neighbours(graph, edges, g, i, forbidden):
+            if ew < width:
+                continue
+            if kind == "regrasp":
+                nxt, nc = (h, j, -1, -1), (c[0] + 1, c[1], c[2] + 1)
+            else:
+                d = int(j > i)
+                nxt = (h, j, e, d)
+                nc = (c[0], c[1] + 1, c[2] + (0 if (e, d) == (e0, d0) else 1))
+            if nc < cost.get(nxt, (np.inf,)):
+                cost[nxt] = nc
+                parent[nxt] = (node, ew, e, kind)
+                heapq.heappush(heap, (nc, nxt))
+    if done is None:  # cannot happen: stage 1 reached a goal at this width
+        return None
+    steps = []
+    node = done
+    while parent[node] is not None:
+        prev, ew, e, kind = parent[node]
+        steps.append(RouteStep(kind, prev[0], prev[1], node[0], node[1], e, float(ew)))
+        node = prev
+    steps.reverse()
+    return Route(tuple(steps), float(width), sum(s.kind == "regrasp" for s in steps), expanded)

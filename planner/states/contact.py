@@ -1,0 +1,184 @@
+"""Judging configurations of a two-finger task: in contact (mode 4S, guaranteed band) and in free space.
+
+:func:`check_contact_state` is OMPL's validity checker of an in-contact segment (no
+overlap between any two bodies, the same four contacts, the 4S kinematics of eqs. 24-25, joint limits, and
+a guaranteed band with every competitor precluded at least the torque resolution wide);
+:func:`check_free_state` that of a regrasp (the fingers clear the workpiece, the palm
+and each other).  Both judge the geometry with :func:`configuration_problem`: joint
+limits, and every pair of bodies of the hand's polygons (fingers, palm, workpiece)
+for overlap.  Units SI (m, rad, s, N m).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from qsplan.mechanics.errors import QsplanError
+
+from qsplan.planner.task.task import Task
+
+__all__ = ["MODE", "TOUCH_AREA", "StateCheck", "check_contact_state", "check_free_state", "configuration_problem",
+           "contact_samples", "free_state_problem", "hand_scene_at", "limit_problem"]
+
+#: Intersection area (m^2) below which two polygons only touch (kept for callers; the checks now measure
+#: overlaps by depth: :data:`qsplan.hands.collision.CONTACT_DEPTH_TOL`).
+TOUCH_AREA = 1e-10
+
+#: The in-contact segments' mode: the workpiece slides on the palm and both fingertips (4S).
+MODE = "SSSS"
+
+
+@dataclass(frozen=True, slots=True)
+class StateCheck:
+    """One configuration of an in-contact segment, judged.
+
+    Attributes
+    ----------
+    x : float
+        Workpiece x (m).
+    ok : bool
+    reason : str or None
+        Why not, in words.
+    lower, upper : float
+        Guaranteed band (N m), NaN without one.
+    desired_lower, desired_upper : float
+        The desired mode's guaranteed band before precluding competitors (N m).
+    competitors : tuple of str
+        Competing modes possible inside the desired mode's band (they cut it).
+    """
+
+    x: float
+    ok: bool
+    reason: str | None
+    lower: float = np.nan
+    upper: float = np.nan
+    desired_lower: float = np.nan
+    desired_upper: float = np.nan
+    competitors: tuple = ()
+
+    @property
+    def width(self) -> float:
+        return float(self.upper - self.lower) if np.isfinite(self.lower) or np.isfinite(self.upper) else np.nan
+
+
+def hand_scene_at(task, x, effort_joint, velocity):
+    """``(pose, q, touching, scene)`` of the grasp with the workpiece at ``x`` (m); ``velocity`` (rad/s) of the velocity-controlled joint."""
+    from qsplan.hands.two_finger import finger_angles
+    from qsplan.hands.two_finger_scene import hand_scene
+
+    pose = task.pose(x)
+    q, touching = finger_angles(task.hand, pose)
+    return pose, q, touching, hand_scene(task.hand, pose, q, effort_joint, velocity=velocity, effort=0.0)
+
+
+def contact_samples(task, xs, effort_joint, speed, name="segment", grasp=None):
+    """The configurations at workpiece ``xs`` (m, shape (n,)) moving at ``speed`` (m/s, signed) as
+    :class:`qsplan.hands.segments.SegmentSamples` (times 0, 1, ...: bands do not depend on them).
+
+    ``grasp`` (:class:`qsplan.hands.grasps.Grasp`): the features the fingers touch; default both inner
+    edges on the vertices of tangency (:func:`qsplan.hands.two_finger.finger_angles`, the scripted tasks).
+
+    Raises
+    ------
+    qsplan.mechanics.SceneError
+        Where a configuration has no four-contact grasp.
+    """
+    from qsplan.hands.segments import ManipulationSegment, SegmentSamples
+    from qsplan.hands.two_finger import JOINT_NAMES, finger_angle_rates
+
+    v = 1 - JOINT_NAMES.index(effort_joint)
+    xs = np.atleast_1d(np.asarray(xs, float))
+    if grasp is not None:
+        from qsplan.planner.states.grasped import grasp_samples
+
+        poses, qs, qds, touch, scenes = grasp_samples(task.hand, grasp, xs, effort_joint, speed)
+    else:
+        poses, qs, qds, touch, scenes = [], [], [], [], []
+        for x in xs:
+            pose = task.pose(x)
+            qd = finger_angle_rates(task.hand, pose, (speed, 0.0, 0.0))
+            _, q, t, scene = hand_scene_at(task, x, effort_joint, qd[v])
+            poses.append(pose), qs.append(q), qds.append(qd), touch.append(t), scenes.append(scene)
+    n = len(poses)
+    poses = np.array(poses)
+    seg = ManipulationSegment(task.hand, name, poses[0], poses[-1], float(max(n - 1, 1)), MODE, effort_joint)
+    return SegmentSamples(seg, np.arange(n, dtype=float), np.linspace(0.0, 1.0, n), poses, np.array(qs),
+                          np.array(qds), np.array(touch), tuple(scenes))  # fmt: skip
+
+
+def limit_problem(task, q) -> str | None:
+    """Which joint of ``q`` (rad, shape (2,)) is beyond its limit, in words, or None."""
+    from qsplan.hands.two_finger import JOINT_NAMES
+
+    lim = task.joint_limits
+    for k, name in enumerate(JOINT_NAMES):
+        if not lim[k, 0] <= q[k] <= lim[k, 1]:
+            return (f"joint limits: the {name} finger's angle {q[k]:.4g} rad is outside its limits "
+                    f"[{lim[k, 0]:g}, {lim[k, 1]:g}] rad (q = {np.round(q, 4).tolist()} rad)")  # fmt: skip
+    return None
+
+
+def configuration_problem(task, pose, q) -> str | None:
+    """What is wrong with the hand at workpiece ``pose`` (shape (3,)) and joints ``q`` (rad, shape (2,)),
+    in words, or None: a joint beyond its limit, or two bodies overlapping (every pair of the palm, the
+    fingers and the workpiece: :func:`qsplan.hands.collision.find_collisions`)."""
+    from qsplan.hands.collision import find_collisions
+
+    q = np.asarray(q, float)
+    why = limit_problem(task, q)
+    if why:
+        return why
+    hit = find_collisions(task.hand, pose, q, first=True)
+    return hit[0].message if hit else None
+
+
+def check_contact_state(task: Task, x: float, effort_joint: str, direction: float, touching=None,
+                        competitors=None, grasp=None) -> StateCheck:  # fmt: skip
+    """Judge workpiece ``x`` (m) of an in-contact segment moving in ``direction`` (sign of xdot).
+
+    Valid when the four contacts are found (the same finger vertices as ``touching``),
+    the joints are inside their limits, no two bodies overlap (:func:`configuration_problem`: every
+    pair, finger against finger too), the 4S kinematics hold and the guaranteed band, competitors precluded, is at least ``task.torque_resolution`` wide.
+    ``grasp``: as in :func:`contact_samples`.
+    """
+    from qsplan.mechanics.bands.effort import band_kinematics
+    from qsplan.mechanics.modes.contact_mode import ContactMode
+
+    from qsplan.planner.torque.pointwise import guaranteed_sweep
+
+    try:
+        S = contact_samples(task, [x], effort_joint, float(np.sign(direction)) * task.workpiece_speed, grasp=grasp)
+    except QsplanError as exc:
+        return StateCheck(float(x), False, f"no four-contact grasp: {exc}")
+    if touching is not None and np.any(S.touching[0] != touching):
+        return StateCheck(float(x), False, "a finger moves to another workpiece vertex (a contact change)")
+    why = configuration_problem(task, S.pose[0], S.q[0])
+    if why:
+        return StateCheck(float(x), False, why)
+    if not band_kinematics(S.scenes[0], ContactMode(MODE)).ok:
+        return StateCheck(float(x), False, "the 4S kinematics fail (eqs. 24-25)")
+    g = guaranteed_sweep(S, task.mu_range, task.shared_mu, MODE, competitors, force_margin=task.force_margin)
+    b, d = g.band, g.desired
+    cut = tuple(c for c, (lo, hi) in g.competitors.items() if np.isfinite(lo[0]))
+    lo, hi = float(b.lower[0]), float(b.upper[0])
+    common = dict(desired_lower=float(d.lower[0]), desired_upper=float(d.upper[0]), competitors=cut)
+    if not b.feasible[0]:
+        return StateCheck(float(x), False, "no guaranteed band: " + (b.reasons[0] or "4S not guaranteed"), **common)
+    if hi - lo < task.torque_resolution:
+        return StateCheck(float(x), False, f"band {hi - lo:.4g} N m narrower than the resolution", lo, hi, **common)
+    return StateCheck(float(x), True, None, lo, hi, **common)
+
+
+def free_state_problem(task: Task, x: float, q) -> str | None:
+    """What is wrong with the free-space finger configuration ``q`` (rad, shape (2,)) with the workpiece
+    at ``x`` (m), in words, or None (see :func:`configuration_problem`)."""
+    return configuration_problem(task, task.pose(x), q)
+
+
+def check_free_state(task: Task, x: float, q) -> bool:
+    """A free-space finger configuration ``q`` (rad, shape (2,)) with the workpiece at ``x`` (m):
+    inside the joint limits, and no two of the fingers, the palm and the workpiece overlapping
+    (the fingers may touch the workpiece, within :data:`qsplan.hands.collision.CONTACT_DEPTH_TOL`)."""
+    return free_state_problem(task, x, q) is None
