@@ -22,8 +22,9 @@ copies the chart to ``docs/bands_speed_accuracy.png`` for the README.
 First it prints the speed of the bands per state (the readable reference, as before issue 13)
 against the batched path (:mod:`qsplan.mechanics.bands.batched`, issue 13 point 2) in states per
 second, best of several runs on one core (the machine is shared: the figures are noisy), for the
-desired band alone and for the full guaranteed band with every competitor precluded, and the share
-of competitor searches the batched root cell does not resolve (searched one state at a time).
+desired band alone, for the full guaranteed band with every competitor precluded, and for that band
+robust to a box of disturbance wrenches (issue 24: :data:`DISTURBANCE`), and the share of competitor
+searches the batched root cell does not resolve (searched one state at a time).
 
 Usage, with qsplan installed (``pip install .``) or ``PYTHONPATH=.``:
 ``python benchmarks/bench_bands.py [N_POINTS] [--speed]`` (default 200 points along the segment;
@@ -44,6 +45,7 @@ import numpy as np
 from qsplan.hands import default_hand, first_segment, sample_segment
 from qsplan.mechanics.bands.batched import guaranteed_bands_box, guaranteed_bands_shared, state_batch
 from qsplan.mechanics.bands.batched_robust import RootStats, robust_bands
+from qsplan.mechanics.bands.disturbance import WrenchBox
 from qsplan.mechanics.bands.guaranteed import guaranteed_band_box, guaranteed_band_shared
 from qsplan.mechanics.bands.robust import robust_band
 from qsplan.mechanics.modes.contact_mode import ContactMode
@@ -63,6 +65,9 @@ REPEAT = 3
 #: Excess (relative to the operating range) above which a sampled band counts as unsafe at a point:
 #: far above rounding in the band edges, far below any torque resolution.
 UNSAFE_RTOL = 1e-9
+#: The disturbance of the speed table's last rows (issue 24): +-0.1 N in each force component, about 5 % of the
+#: workpiece's weight (1.962 N), and that force at 2 cm as moment (N, N, N m).
+DISTURBANCE = WrenchBox((-0.1, -0.1, -2e-3), (0.1, 0.1, 2e-3))
 ROOT = Path(__file__).resolve().parent.parent
 
 
@@ -107,8 +112,16 @@ def speed_table(samples, comps, repeat: int = 5) -> list:
         robust_bands(scenes, mode, MU_RANGE, shared=shared, competitors=comps, stats=stats)
         t_new, _ = best_of(lambda: robust_bands(scenes, mode, MU_RANGE, shared=shared, competitors=comps), repeat)
         rows.append(("guaranteed + preclusion", kind, n / t_ref, n / t_new, stats))
+        box = DISTURBANCE
+        t_ref, _ = best_of(lambda: [robust_band(s, mode, MU_RANGE, shared=shared, competitors=comps, disturbance=box) for s in scenes],
+                           max(1, repeat // 2))  # fmt: skip
+        stats = RootStats()
+        robust_bands(scenes, mode, MU_RANGE, shared=shared, competitors=comps, stats=stats, disturbance=box)
+        t_new, _ = best_of(lambda: robust_bands(scenes, mode, MU_RANGE, shared=shared, competitors=comps, disturbance=box), repeat)
+        rows.append(("... + disturbance box", kind, n / t_ref, n / t_new, stats))
     print(f"bands per state against batched, segment 1 ({n} samples), friction in {list(MU_RANGE)}, competitors {list(comps)}")
-    print(f"states per second, best of {repeat}, one core (shared machine: noisy); scenes built beforehand")
+    print(f"states per second, best of {repeat}, one core (shared machine: noisy); scenes built beforehand; "
+          f"disturbance box {list(DISTURBANCE.lo)} to {list(DISTURBANCE.hi)} (N, N, N m)")  # fmt: skip
     print(f"{'band':<24} {'friction':<8} {'per state':>10} {'batched':>10} {'speed-up':>9} {'root-cell fallback':>19}")
     for band, kind, a, b, st in rows:
         fb = "-" if st is None else f"{st.fallback}/{st.root + st.fallback} ({100 * st.share_fallback:.1f} %)"

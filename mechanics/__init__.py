@@ -62,6 +62,8 @@ _LAZY = {
     "sampled_band": "qsplan.mechanics.bands.guaranteed",
     "RobustBand": "qsplan.mechanics.bands.robust",
     "robust_band": "qsplan.mechanics.bands.robust",
+    "WrenchBox": "qsplan.mechanics.bands.disturbance",
+    "check_wrench_box": "qsplan.mechanics.bands.disturbance",
     # errors
     "ModeError": "qsplan.mechanics.errors",
     "NoAnswerError": "qsplan.mechanics.errors",
@@ -171,6 +173,8 @@ __all__ = [
     "QsplanError",
     "RobustBand",
     "robust_band",
+    "WrenchBox",
+    "check_wrench_box",
     "SceneError",
     "ModeCheck",
     "check_mode",

@@ -30,8 +30,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from qsplan.mechanics.bands.batched_modes import BatchKinematics, batch_kinematics, batch_rows_many
+from qsplan.mechanics.bands.disturbance import check_wrench_box, loaded_reason, worst_over_wrenches, wrench_vertex_rows
 from qsplan.mechanics.bands.effort import Band, check_force_margin, check_one_effort_joint, intersect_rows
-from qsplan.mechanics.bands.guaranteed import shared_band_from_rows, shared_nodes
+from qsplan.mechanics.bands.guaranteed import shared_band_from_rows, shared_band_over_wrenches, shared_nodes
 from qsplan.mechanics.errors import SceneError
 from qsplan.mechanics.model.friction import check_mu_range
 from qsplan.mechanics.modes.contact_mode import ContactMode
@@ -209,7 +210,7 @@ def take_states(batch: StateBatch, rows) -> StateBatch:
                       batch.log_row_norm[rows], batch.drive[rows], batch.vtol[rows], batch.r0[rows], batch.velocity[rows])  # fmt: skip
 
 
-def batch_rows(batch: StateBatch, bk: BatchKinematics, mu_rows, force_margin=None):
+def batch_rows(batch: StateBatch, bk: BatchKinematics, mu_rows, force_margin=None, loads: bool = False):
     """:func:`qsplan.mechanics.bands.effort.band_rows` at every state: the rows ``s0 + tau s1`` of eq. (28).
 
     Parameters
@@ -217,6 +218,8 @@ def batch_rows(batch: StateBatch, bk: BatchKinematics, mu_rows, force_margin=Non
     mu_rows : array-like, shape (N, n_c) or (S, N, n_c)
         Friction points, the same for every state or one set per state.
     force_margin : ForceMargin, optional
+    loads : bool
+        Also return the slopes in an extra wrench on the workpiece, ``s2`` (S, N, r, 3).
 
     Returns
     -------
@@ -224,7 +227,7 @@ def batch_rows(batch: StateBatch, bk: BatchKinematics, mu_rows, force_margin=Non
         NaN where ``Q_AI`` is singular; meaningless at states where ``bk.ok`` is False.
     det, scale : ndarray, shape (S, N)
     """
-    return batch_rows_many([(batch, bk, mu_rows)], force_margin)[0]
+    return batch_rows_many([(batch, bk, mu_rows)], force_margin, loads)[0]
 
 
 def _intersect(s0, s1, scale, tol):
@@ -233,29 +236,38 @@ def _intersect(s0, s1, scale, tol):
     return lower.reshape(S, N), upper.reshape(S, N), ok.reshape(S, N)
 
 
-def effort_bands_batch(batch: StateBatch, mode, mu_rows, tol: Tolerances = DEFAULT_TOLERANCES, *, force_margin=None):
+def effort_bands_batch(batch: StateBatch, mode, mu_rows, tol: Tolerances = DEFAULT_TOLERANCES, *, force_margin=None,
+                       disturbance=None):  # fmt: skip
     """:func:`qsplan.mechanics.bands.effort.effort_bands` at every state: lower, upper, ok, each (S, N).
 
     ``mu_rows`` (N, n_c) or (S, N, n_c); NaN edges and ``ok`` False where the kinematics fail.
     """
     force_margin = None if force_margin is None else check_force_margin(force_margin)
+    box = check_wrench_box(disturbance)
     bk = batch_kinematics(batch, mode, tol)
-    s0, s1, _, scale = batch_rows(batch, bk, mu_rows, force_margin)
+    rows = batch_rows(batch, bk, mu_rows, force_margin, box is not None)
+    s0, s1, _, scale = rows if box is None else wrench_vertex_rows(*rows, box.vertices())
     lower, upper, ok = _intersect(s0, s1, scale, tol)
+    if box is not None:
+        lower, upper, ok = worst_over_wrenches(lower, upper, ok, len(box.vertices()))
     fail = ~bk.ok
     lower[fail], upper[fail], ok[fail] = np.nan, np.nan, False
     return lower, upper, ok
 
 
 def point_bands_batch(batch: StateBatch, mode, mu, tol: Tolerances = DEFAULT_TOLERANCES, *, force_margin=None,
-                      method: str = "point", bk: BatchKinematics | None = None) -> list:  # fmt: skip
+                      method: str = "point", bk: BatchKinematics | None = None, disturbance=None) -> list:  # fmt: skip
     """:func:`qsplan.mechanics.bands.effort.effort_band` at every state, friction ``mu`` (n_c,) or (S, n_c)."""
     force_margin = None if force_margin is None else check_force_margin(force_margin)
+    box = check_wrench_box(disturbance)
     bk = batch_kinematics(batch, mode, tol) if bk is None else bk
     mu = np.broadcast_to(np.asarray(mu, dtype=float), (batch.size, batch.n_c))
-    s0, s1, _, scale = batch_rows(batch, bk, mu[:, None, :], force_margin)
+    rows = batch_rows(batch, bk, mu[:, None, :], force_margin, box is not None)
+    s0, s1, _, scale = rows if box is None else wrench_vertex_rows(*rows, box.vertices())
     lower, upper, ok = _intersect(s0, s1, scale, tol)
-    finite = np.all(np.isfinite(s0[:, 0]), axis=1)
+    finite = np.all(np.isfinite(s0), axis=(1, 2))
+    if box is not None:
+        lower, upper, ok = worst_over_wrenches(lower, upper, ok, s0.shape[1])
     letters, joint, out, kin_ok = bk.mode.letters, batch.joint, [], bk.ok
     for s in range(batch.size):
         if not kin_ok[s]:
@@ -263,7 +275,7 @@ def point_bands_batch(batch: StateBatch, mode, mu, tol: Tolerances = DEFAULT_TOL
         elif not finite[s]:
             out.append(Band(letters, joint, np.nan, np.nan, False, "equilibrium_singular", method))
         elif not ok[s, 0]:
-            out.append(Band(letters, joint, np.nan, np.nan, False, "coulomb: no effort satisfies eq. (28)", method))
+            out.append(Band(letters, joint, np.nan, np.nan, False, loaded_reason("coulomb: no effort satisfies eq. (28)", box), method))
         else:
             out.append(Band(letters, joint, float(lower[s, 0]), float(upper[s, 0]), True, None, method))
     return out
@@ -285,10 +297,13 @@ BOX_REASONS = (None, "kinematics", "equilibrium_singular: det Q_AI changes sign 
                "coulomb: no effort works at some vertex of the mu box", "coulomb: vertex bands do not overlap")  # fmt: skip
 
 
-def box_band_arrays(batch: StateBatch, bk: BatchKinematics, lo, hi, tol: Tolerances = DEFAULT_TOLERANCES, force_margin=None):
+def box_band_arrays(batch: StateBatch, bk: BatchKinematics, lo, hi, tol: Tolerances = DEFAULT_TOLERANCES, force_margin=None,
+                    disturbance=None):  # fmt: skip
     """:func:`guaranteed_bands_box`'s numbers: ``lower, upper`` (S,) (meaningful where ``why`` is 0) and ``why`` (S,)
-    of int, the index of the reason in :data:`BOX_REASONS` (``lo, hi`` checked, ``force_margin`` a ForceMargin)."""
-    s0, s1, det, scale = batch_rows(batch, bk, box_vertices(bk.mode, lo, hi), force_margin)
+    of int, the index of the reason in :data:`BOX_REASONS` (``lo, hi`` checked, ``force_margin`` a ForceMargin,
+    ``disturbance`` a WrenchBox or None: the vertices of the friction box times the wrench box)."""
+    rows = batch_rows(batch, bk, box_vertices(bk.mode, lo, hi), force_margin, disturbance is not None)
+    s0, s1, det, scale = rows if disturbance is None else wrench_vertex_rows(*rows, disturbance.vertices())
     steady = np.all(det > 0, axis=1) | np.all(det < 0, axis=1)
     lower, upper, ok = _intersect(s0, s1, scale, tol)
     lo_, up_ = lower.max(axis=1), upper.min(axis=1)
@@ -296,45 +311,51 @@ def box_band_arrays(batch: StateBatch, bk: BatchKinematics, lo, hi, tol: Toleran
     return lo_, up_, why
 
 
-def box_bands(bk: BatchKinematics, joint: int, lower, upper, why) -> list:
-    """The :class:`qsplan.mechanics.bands.effort.Band` of every state from :func:`box_band_arrays`."""
+def box_bands(bk: BatchKinematics, joint: int, lower, upper, why, disturbance=None) -> list:
+    """The :class:`qsplan.mechanics.bands.effort.Band` of every state from :func:`box_band_arrays` (``disturbance``: its box)."""
     letters, m, out = bk.mode.letters, "box-vertices", []
     for s, w in enumerate(why.tolist()):
         if w == 0:
             out.append(Band(letters, joint, float(lower[s]), float(upper[s]), True, None, m))
         else:
-            out.append(Band(letters, joint, np.nan, np.nan, False, f"kinematics: {bk.status_name(s)}" if w == 1 else BOX_REASONS[w], m))
+            why_s = f"kinematics: {bk.status_name(s)}" if w == 1 else loaded_reason(BOX_REASONS[w], disturbance)
+            out.append(Band(letters, joint, np.nan, np.nan, False, why_s, m))
     return out
 
 
 def guaranteed_bands_box(batch: StateBatch, mode, lo, hi, tol: Tolerances = DEFAULT_TOLERANCES, *,
-                         force_margin=None, bk: BatchKinematics | None = None) -> list:  # fmt: skip
+                         force_margin=None, bk: BatchKinematics | None = None, disturbance=None) -> list:  # fmt: skip
     """:func:`qsplan.mechanics.bands.guaranteed.guaranteed_band_box` at every state (vertex method, exact).
     ``bk``: ``mode``'s kinematic stage on ``batch`` if already computed."""
     force_margin = None if force_margin is None else check_force_margin(force_margin)
+    box = check_wrench_box(disturbance)
     lo, hi = check_mu_range(lo, hi, n=batch.n_c)
     bk = batch_kinematics(batch, mode, tol) if bk is None else bk
-    return box_bands(bk, batch.joint, *box_band_arrays(batch, bk, lo, hi, tol, force_margin))
+    return box_bands(bk, batch.joint, *box_band_arrays(batch, bk, lo, hi, tol, force_margin, box), box)
 
 
 def guaranteed_bands_shared(batch: StateBatch, mode, lo: float, hi: float, tol: Tolerances = DEFAULT_TOLERANCES, *,
-                            force_margin=None, bk: BatchKinematics | None = None) -> list:  # fmt: skip
+                            force_margin=None, bk: BatchKinematics | None = None, disturbance=None) -> list:  # fmt: skip
     """:func:`qsplan.mechanics.bands.guaranteed.guaranteed_band_shared` at every state (polynomial roots, exact).
 
     The rows at the Chebyshev nodes are batched; the roots of each state's polynomials are found
     by the reference's own function (:func:`qsplan.mechanics.bands.guaranteed.shared_band_from_rows`).
     """
     force_margin = None if force_margin is None else check_force_margin(force_margin)
+    box = check_wrench_box(disturbance)
     lo, hi = check_mu_range(lo, hi)
     if hi == lo:
-        return point_bands_batch(batch, mode, np.full(batch.n_c, lo), tol, force_margin=force_margin, method="shared-roots", bk=bk)
+        return point_bands_batch(batch, mode, np.full(batch.n_c, lo), tol, force_margin=force_margin, method="shared-roots", bk=bk,
+                                 disturbance=box)  # fmt: skip
     bk = batch_kinematics(batch, mode, tol) if bk is None else bk
     nodes = shared_nodes(bk.mode, lo, hi)
-    s0, s1, det, scale = batch_rows(batch, bk, np.repeat(nodes[:, None], batch.n_c, axis=1), force_margin)
+    rows = batch_rows(batch, bk, np.repeat(nodes[:, None], batch.n_c, axis=1), force_margin, box is not None)
     letters, joint, out, kin_ok = bk.mode.letters, batch.joint, [], bk.ok
     for s in range(batch.size):
         if not kin_ok[s]:
             out.append(Band(letters, joint, np.nan, np.nan, False, f"kinematics: {bk.status_name(s)}", "shared-roots"))
+        elif box is None:
+            out.append(shared_band_from_rows(bk.mode, joint, nodes, *(x[s] for x in rows), lo, hi, tol))
         else:
-            out.append(shared_band_from_rows(bk.mode, joint, nodes, s0[s], s1[s], det[s], scale[s], lo, hi, tol))
+            out.append(shared_band_over_wrenches(bk.mode, joint, nodes, *(x[s] for x in rows), box, lo, hi, tol))
     return out

@@ -24,7 +24,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from qsplan.mechanics.bands.effort import coulomb_rows, row_margins
+from qsplan.mechanics.bands.disturbance import load_columns
+from qsplan.mechanics.bands.effort import coulomb_columns, coulomb_rows, row_margins
 from qsplan.mechanics.modes.contact_mode import ContactMode, letters_to_codes
 from qsplan.mechanics.modes.equilibrium import equilibrium_columns
 from qsplan.mechanics.modes.kinematics import applicable_rows, check_mode_fits, kinematic_tests, sliding_directions
@@ -161,15 +162,18 @@ def _distinct_points(bk: BatchKinematics, mu):
     return mu[first], inverse.reshape(-1)
 
 
-def batch_rows_many(jobs, force_margin=None) -> list:
+def batch_rows_many(jobs, force_margin=None, loads: bool = False) -> list:
     """:func:`qsplan.mechanics.bands.batched.batch_rows` of every job ``(batch, bk, mu_rows)``, one ``det`` and one
     ``solve`` for all (every batch with the same joints, so ``Q_AI`` is k x k throughout).  Friction points shared by
     the states and equal at the mode's sliding contacts share their matrix (a rolling contact's friction enters its
     Coulomb rows only, eq. 28): it is factorised once.
 
+    ``loads``: also each job's slopes in an extra wrench on the workpiece, ``s2`` (S, N, r, 3), as
+    :func:`qsplan.mechanics.bands.effort.band_rows` gives them (the same right-hand sides, :func:`load_columns`).
+
     Returns
     -------
-    list of (s0, s1, det, scale)
+    list of (s0, s1, det, scale) or, with ``loads``, (s0, s1, det, scale, s2)
         Per job, shapes (S, N, r), (S, N, r), (S, N), (S, N), as ``batch_rows`` returns them.
     """
     eqs, inverses = [], []
@@ -188,24 +192,28 @@ def batch_rows_many(jobs, force_margin=None) -> list:
     det = np.linalg.det(Q)
     bad = ~np.isfinite(det) | (det == 0)
     Q[bad] = np.eye(k)  # a singular Q_AI: any solve, its rows are NaN below
-    e = np.zeros(k)
-    e[3] = 1.0
-    rhs = np.concatenate([np.broadcast_to(np.stack([b.r0, np.broadcast_to(e, b.r0.shape)], axis=2)[:, None],
-                                          q.shape[:2] + (k, 2)).reshape(-1, k, 2) for (b, _, _), (q, _) in zip(jobs, eqs)])  # fmt: skip
+    n = 5 if loads else 2
+    rhs = np.concatenate([np.broadcast_to(load_columns(b.r0, loads)[:, None], q.shape[:2] + (k, n)).reshape(-1, k, n)
+                          for (b, _, _), (q, _) in zip(jobs, eqs)])  # fmt: skip
     sol = np.linalg.solve(Q, rhs)
     out, at = [], 0
     for (b, bk, _), (q, mu), inverse in zip(jobs, eqs, inverses):
         S, U = q.shape[:2]
         part = slice(at, at + S * U)
         at += S * U
-        sol_j, bad_j, det_j = sol[part].reshape(S, U, k, 2), bad[part].reshape(S, U), det[part].reshape(S, U)
+        sol_j, bad_j, det_j = sol[part].reshape(S, U, k, n), bad[part].reshape(S, U), det[part].reshape(S, U)
         if inverse is not None:
             sol_j, bad_j, det_j = sol_j[:, inverse], bad_j[:, inverse], det_j[:, inverse]
-        s0, s1 = coulomb_rows(bk.mode, bk.idx, bk.contact, mu, sol_j)
+        if loads:
+            rows = coulomb_columns(bk.mode, bk.idx, bk.contact, mu, sol_j)
+            s0, s1, s2 = rows[..., 0], rows[..., 1], rows[..., 2:]
+            s2[bad_j] = np.nan
+        else:
+            s0, s1 = coulomb_rows(bk.mode, bk.idx, bk.contact, mu, sol_j)
         scale = np.maximum(np.max(np.abs(sol_j[..., 0]), axis=2), np.max(np.abs(b.r0), axis=1)[:, None])
         if force_margin is not None:
             s0 = s0 - row_margins(bk.mode, force_margin)
         s0[bad_j] = np.nan
         s1[bad_j] = np.nan
-        out.append((s0, s1, det_j, scale))
+        out.append((s0, s1, det_j, scale, s2) if loads else (s0, s1, det_j, scale))
     return out

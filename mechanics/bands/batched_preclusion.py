@@ -12,7 +12,9 @@ factorisation, :func:`qsplan.mechanics.bands.batched_modes.batch_rows_many`).  W
 resolves both searches (the smallest and the largest possibly-feasible effort: the control values
 do not depend on the interval, so one evaluation serves both) the answer is the reference's; the
 other pairs run the per-state search.  The answers are arrays (:class:`HullArrays`), turned into
-:class:`~qsplan.mechanics.bands.preclusion.CompetitorTorques` only where asked.
+:class:`~qsplan.mechanics.bands.preclusion.CompetitorTorques` only where asked.  With a box of disturbance
+wrenches the root cell is the friction set times the wrench box, its control values at the wrench vertices in
+:class:`qsplan.mechanics.bands.cells.FrictionCells`' order (the same numbers as the per-state search's root).
 """
 
 from __future__ import annotations
@@ -23,6 +25,7 @@ import numpy as np
 
 from qsplan.mechanics.bands.batched import StateBatch, take_states
 from qsplan.mechanics.bands.batched_modes import BatchKinematics, batch_kinematics, batch_rows_many
+from qsplan.mechanics.bands.disturbance import check_wrench_box, wrench_vertex_rows
 from qsplan.mechanics.bands.guaranteed import bernstein_matrix, shared_coordinate, shared_coordinates, shared_nodes
 from qsplan.mechanics.bands.preclusion import (
     MAX_CELLS,
@@ -101,19 +104,24 @@ def _vertices(bk: BatchKinematics, lo, hi) -> np.ndarray:
     return mu
 
 
-def _root_cells(jobs, lo, hi, shared: bool) -> list:
+def _root_cells(jobs, lo, hi, shared: bool, box=None) -> list:
     """Control values of the root cell and the rows at its friction points, per job ``(batch, bk)``:
-    ``(det (S, K), N0, N1 (S, K, R), s0, s1 (S, P, R), scale (S, P))``."""
+    ``(det (S, K), N0, N1 (S, K, R), s0, s1 (S, P, R), scale (S, P))``; with a wrench box ``box`` at each of its
+    vertices, wrench-major (:class:`qsplan.mechanics.bands.cells.FrictionCells`' order)."""
+    loads = box is not None
+    verts = None if box is None else box.vertices()
     if not shared:
-        rows = batch_rows_many([(b, bk, _vertices(bk, lo, hi)) for b, bk in jobs])
+        rows = batch_rows_many([(b, bk, _vertices(bk, lo, hi)) for b, bk in jobs], loads=loads)
+        rows = rows if box is None else [wrench_vertex_rows(*r, verts) for r in rows]
         return [(det, s0 * det[..., None], s1 * det[..., None], s0, s1, scale) for s0, s1, det, scale in rows]
     nodes = [shared_nodes(bk.mode, lo, hi) for _, bk in jobs]
-    at_nodes = batch_rows_many([(b, bk, np.repeat(nd[:, None], b.n_c, axis=1)) for (b, bk), nd in zip(jobs, nodes)])
+    at_nodes = batch_rows_many([(b, bk, np.repeat(nd[:, None], b.n_c, axis=1)) for (b, bk), nd in zip(jobs, nodes)], loads=loads)
     a, b = np.array([lo]), np.array([hi])
     pts = np.stack([a, 0.5 * (a + b), b], axis=1)
-    at_points = batch_rows_many([(bt, bk, np.repeat(pts.reshape(-1, 1), bt.n_c, axis=1)) for bt, bk in jobs])
+    at_points = batch_rows_many([(bt, bk, np.repeat(pts.reshape(-1, 1), bt.n_c, axis=1)) for bt, bk in jobs], loads=loads)
     out = []
-    for (_, bk), nd, (s0, s1, det, _), (p0, p1, _, scale) in zip(jobs, nodes, at_nodes, at_points):
+    for (_, bk), nd, node_rows, point_rows in zip(jobs, nodes, at_nodes, at_points):
+        s0, s1, det = node_rows[:3]
         deg = nd.size - 1
         V = np.vander(shared_coordinates(bk.mode), deg + 1, increasing=True)
         V = np.broadcast_to(V, (det.shape[0], deg + 1, deg + 1))
@@ -124,6 +132,13 @@ def _root_cells(jobs, lo, hi, shared: bool) -> list:
         det_c = np.concatenate([Mb @ c for c in cdet])
         N0 = np.concatenate([Mb @ c for c in cN0])
         N1 = np.concatenate([Mb @ c for c in cN1])
+        if box is None:
+            p0, p1, _, scale = point_rows
+        else:
+            cN2 = np.linalg.solve(V, (node_rows[4] * det[..., None, None]).reshape(det.shape + (-1,)))
+            N2 = np.concatenate([(Mb @ c).reshape(N0.shape[1:] + (3,))[None] for c in cN2])
+            N0, N1, det_c, _ = wrench_vertex_rows(N0, N1, det_c, None, N2, verts)
+            p0, p1, _, scale = wrench_vertex_rows(*point_rows, verts)
         out.append((det_c, N0, N1, p0, p1, scale))
     return out
 
@@ -177,7 +192,7 @@ def _root_searches(cells, gl, gh, atol, tol):
 
 def competitor_hulls(batch: StateBatch, kin: dict, comps, lo, hi, g_lo, g_hi, shared=False, tol: Tolerances = DEFAULT_TOLERANCES,
                      rtol: float = PRECLUSION_RTOL, max_cells: int = MAX_CELLS, stats: RootStats | None = None,
-                     states=None) -> dict:  # fmt: skip
+                     states=None, disturbance=None) -> dict:  # fmt: skip
     """:func:`qsplan.mechanics.bands.preclusion.competitor_torques` of every competitor at every state.
 
     Parameters
@@ -192,12 +207,15 @@ def competitor_hulls(batch: StateBatch, kin: dict, comps, lo, hi, g_lo, g_hi, sh
         The states to judge (default all); the others come back empty.
     stats : RootStats, optional
         Counts the searches the root cell resolved and those searched one at a time.
+    disturbance : WrenchBox or (array-like, array-like), optional
+        A box of external wrenches on the workpiece (as :func:`~qsplan.mechanics.bands.preclusion.competitor_torques`).
 
     Returns
     -------
     dict of str to HullArrays
     """
     S = batch.size
+    box = check_wrench_box(disturbance)
     g_lo = np.broadcast_to(np.asarray(g_lo, dtype=float), (S,))
     g_hi = np.broadcast_to(np.asarray(g_hi, dtype=float), (S,))
     lo_a, hi_a = friction_set(lo, hi, batch.n_c, shared)
@@ -224,7 +242,7 @@ def competitor_hulls(batch: StateBatch, kin: dict, comps, lo, hi, g_lo, g_hi, sh
     gl = [g_lo[live] for _, live in lives]
     gh = [g_hi[live] for _, live in lives]
     atol = [rtol * np.maximum(np.maximum(finite(a), finite(b)), 1.0) for a, b in zip(gl, gh)]
-    found = _root_searches(_root_cells(jobs, c_lo, c_hi, c_shared), gl, gh, atol, tol)
+    found = _root_searches(_root_cells(jobs, c_lo, c_hi, c_shared, box), gl, gh, atol, tol)
     for (c, live), (low, up, resolved), a, b in zip(lives, found, gl, gh):
         h = out[c]
         bounded = resolved & (low != np.inf)
@@ -237,7 +255,7 @@ def competitor_hulls(batch: StateBatch, kin: dict, comps, lo, hi, g_lo, g_hi, sh
             stats.fallback += int((~resolved).sum())
         for j in np.flatnonzero(~resolved):  # the root cell leaves it open: the per-state search
             s = int(live[j])
-            ct = competitor_torques(batch.scenes[s], c, lo, hi, float(a[j]), float(b[j]), shared, tol, rtol, max_cells)
+            ct = competitor_torques(batch.scenes[s], c, lo, hi, float(a[j]), float(b[j]), shared, tol, rtol, max_cells, disturbance=box)
             h.searched[s] = ct
             h.lower[s], h.upper[s], h.empty[s], h.exact[s], h.cells[s] = ct.lower, ct.upper, ct.empty, ct.exact, ct.cells
     return out
@@ -245,7 +263,7 @@ def competitor_hulls(batch: StateBatch, kin: dict, comps, lo, hi, g_lo, g_hi, sh
 
 def competitor_torques_batch(batch: StateBatch, mode, lo, hi, g_lo, g_hi, shared=False, tol: Tolerances = DEFAULT_TOLERANCES,
                              rtol: float = PRECLUSION_RTOL, max_cells: int = MAX_CELLS, stats: RootStats | None = None,
-                             bk: BatchKinematics | None = None) -> list:  # fmt: skip
+                             bk: BatchKinematics | None = None, disturbance=None) -> list:  # fmt: skip
     """:func:`qsplan.mechanics.bands.preclusion.competitor_torques` at every state of ``batch``.
 
     Parameters
@@ -256,6 +274,8 @@ def competitor_torques_batch(batch: StateBatch, mode, lo, hi, g_lo, g_hi, shared
         Counts the states the root cell resolved and those searched one at a time.
     bk : BatchKinematics, optional
         ``mode``'s kinematic stage on ``batch`` if already computed (the same arrays :func:`batch_kinematics` gives).
+    disturbance : WrenchBox or (array-like, array-like), optional
+        As in :func:`competitor_hulls`.
 
     Returns
     -------
@@ -270,5 +290,6 @@ def competitor_torques_batch(batch: StateBatch, mode, lo, hi, g_lo, g_hi, shared
         k = int(np.flatnonzero(~(g_lo <= g_hi))[0])
         raise SceneError(f"effort interval: expected g_lo <= g_hi; got {g_lo[k]}, {g_hi[k]}")
     bk = batch_kinematics(batch, mode, tol) if bk is None else bk
-    h = competitor_hulls(batch, {mode.letters: bk}, [mode.letters], lo, hi, g_lo, g_hi, shared, tol, rtol, max_cells, stats)
+    h = competitor_hulls(batch, {mode.letters: bk}, [mode.letters], lo, hi, g_lo, g_hi, shared, tol, rtol, max_cells, stats,
+                         disturbance=disturbance)  # fmt: skip
     return [h[mode.letters].torques(s) for s in range(S)]

@@ -8,7 +8,8 @@ competitor's hull inside it (:func:`qsplan.mechanics.bands.batched_preclusion.co
 the reference's own assembly per state (:func:`qsplan.mechanics.bands.robust.assemble_robust_band`).
 :func:`robust_band_arrays` gives the same numbers as arrays, cut out for all states at once by
 :func:`assemble_band_arrays` (the twin of ``assemble_robust_band`` the tests compare it with): the band
-tables' path, with no object per state.
+tables' path, with no object per state.  Both take the reference's ``disturbance`` (a box of wrenches on the workpiece)
+and pass it to each part.
 """
 
 from __future__ import annotations
@@ -20,6 +21,7 @@ import numpy as np
 from qsplan.mechanics.bands.batched import StateBatch, box_band_arrays, box_bands, guaranteed_bands_shared, map_batches
 from qsplan.mechanics.bands.batched_modes import modes_kinematics
 from qsplan.mechanics.bands.batched_preclusion import RootStats, competitor_hulls, competitor_torques_batch
+from qsplan.mechanics.bands.disturbance import check_wrench_box
 from qsplan.mechanics.bands.effort import check_force_margin
 from qsplan.mechanics.bands.robust import TOUCH_RTOL, assemble_robust_band, check_mu_pair
 from qsplan.mechanics.model.friction import check_mu_range
@@ -127,10 +129,11 @@ def assemble_band_arrays(lower, upper, feasible, exact, hulls, admissible: dict 
                         np.where(feasible, lower, np.nan), np.where(feasible, upper, np.nan), feasible)  # fmt: skip
 
 
-def _robust_batch(batch: StateBatch, mode, lo, hi, shared, competitors, force_margin, stats):
+def _robust_batch(batch: StateBatch, mode, lo, hi, shared, competitors, force_margin, stats, box=None):
     """The parts of every state's robust band: ``(union, admissible, desired, hulls)``: the competitors, where each
     competes (None: everywhere), the desired band as ``(lower, upper, feasible, exact, bands)`` (``bands()`` makes
-    its :class:`~qsplan.mechanics.bands.effort.Band` objects) and each competitor's :class:`HullArrays`."""
+    its :class:`~qsplan.mechanics.bands.effort.Band` objects) and each competitor's :class:`HullArrays`; ``box``: the
+    checked disturbance (a WrenchBox or None)."""
     s0 = batch.scenes[0]
     if competitors is None:
         others = [m.letters for m in enumerate_modes(s0.n_contacts, s0.dof) if m.letters != mode.letters]
@@ -141,31 +144,33 @@ def _robust_batch(batch: StateBatch, mode, lo, hi, shared, competitors, force_ma
         kin, union, admissible = modes_kinematics(batch, [mode]), tuple(competitors), None
     bk = kin[mode.letters]
     if shared:
-        bands = guaranteed_bands_shared(batch, mode, lo, hi, force_margin=force_margin, bk=bk)
+        bands = guaranteed_bands_shared(batch, mode, lo, hi, force_margin=force_margin, bk=bk, disturbance=box)
         d_lo, d_up = np.array([d.lower for d in bands], float), np.array([d.upper for d in bands], float)
         feasible, exact = np.array([d.feasible for d in bands], bool), np.array([d.exact for d in bands], bool)
         desired = (d_lo, d_up, feasible, exact, lambda: bands)
     else:
         margin = None if force_margin is None else check_force_margin(force_margin)
         lo_a, hi_a = check_mu_range(lo, hi, n=batch.n_c)
-        d_lo, d_up, why = box_band_arrays(batch, bk, lo_a, hi_a, force_margin=margin)
+        d_lo, d_up, why = box_band_arrays(batch, bk, lo_a, hi_a, force_margin=margin, disturbance=box)
         feasible = why == 0
-        desired = (d_lo, d_up, feasible, np.ones(batch.size, bool), lambda: box_bands(bk, batch.joint, d_lo, d_up, why))
+        desired = (d_lo, d_up, feasible, np.ones(batch.size, bool), lambda: box_bands(bk, batch.joint, d_lo, d_up, why, box))
     idx = np.flatnonzero(feasible)
     hulls = {}
     if idx.size and union:
         if competitors is not None:
             kin = {**kin, **modes_kinematics(batch, [c for c in dict.fromkeys(union) if c not in kin])}
-        hulls = competitor_hulls(batch, kin, list(dict.fromkeys(union)), lo, hi, d_lo + 0.0, d_up + 0.0, shared, stats=stats, states=idx)
+        hulls = competitor_hulls(batch, kin, list(dict.fromkeys(union)), lo, hi, d_lo + 0.0, d_up + 0.0, shared, stats=stats, states=idx,
+                                 disturbance=box)  # fmt: skip
     return union, admissible, desired, hulls
 
 
 def robust_bands(scenes, mode, mu_range, *, shared: bool = False, competitors=None, force_margin=None,
-                 stats: RootStats | None = None) -> list:  # fmt: skip
+                 stats: RootStats | None = None, disturbance=None) -> list:  # fmt: skip
     """:func:`qsplan.mechanics.bands.robust.robust_band` at every scene, batched (same results).
 
     Scenes are grouped by :func:`qsplan.mechanics.bands.batched.batch_signature`; each group is one batch.
     ``stats`` (:class:`RootStats`) counts the competitor searches the batched root cell resolved.
+    ``disturbance``: a box of external wrenches on the workpiece, as in ``robust_band``.
 
     Returns
     -------
@@ -173,23 +178,25 @@ def robust_bands(scenes, mode, mu_range, *, shared: bool = False, competitors=No
     """
     lo, hi = check_mu_pair(mu_range)
     mode = mode_from_letters(mode)
+    box = check_wrench_box(disturbance)
 
     def per_batch(batch):
-        union, admissible, desired, hulls = _robust_batch(batch, mode, lo, hi, shared, competitors, force_margin, stats)
+        union, admissible, desired, hulls = _robust_batch(batch, mode, lo, hi, shared, competitors, force_margin, stats, box)
         out = []
         for s, d in enumerate(desired[4]()):
             comps = union if admissible is None else tuple(c for c in union if admissible[c][s])
             torques = {c: h.torques(s) for c, h in hulls.items()} if d.feasible else {}
-            out.append(assemble_robust_band(mode, d, comps, torques, (lo, hi), shared))
+            out.append(assemble_robust_band(mode, d, comps, torques, (lo, hi), shared, box))
         return out
 
     return map_batches(scenes, per_batch)
 
 
 def robust_band_arrays(batch: StateBatch, mode, mu_range, *, shared: bool = False, competitors=None, force_margin=None,
-                       stats: RootStats | None = None) -> RobustArrays:  # fmt: skip
+                       stats: RootStats | None = None, disturbance=None) -> RobustArrays:  # fmt: skip
     """:func:`robust_bands`' numbers at every state of ``batch`` as arrays (:class:`RobustArrays`; no reasons)."""
     lo, hi = check_mu_pair(mu_range)
     mode = mode_from_letters(mode)
-    union, admissible, desired, hulls = _robust_batch(batch, mode, lo, hi, shared, competitors, force_margin, stats)
+    box = check_wrench_box(disturbance)
+    union, admissible, desired, hulls = _robust_batch(batch, mode, lo, hi, shared, competitors, force_margin, stats, box)
     return assemble_band_arrays(*desired[:4], [hulls[c] for c in union] if hulls else [], admissible)

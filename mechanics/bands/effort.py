@@ -7,7 +7,9 @@ Every Coulomb inequality of eq. (28) is then ``s_r(tau) = s0_r + tau s1_r >= 0``
 a half-line of efforts, and the band is their intersection (Section 5.2,
 Figs. 10-12).  A :class:`ForceMargin` asks for ``s_r >= m_r`` instead: every loaded
 contact's normal force at least ``normal`` and every rolling contact's cone slacks at
-least ``slack`` (N); still a half-line per row.  Bands over uncertain friction
+least ``slack`` (N); still a half-line per row.  An extra wrench on the workpiece moves
+every row affinely (``band_rows(..., loads=True)``; bands robust to a box of them:
+:mod:`qsplan.mechanics.bands.disturbance`).  Bands over uncertain friction
 (guaranteed, possible, sampled) are in :mod:`qsplan.mechanics.bands.guaranteed`.
 """
 
@@ -17,6 +19,13 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from qsplan.mechanics.bands.disturbance import (
+    check_wrench_box,
+    load_columns,
+    loaded_reason,
+    worst_over_wrenches,
+    wrench_vertex_rows,
+)
 from qsplan.mechanics.errors import QsplanError, SceneError
 from qsplan.mechanics.modes.contact_mode import ContactMode
 from qsplan.mechanics.numerics import DEFAULT_TOLERANCES, Status, Tolerances
@@ -34,6 +43,7 @@ __all__ = [
     "band_kinematics",
     "band_rows",
     "coulomb_rows",
+    "coulomb_columns",
     "intersect_rows",
     "effort_band",
     "effort_bands",
@@ -198,7 +208,7 @@ def band_kinematics(scene: Scene, mode: ContactMode, tol: Tolerances = DEFAULT_T
     return ModeKinematics(*single_mode_kinematics(scene, mode, tol))
 
 
-def band_rows(scene: Scene, mk: ModeKinematics, mu_rows, force_margin=None) -> tuple:
+def band_rows(scene: Scene, mk: ModeKinematics, mu_rows, force_margin=None, *, loads: bool = False) -> tuple:
     """Coulomb slacks of eq. (28) as affine functions of the effort, at each mu row.
 
     Parameters
@@ -212,6 +222,9 @@ def band_rows(scene: Scene, mk: ModeKinematics, mu_rows, force_margin=None) -> t
         Subtracted from ``s0`` (:func:`row_margins`): the rows then read ``s(tau) - m >= 0``.
         ``det Q_AI (s - m)`` stays multilinear in the mu's (``det`` is), so the vertex and root
         arguments of :mod:`qsplan.mechanics.bands.guaranteed` hold unchanged.
+    loads : bool
+        Also return ``s2``: the rows' change per unit of an external wrench added to ``g_obj``
+        (:mod:`qsplan.mechanics.bands.disturbance`; eq. 26 is affine in it).
 
     Returns
     -------
@@ -223,6 +236,8 @@ def band_rows(scene: Scene, mk: ModeKinematics, mu_rows, force_margin=None) -> t
         ``det Q_AI`` (sign and size tell singularity).
     scale : ndarray, shape (N,)
         Force scale of each row set (N), for tolerances.
+    s2 : ndarray, shape (N, r, 3)
+        With ``loads`` only: ``s = s0 + tau s1 + s2 . w`` under an extra wrench ``w`` on the workpiece (N, N, N m).
     """
     mu_rows = np.atleast_2d(np.asarray(mu_rows, dtype=float))
     N = mu_rows.shape[0]
@@ -231,19 +246,23 @@ def band_rows(scene: Scene, mk: ModeKinematics, mu_rows, force_margin=None) -> t
     det = np.linalg.det(Q)
     E = mk.pool.E
     r0 = np.concatenate([-scene.g_obj, -scene.g_man[E]])
-    e = np.zeros_like(r0)
-    e[3] = 1.0
     bad = ~np.isfinite(det) | (det == 0)
     Qs = Q.copy()
     Qs[bad] = np.eye(Q.shape[1])
-    sol = np.linalg.solve(Qs, np.broadcast_to(np.column_stack([r0, e]), (N, r0.size, 2)))  # (N, k, 2)
-    s0, s1 = coulomb_rows(mk.mode, kin.idx[0], kin.contact[0], mu_rows, sol)
+    rhs = load_columns(r0, loads)
+    sol = np.linalg.solve(Qs, np.broadcast_to(rhs, (N,) + rhs.shape))  # (N, k, 2), or (N, k, 5) with loads
+    if loads:
+        rows = coulomb_columns(mk.mode, kin.idx[0], kin.contact[0], mu_rows, sol)
+        s0, s1, s2 = rows[..., 0], rows[..., 1], rows[..., 2:]
+        s2[bad] = np.nan
+    else:
+        s0, s1 = coulomb_rows(mk.mode, kin.idx[0], kin.contact[0], mu_rows, sol)
     scale = np.maximum(np.max(np.abs(sol[:, :, 0]), axis=1), np.max(np.abs(r0)))
     if force_margin is not None:
         s0 = s0 - row_margins(mk.mode, force_margin)[None, :]
     s0[bad] = np.nan
     s1[bad] = np.nan
-    return s0, s1, det, scale
+    return (s0, s1, det, scale, s2) if loads else (s0, s1, det, scale)
 
 
 def coulomb_rows(mode: ContactMode, idx, contact, mu_rows, sol) -> tuple:
@@ -263,26 +282,29 @@ def coulomb_rows(mode: ContactMode, idx, contact, mu_rows, sol) -> tuple:
     s0, s1 : ndarray, shape (..., r)
         In :func:`band_rows`' order, without margins.
     """
+    rows = coulomb_columns(mode, idx, contact, mu_rows, sol)
+    return np.ascontiguousarray(rows[..., 0]), np.ascontiguousarray(rows[..., 1])
+
+
+def coulomb_columns(mode: ContactMode, idx, contact, mu_rows, sol) -> np.ndarray:
+    """:func:`coulomb_rows` for every column of ``sol`` (..., k, n): the rows of eq. (28), shape (..., r, n).
+
+    The rows are linear in ``c_A``, so each column (the value at zero effort, the slope in the effort, the
+    slopes in a wrench) maps alike.
+    """
     n_c = mu_rows.shape[-1]
     rows_n = idx < n_c
-    out0, out1 = [], []
+    out = []
     for c, letter in enumerate(mode.letters):
         if letter == "B":
             continue
         jn = int(np.flatnonzero(rows_n & (contact == c))[0])
-        cn = sol[..., jn, :]  # (..., 2): value at tau = 0, slope
+        cn = sol[..., jn, :]  # (..., n): value at tau = 0, slope, ...
         if letter == "R":
             jt = int(np.flatnonzero(~rows_n & (contact == c))[0])
-            ct = sol[..., jt, :]
-            for row in coulomb_slacks(mu_rows[..., c : c + 1], cn, ct):  # linear: value and slope alike
-                out0.append(row[..., 0])
-                out1.append(row[..., 1])
-            out0.append(cn[..., 0])  # c_n >= 0 (eq. 9); implied by the cone rows only when mu > 0
-            out1.append(cn[..., 1])
-        else:
-            out0.append(cn[..., 0])
-            out1.append(cn[..., 1])
-    return np.stack(out0, axis=-1), np.stack(out1, axis=-1)
+            out += coulomb_slacks(mu_rows[..., c : c + 1], cn, sol[..., jt, :])  # linear: every column alike
+        out.append(cn)  # c_n >= 0 (eq. 9); for rolling contacts implied by the cone rows only when mu > 0
+    return np.stack(out, axis=-2)
 
 
 def intersect_rows(s0, s1, scale, tol: Tolerances):
@@ -302,8 +324,13 @@ def intersect_rows(s0, s1, scale, tol: Tolerances):
     return lower, upper, ok
 
 
-def effort_bands(scene: Scene, mode: ContactMode, mu_rows, tol: Tolerances = DEFAULT_TOLERANCES, *, force_margin=None):
+def effort_bands(scene: Scene, mode: ContactMode, mu_rows, tol: Tolerances = DEFAULT_TOLERANCES, *, force_margin=None,
+                 disturbance=None):  # fmt: skip
     """Bands of ``mode`` at many friction points at once (``force_margin``: see :class:`ForceMargin`).
+
+    ``disturbance`` (:class:`qsplan.mechanics.bands.disturbance.WrenchBox` or ``(lo, hi)``): each band holds for
+    every wrench of the box added to ``g_obj`` (the intersection over the box's vertices, exact: eq. 26 is affine
+    in the wrench).
 
     Returns
     -------
@@ -313,18 +340,22 @@ def effort_bands(scene: Scene, mode: ContactMode, mu_rows, tol: Tolerances = DEF
     """
     check_one_effort_joint(scene)
     force_margin = None if force_margin is None else check_force_margin(force_margin)
+    box = check_wrench_box(disturbance)
     mu_rows = np.atleast_2d(np.asarray(mu_rows, dtype=float))
     mk = band_kinematics(scene, mode, tol)
     N = mu_rows.shape[0]
     if not mk.ok:
         return np.full(N, np.nan), np.full(N, np.nan), np.zeros(N, dtype=bool)
+    if box is not None:
+        rows = wrench_vertex_rows(*band_rows(scene, mk, mu_rows, force_margin, loads=True), box.vertices())
+        return worst_over_wrenches(*intersect_rows(rows[0], rows[1], rows[3], tol), len(box.vertices()))
     s0, s1, _, scale = band_rows(scene, mk, mu_rows, force_margin)
     lower, upper, ok = intersect_rows(s0, s1, scale, tol)
     return lower, upper, ok
 
 
 def effort_band(scene: Scene, mode: ContactMode | str, mu=None, tol: Tolerances = DEFAULT_TOLERANCES, *,
-                force_margin=None) -> Band:
+                force_margin=None, disturbance=None) -> Band:
     """The band of ``mode`` at the scene's friction (or at ``mu``), eq. (28).
 
     Parameters
@@ -336,18 +367,25 @@ def effort_band(scene: Scene, mode: ContactMode | str, mu=None, tol: Tolerances 
     mu : array-like, shape (n_c,), optional
     force_margin : ForceMargin or (float, float), optional
         Minimum normal force and Coulomb slack (N) the band keeps (default none: eq. 28 as is).
+    disturbance : WrenchBox or (array-like, array-like), optional
+        A box of external wrenches on the workpiece (N, N, N m, added to ``g_obj``): the band holds for every
+        one (:mod:`qsplan.mechanics.bands.disturbance`).
     """
     joint = check_one_effort_joint(scene)
     mode = check_mode_fits(scene, mode)
     force_margin = None if force_margin is None else check_force_margin(force_margin)
+    box = check_wrench_box(disturbance)
     mk = band_kinematics(scene, mode, tol)
     if not mk.ok:
         return Band(mode.letters, joint, np.nan, np.nan, False, f"kinematics: {mk.status}")
     mu = scene.mu if mu is None else np.broadcast_to(np.asarray(mu, float), (scene.n_contacts,))
-    s0, s1, det, scale = band_rows(scene, mk, mu[None], force_margin)
+    rows = band_rows(scene, mk, mu[None], force_margin, loads=box is not None)
+    s0, s1, det, scale = rows if box is None else wrench_vertex_rows(*rows, box.vertices())
     if not np.isfinite(s0).all():
         return Band(mode.letters, joint, np.nan, np.nan, False, "equilibrium_singular")
     lower, upper, ok = intersect_rows(s0, s1, scale, tol)
+    if box is not None:
+        lower, upper, ok = worst_over_wrenches(lower, upper, ok, s0.shape[0])
     if not ok[0]:
-        return Band(mode.letters, joint, np.nan, np.nan, False, "coulomb: no effort satisfies eq. (28)")
+        return Band(mode.letters, joint, np.nan, np.nan, False, loaded_reason("coulomb: no effort satisfies eq. (28)", box))
     return Band(mode.letters, joint, float(lower[0]), float(upper[0]), True)

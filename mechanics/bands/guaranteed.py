@@ -16,6 +16,12 @@ Over uncertain friction the guarantee is exact:
   polynomials are fitted in ``t`` (``[lo, hi]`` mapped onto ``[-1, 1]``), so any
   range wider than zero, however narrow, is fitted as well as ``[0, 1]``.
 
+A box of disturbance wrenches (``disturbance=``, :mod:`qsplan.mechanics.bands.disturbance`) keeps both
+exact: with friction fixed the rows are affine in the wrench (eq. 26), so the box's vertices decide "every
+wrench": the box band's vertices are those of the friction box times the wrench box, and the shared band
+is the intersection of the root bands at the wrench vertices (each row at the vertices that can be its
+worst: where a row's slope in a wrench component keeps its sign over the range, the other end is dominated).
+
 A force margin (:class:`qsplan.mechanics.bands.effort.ForceMargin`: ``s_r >= m_r``
 with a constant ``m_r`` instead of ``s_r >= 0``) keeps both exact: where ``det Q_AI``
 keeps its sign, ``s_r - m_r >= 0`` iff ``det (s_r - m_r) = det s_r - m_r det`` has
@@ -34,6 +40,7 @@ from math import comb
 
 import numpy as np
 
+from qsplan.mechanics.bands.disturbance import check_wrench_box, loaded_reason, wrench_vertex_rows
 from qsplan.mechanics.bands.effort import (
     Band,
     band_kinematics,
@@ -59,6 +66,7 @@ __all__ = [
     "sampled_band",
     "bernstein_matrix",
     "shared_band_from_rows",
+    "shared_band_over_wrenches",
     "shared_coordinate",
     "shared_coordinates",
     "shared_nodes",
@@ -87,7 +95,7 @@ def _box_vertices(scene: Scene, mode: ContactMode, lo, hi) -> np.ndarray:
 
 
 def guaranteed_band_box(scene: Scene, mode: ContactMode, lo, hi, tol: Tolerances = DEFAULT_TOLERANCES, *,
-                        force_margin=None) -> Band:  # fmt: skip
+                        force_margin=None, disturbance=None) -> Band:  # fmt: skip
     """Efforts for which ``mode`` is feasible for **every** mu with ``lo <= mu_i <= hi`` (exact).
 
     Parameters
@@ -96,15 +104,21 @@ def guaranteed_band_box(scene: Scene, mode: ContactMode, lo, hi, tol: Tolerances
         Independent intervals per contact (breaking contacts' mu do not matter).
     force_margin : ForceMargin or (float, float), optional
         Minimum normal force and Coulomb slack (N) kept for every mu in the box (default none).
+    disturbance : WrenchBox or (array-like, array-like), optional
+        A box of external wrenches on the workpiece (N, N, N m, added to ``g_obj``): the band holds for every
+        one too; the vertices are then those of the friction box times the wrench box (exact,
+        :mod:`qsplan.mechanics.bands.disturbance`).
     """
     joint = check_one_effort_joint(scene)
     mode = check_mode_fits(scene, mode)
     force_margin = None if force_margin is None else check_force_margin(force_margin)
+    box = check_wrench_box(disturbance)
     verts = _box_vertices(scene, mode, lo, hi)
     mk = band_kinematics(scene, mode, tol)
     if not mk.ok:
         return Band(mode.letters, joint, np.nan, np.nan, False, f"kinematics: {mk.status}", "box-vertices")
-    s0, s1, det, scale = band_rows(scene, mk, verts, force_margin)
+    rows = band_rows(scene, mk, verts, force_margin, loads=box is not None)
+    s0, s1, det, scale = rows if box is None else wrench_vertex_rows(*rows, box.vertices())  # det: per friction vertex
     if not (np.all(det > 0) or np.all(det < 0)):
         return Band(
             mode.letters, joint, np.nan, np.nan, False,
@@ -113,14 +127,16 @@ def guaranteed_band_box(scene: Scene, mode: ContactMode, lo, hi, tol: Tolerances
         )  # fmt: skip
     lower, upper, ok = intersect_rows(s0, s1, scale, tol)
     if not ok.all():
-        return Band(mode.letters, joint, np.nan, np.nan, False, "coulomb: no effort works at some vertex of the mu box", "box-vertices")
+        why = "coulomb: no effort works at some vertex of the mu box"
+        return Band(mode.letters, joint, np.nan, np.nan, False, loaded_reason(why, box), "box-vertices")
     lo_, up_ = float(lower.max()), float(upper.min())
     if lo_ > up_:
-        return Band(mode.letters, joint, np.nan, np.nan, False, "coulomb: vertex bands do not overlap", "box-vertices")
+        why = loaded_reason("coulomb: vertex bands do not overlap", box)
+        return Band(mode.letters, joint, np.nan, np.nan, False, why, "box-vertices")
     return Band(mode.letters, joint, lo_, up_, True, None, "box-vertices")
 
 
-def possible_band_box(scene: Scene, mode: ContactMode, lo, hi, tol: Tolerances = DEFAULT_TOLERANCES) -> Band:
+def possible_band_box(scene: Scene, mode: ContactMode, lo, hi, tol: Tolerances = DEFAULT_TOLERANCES, *, disturbance=None) -> Band:
     """An interval containing every effort for which ``mode`` is feasible for **some** mu in the box.
 
     Used to preclude a competing mode: outside this interval the mode is
@@ -129,15 +145,19 @@ def possible_band_box(scene: Scene, mode: ContactMode, lo, hi, tol: Tolerances =
     function); requiring every row separately gives a superset of the true set
     (``exact=False``: conservative for precluding).  When ``det Q_AI`` changes sign
     in the box, the mode may be feasible for any effort near the singularity:
-    the whole line is returned.
+    the whole line is returned.  With ``disturbance`` (a wrench box, as in :func:`guaranteed_band_box`)
+    "some mu" is "some mu and some wrench": each row is multilinear in both, so the vertices of the
+    product box decide it alike.
     """
     joint = check_one_effort_joint(scene)
     mode = check_mode_fits(scene, mode)
+    box = check_wrench_box(disturbance)
     verts = _box_vertices(scene, mode, lo, hi)
     mk = band_kinematics(scene, mode, tol)
     if not mk.ok:
         return Band(mode.letters, joint, np.nan, np.nan, False, f"kinematics: {mk.status}", "possible-superset", True)
-    s0, s1, det, scale = band_rows(scene, mk, verts)
+    rows = band_rows(scene, mk, verts, loads=box is not None)
+    s0, s1, det, scale = rows if box is None else wrench_vertex_rows(*rows, box.vertices())
     if not (np.all(det > 0) or np.all(det < 0)):
         return Band(mode.letters, joint, -np.inf, np.inf, True, "det Q_AI changes sign in the box", "possible-superset", False)
     ftol = tol.force * scale[:, None]
@@ -168,22 +188,22 @@ def possible_band_box(scene: Scene, mode: ContactMode, lo, hi, tol: Tolerances =
 
 
 def sampled_band(scene: Scene, mode: ContactMode, mu_rows, tol: Tolerances = DEFAULT_TOLERANCES, *,
-                 force_margin=None) -> Band:  # fmt: skip
+                 force_margin=None, disturbance=None) -> Band:  # fmt: skip
     """The paper's method: intersect the point bands over the listed mu (e.g. 0, 0.01, ..., 0.2).
 
     Parameters
     ----------
     mu_rows : array-like, shape (N, n_c) or (N,)
         Friction points; a 1-D array gives one shared coefficient per sample.
-    force_margin : ForceMargin or (float, float), optional
-        As in :func:`guaranteed_band_box`.
+    force_margin, disturbance : optional
+        As in :func:`guaranteed_band_box` (the disturbance's vertices are checked at every sample: exact there).
     """
     joint = check_one_effort_joint(scene)
     mode = check_mode_fits(scene, mode)
     mu_rows = np.asarray(mu_rows, dtype=float)
     if mu_rows.ndim == 1:
         mu_rows = np.repeat(mu_rows[:, None], scene.n_contacts, axis=1)
-    lower, upper, ok = effort_bands(scene, mode, mu_rows, tol, force_margin=force_margin)
+    lower, upper, ok = effort_bands(scene, mode, mu_rows, tol, force_margin=force_margin, disturbance=disturbance)
     if not ok.all():
         return Band(mode.letters, joint, np.nan, np.nan, False, "infeasible at some sample", "sampled", False)
     lo_, up_ = float(lower.max()), float(upper.min())
@@ -199,7 +219,7 @@ def _poly_fit_exact(x, y, degree):
 
 
 def guaranteed_band_shared(scene: Scene, mode: ContactMode, lo: float, hi: float, tol: Tolerances = DEFAULT_TOLERANCES,
-                           *, force_margin=None) -> Band:  # fmt: skip
+                           *, force_margin=None, disturbance=None) -> Band:  # fmt: skip
     """Efforts for which ``mode`` is feasible for every shared coefficient ``mu`` in ``[lo, hi]`` (exact).
 
     With one coefficient shared by all contacts, ``det Q_AI`` is a polynomial of
@@ -211,20 +231,62 @@ def guaranteed_band_shared(scene: Scene, mode: ContactMode, lo: float, hi: float
     the row holds there and fatally if not).  A root of ``det Q_AI`` inside the
     interval means a degenerate mode: nothing is guaranteed.  With ``force_margin``
     (as in :func:`guaranteed_band_box`) ``N0_r`` is ``det Q_AI (s0_r - m_r)``, of the same degree.
+    With ``disturbance`` (a wrench box, as in :func:`guaranteed_band_box`): the intersection of these
+    bands over the wrench box's vertices (:func:`shared_band_over_wrenches`; exact).
     """
     joint = check_one_effort_joint(scene)
     mode = check_mode_fits(scene, mode)
     force_margin = None if force_margin is None else check_force_margin(force_margin)
+    box = check_wrench_box(disturbance)
     lo, hi = check_mu_range(lo, hi)
     mk = band_kinematics(scene, mode, tol)
     if not mk.ok:
         return Band(mode.letters, joint, np.nan, np.nan, False, f"kinematics: {mk.status}", "shared-roots")
     if hi == lo:
-        b = effort_band(scene, mode, np.full(scene.n_contacts, lo), tol, force_margin=force_margin)
+        b = effort_band(scene, mode, np.full(scene.n_contacts, lo), tol, force_margin=force_margin, disturbance=box)
         return Band(b.mode, joint, b.lower, b.upper, b.feasible, b.reason, "shared-roots")
     nodes = shared_nodes(mode, lo, hi)
-    s0, s1, det, scale = band_rows(scene, mk, np.repeat(nodes[:, None], scene.n_contacts, axis=1), force_margin)
-    return shared_band_from_rows(mode, joint, nodes, s0, s1, det, scale, lo, hi, tol)
+    rows = band_rows(scene, mk, np.repeat(nodes[:, None], scene.n_contacts, axis=1), force_margin, loads=box is not None)
+    if box is not None:
+        return shared_band_over_wrenches(mode, joint, nodes, *rows, box, lo, hi, tol)
+    return shared_band_from_rows(mode, joint, nodes, *rows, lo, hi, tol)
+
+
+def shared_band_over_wrenches(mode: ContactMode, joint: int, nodes, s0, s1, det, scale, s2, box, lo: float, hi: float,
+                              tol: Tolerances = DEFAULT_TOLERANCES) -> Band:  # fmt: skip
+    """:func:`shared_band_from_rows` at every vertex of the wrench box ``box``, intersected: the efforts that hold
+    ``mode`` for every shared mu in ``[lo, hi]`` and every wrench of the box (``band_rows(..., loads=True)``' output
+    at :func:`shared_nodes`).  Exact: for fixed mu the rows are affine in the wrench (eq. 26), so its box's
+    vertices decide "every wrench"; at each vertex the roots decide "every mu"."""
+    verts = box.vertices()
+    s0w, _, _, scalew = wrench_vertex_rows(s0, s1, det, scale, s2, verts)
+    W, n = verts.shape[0], nodes.size
+    keep = _worst_vertices(mode, s2, det, box)
+    b = _shared_band(mode, joint, nodes, s0w.reshape(W, n, -1), s1, det, scalew.reshape(W, n), lo, hi, tol, keep)
+    return Band(b.mode, joint, b.lower, b.upper, b.feasible, loaded_reason(b.reason, box), "shared-roots")
+
+
+def _worst_vertices(mode: ContactMode, s2, det, box) -> np.ndarray:
+    """Which wrench vertices can be a row's worst somewhere in the range, (W, r) of bool (``s2`` at the nodes).
+
+    Exact pruning: where the slope ``s2_rj`` of row ``r`` in wrench component ``j`` keeps one sign over the whole
+    range, the vertex with ``w_j`` at the other end is dominated (``s_r`` there is larger by ``s2_rj (hi_j - lo_j)
+    >= 0`` for every mu and effort, eq. 26), so it cuts nothing the kept one does not.  The sign is proved by the
+    Bernstein coefficients of ``det Q_AI * s2_rj`` (all of one sign: so is the polynomial) and the sign of ``det``
+    (constant, else the mode is singular and no row is looked at).
+    """
+    n = det.size
+    V = np.vander(shared_coordinates(mode), n, increasing=True)
+    coef = np.linalg.solve(V, (s2 * det[:, None, None]).reshape(n, -1))  # power basis in t, (n, 3 r)
+    B = (bernstein_matrix(n - 1, np.array([-1.0]), np.array([1.0]))[0] @ coef).reshape((n,) + s2.shape[1:])
+    B = B * np.sign(det[0])
+    rising, falling = np.all(B >= 0, axis=0), np.all(B <= 0, axis=0) & ~np.all(B == 0, axis=0)  # (r, 3)
+    verts, hi = box.vertices(), np.array(box.hi)
+    at_hi = verts == hi  # (W, 3)
+    dominated = (at_hi[:, None, :] & rising[None]) | (~at_hi[:, None, :] & falling[None])
+    free = np.zeros(3, bool)
+    free[list(box.free)] = True
+    return ~np.any(dominated & free, axis=2) | ~np.isfinite(B).all() | (det[0] == 0)
 
 
 def shared_coordinates(mode: ContactMode) -> np.ndarray:
@@ -254,6 +316,15 @@ def shared_band_from_rows(mode: ContactMode, joint: int, nodes, s0, s1, det, sca
 
     The polynomials are in ``t`` (:func:`shared_coordinate`), their extremes sought on ``[-1, 1]``.
     """
+    return _shared_band(mode, joint, nodes, s0[None], s1, det, scale[None], lo, hi, tol)
+
+
+def _shared_band(mode: ContactMode, joint: int, nodes, s0s, s1, det, scales, lo: float, hi: float, tol: Tolerances,
+                 keep=None) -> Band:  # fmt: skip
+    """:func:`shared_band_from_rows` for the rows ``s0s`` (V, deg + 1, r) with their ``scales`` (V, deg + 1) that share
+    ``s1`` and ``det`` (the rows under each wrench of a box: eq. 26 moves only ``s0``): the intersection of their bands.
+    ``det Q_AI`` and each row's slope polynomial are fitted and their roots found once.  ``keep`` (V, r) of bool: the
+    (set, row) pairs to look at (default all; :func:`_worst_vertices` drops dominated ones)."""
     deg = len(mode.sliding) + 1
     t = shared_coordinates(mode)
     mu_of = lambda x: 0.5 * (lo + hi) + 0.5 * (hi - lo) * x  # noqa: E731 - for messages
@@ -265,32 +336,36 @@ def shared_band_from_rows(mode: ContactMode, joint: int, nodes, s0, s1, det, sca
                     f"equilibrium_singular: det Q_AI vanishes at mu = {mu_of(roots_det[0]) if roots_det else nodes[det == 0][0]:.6g}",
                     "shared-roots")  # fmt: skip
     lower, upper = -np.inf, np.inf
-    fscale = float(np.max(scale))
-    for r in range(s0.shape[1]):
-        n0 = P(_poly_fit_exact(t, s0[:, r] * det, deg))
+    fscales = [float(np.max(scale)) for scale in scales]
+    for r in range(s1.shape[1]):
         n1 = P(_poly_fit_exact(t, s1[:, r] * det, deg))
         d = P(pdet)
-        cand = [-1.0, 1.0]
-        crit = (n0.deriv() * n1 - n0 * n1.deriv()).roots()
-        cand += [c.real for c in np.atleast_1d(crit) if abs(c.imag) < CRITICAL_IMAG_TOL and -1.0 < c.real < 1.0]
         zeros1 = [c.real for c in np.atleast_1d(n1.roots()) if abs(c.imag) < ROOT_IMAG_TOL and -1.0 <= c.real <= 1.0]
-        for z in zeros1:
-            # at a root of the slope the row holds for every effort iff s0 >= 0 there
-            if n0(z) / d(z) < -tol.force * fscale:
-                return Band(mode.letters, joint, np.nan, np.nan, False,
-                            f"coulomb: row {r} fails for every effort at mu = {mu_of(z):.6g}", "shared-roots")  # fmt: skip
-        for c in cand:
-            sl = n1(c) / d(c)
-            if abs(sl) <= tol.force * max(1e-300, float(np.max(np.abs(s1[:, r])))):
-                if n0(c) / d(c) < -tol.force * fscale:
-                    return Band(mode.letters, joint, np.nan, np.nan, False, f"coulomb: row {r} fails at mu = {mu_of(c):.6g}",
-                                "shared-roots")  # fmt: skip
+        flat = tol.force * max(1e-300, float(np.max(np.abs(s1[:, r]))))
+        for v, (s0, fscale) in enumerate(zip(s0s, fscales)):
+            if keep is not None and not keep[v, r]:
                 continue
-            e = -n0(c) / n1(c)
-            if sl > 0:
-                lower = max(lower, e)
-            else:
-                upper = min(upper, e)
+            n0 = P(_poly_fit_exact(t, s0[:, r] * det, deg))
+            cand = [-1.0, 1.0]
+            crit = (n0.deriv() * n1 - n0 * n1.deriv()).roots()
+            cand += [c.real for c in np.atleast_1d(crit) if abs(c.imag) < CRITICAL_IMAG_TOL and -1.0 < c.real < 1.0]
+            for z in zeros1:
+                # at a root of the slope the row holds for every effort iff s0 >= 0 there
+                if n0(z) / d(z) < -tol.force * fscale:
+                    return Band(mode.letters, joint, np.nan, np.nan, False,
+                                f"coulomb: row {r} fails for every effort at mu = {mu_of(z):.6g}", "shared-roots")  # fmt: skip
+            for c in cand:
+                sl = n1(c) / d(c)
+                if abs(sl) <= flat:
+                    if n0(c) / d(c) < -tol.force * fscale:
+                        return Band(mode.letters, joint, np.nan, np.nan, False, f"coulomb: row {r} fails at mu = {mu_of(c):.6g}",
+                                    "shared-roots")  # fmt: skip
+                    continue
+                e = -n0(c) / n1(c)
+                if sl > 0:
+                    lower = max(lower, e)
+                else:
+                    upper = min(upper, e)
     if lower > upper:
         return Band(mode.letters, joint, np.nan, np.nan, False, "coulomb: no effort works for every mu in the range", "shared-roots")
     return Band(mode.letters, joint, float(lower), float(upper), True, None, "shared-roots")

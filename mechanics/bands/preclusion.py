@@ -33,6 +33,12 @@ Method (branch and bound over friction cells, exact to a tolerance):
   end is the smallest bound left, so it never lies inside the competitor's true
   set: the result is exact to ``tol`` when the search finishes, and conservative
   (wider) when it runs out of its cell budget, which is said in the result.
+* With a box of disturbance wrenches (:mod:`qsplan.mechanics.bands.disturbance`) the competitor is
+  possible if some friction **and some wrench** of the box admit it: a projection, whose extreme may lie
+  inside the wrench box.  The wrench is three more sides of every cell
+  (:class:`qsplan.mechanics.bands.cells.FrictionCells`): ``N_r`` is multilinear in (friction, wrench), so
+  the control values at the product cell's vertices bound it with common weights, and every argument
+  below holds unchanged; a certificate covers the whole wrench cell at once (exact at fixed friction).
 * Unbounded sides are explicit: a cell may admit arbitrarily low efforts (bound
   ``-inf``: every row falls with the effort at some control point); such a cell
   is kept and, if the budget runs out, reported as ``-inf`` (conservative), never
@@ -50,9 +56,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from qsplan.mechanics.bands.cells import FrictionCells, point_bands
 from qsplan.mechanics.bands.certificates import MAX_CERTIFICATES, certified_lower_bounds
-from qsplan.mechanics.bands.effort import band_kinematics, band_rows, intersect_rows
-from qsplan.mechanics.bands.guaranteed import bernstein_matrix, shared_coordinate, shared_coordinates, shared_nodes
+from qsplan.mechanics.bands.disturbance import check_wrench_box
+from qsplan.mechanics.bands.effort import band_kinematics
 from qsplan.mechanics.errors import SceneError
 from qsplan.mechanics.model.friction import check_mu_range
 from qsplan.mechanics.modes.contact_mode import mode_from_letters
@@ -80,12 +87,6 @@ MAX_CELLS = 4000
 #: at 64; on 15 hard bands of the band-safety scenes 64 gives the answers of 0 (256 loses two exact bands).
 CERTIFY_AFTER = 64
 
-#: Weight of a cell side's relative width when choosing the side to bisect (the change of the
-#: control values along it weighs 1): small, so it only breaks ties between sides the rows do not
-#: tell apart, such as sides along which nothing changes.
-SPLIT_TIE = 1e-3
-
-
 @dataclass(frozen=True, slots=True)
 class CompetitorTorques:
     """Efforts inside ``G`` for which a competing mode may be feasible (N m or N).
@@ -96,7 +97,7 @@ class CompetitorTorques:
     lower, upper : float
         Hull of the competitor's possibly-feasible efforts inside ``G``; ``-inf`` / ``inf`` where
         it reaches an unbounded side of ``G``; NaN when it is infeasible for every effort in ``G``
-        and every friction in the set.
+        and every friction in the set (and every wrench of the disturbance box, if any).
     empty : bool
         The competitor is precluded on the whole of ``G`` (proved).
     exact : bool
@@ -116,105 +117,6 @@ class CompetitorTorques:
     exact: bool
     reason: str | None = None
     cells: int = 0
-
-
-class _Cells:
-    """Control values of the competitor's rows on friction cells (box vertices or Bernstein coefficients)."""
-
-    def __init__(self, scene, mk, lo, hi, shared, tol):
-        self.scene, self.mk, self.tol = scene, mk, tol
-        self.shared = shared
-        n_c = scene.n_contacts
-        self.n_c = n_c
-        if shared:
-            nodes = shared_nodes(mk.mode, lo, hi)
-            self.deg, self.range = nodes.size - 1, (lo, hi)
-            s0, s1, det, _ = band_rows(scene, mk, np.repeat(nodes[:, None], n_c, axis=1))
-            V = np.vander(shared_coordinates(mk.mode), self.deg + 1, increasing=True)
-            self.cdet = np.linalg.solve(V, det)  # (deg+1,) power-basis coefficients in t (shared_coordinate)
-            self.cN0 = np.linalg.solve(V, s0 * det[:, None])  # (deg+1, R)
-            self.cN1 = np.linalg.solve(V, s1 * det[:, None])
-            self.root = (np.array([[lo]]), np.array([[hi]]))
-        else:
-            self.free = [c for c in range(n_c) if mk.mode.letters[c] != "B" and hi[c] > lo[c]]
-            self.base = lo.copy()
-            self.root = (lo[self.free][None], hi[self.free][None])
-
-    def evaluate(self, clo, chi):
-        """Control values and point bands of cells ``[clo, chi]`` (m, d).
-
-        Returns det (m, K), N0 (m, K, R), N1 (m, K, R), and the bands at actual
-        friction points: pl, pu (m, P), pok (m, P).
-        """
-        m = clo.shape[0]
-        if self.shared:
-            return self._bernstein(clo[:, 0], chi[:, 0])
-        d = len(self.free)
-        bits = ((np.arange(2**d)[:, None] >> np.arange(d)[None]) & 1).astype(bool)  # (K, d)
-        verts = np.where(bits[None], chi[:, None, :], clo[:, None, :])  # (m, K, d)
-        mu = np.broadcast_to(self.base, (m, 2**d, self.n_c)).copy()
-        mu[:, :, self.free] = verts
-        s0, s1, det, scale = band_rows(self.scene, self.mk, mu.reshape(-1, self.n_c))
-        R = s0.shape[1]
-        N0 = (s0 * det[:, None]).reshape(m, 2**d, R)
-        N1 = (s1 * det[:, None]).reshape(m, 2**d, R)
-        pl, pu, pok = point_bands(s0, s1, scale, self.tol)
-        K = 2**d
-        det = det.reshape(m, K)
-        return det, N0, N1, pl.reshape(m, K), pu.reshape(m, K), pok.reshape(m, K), _spread(det, N0, N1, d)
-
-    def _bernstein(self, a, b):
-        M = bernstein_matrix(self.deg, shared_coordinate(a, *self.range), shared_coordinate(b, *self.range))
-        det = M @ self.cdet
-        N0 = M @ self.cN0
-        N1 = M @ self.cN1
-        # point bands from the model itself (the fitted polynomials lose their accuracy near a root of det)
-        pts = np.stack([a, 0.5 * (a + b), b], axis=1)  # (m, 3)
-        s0, s1, _, scale = band_rows(self.scene, self.mk, np.repeat(pts.reshape(-1, 1), self.n_c, axis=1))
-        pl, pu, pok = point_bands(s0, s1, scale, self.tol)
-        m = a.size
-        return det, N0, N1, pl.reshape(m, 3), pu.reshape(m, 3), pok.reshape(m, 3), np.ones((m, 1))
-
-    @staticmethod
-    def split(clo, chi, spread):
-        """Bisect each cell along the side where its control values vary most (``spread`` (m, d)).
-
-        Splitting a side along which the rows hardly change does not tighten the bound; the
-        widest side breaks ties (and is the choice where every side is flat).
-        """
-        width = chi - clo
-        if not width.shape[1]:
-            return clo, chi
-        k = np.argmax(spread * (width > 0) + SPLIT_TIE * width / np.maximum(width.max(axis=1, keepdims=True), 1e-300), axis=1)
-        rows = np.arange(clo.shape[0])
-        mid = 0.5 * (clo[rows, k] + chi[rows, k])
-        lo2, hi1 = clo.copy(), chi.copy()
-        hi1[rows, k] = mid
-        lo2[rows, k] = mid
-        return np.vstack([clo, lo2]), np.vstack([hi1, chi])
-
-
-def _spread(det, N0, N1, d):
-    """How much the control values change along each side of each cell, relative to their size, (m, d).
-
-    For side ``i``: the largest change between vertices that differ in coordinate ``i`` only, of
-    ``det`` and of every row's ``N0`` and ``N1``, each scaled by its largest magnitude on the cell.
-    """
-    m, K, _ = N0.shape
-    if d == 0:  # a point cell: nothing to split
-        return np.zeros((m, 0))
-
-    def unit(x, axes):
-        x = np.where(np.isfinite(x), x, 0.0)
-        return x / np.maximum(np.max(np.abs(x), axis=axes, keepdims=True), 1e-300)
-
-    X = np.concatenate([unit(det, 1)[:, :, None], unit(N0, (1, 2)), unit(N1, (1, 2))], axis=2)  # (m, K, 1 + 2R)
-    idx = np.arange(K)
-    return np.stack([np.max(np.abs(X[:, idx ^ (1 << i)] - X), axis=(1, 2)) for i in range(d)], axis=1)
-
-
-#: The band of each friction point from its rows ``s0 + tau s1 >= 0``: the effort-band intersection itself.
-point_bands = intersect_rows
 
 
 def cell_lower_bounds(det, N0, N1, g_lo, g_hi, tol: Tolerances):
@@ -286,7 +188,7 @@ def cell_lower_bounds(det, N0, N1, g_lo, g_hi, tol: Tolerances):
     return out, steady
 
 
-def _search(cells: _Cells, lo_, hi_, flip, atol, budget, tol):
+def _search(cells: FrictionCells, lo_, hi_, flip, atol, budget, tol):
     """Smallest effort of ``[lo_, hi_]`` possibly feasible; with ``flip`` the efforts are negated
     (pass ``-hi, -lo`` to find the largest).
 
@@ -341,8 +243,9 @@ def friction_set(lo, hi, n_c: int, shared: bool):
 
 
 def competitor_torques(scene, mode, lo, hi, g_lo, g_hi, shared=False, tol: Tolerances = DEFAULT_TOLERANCES,
-                       rtol: float = PRECLUSION_RTOL, max_cells: int = MAX_CELLS) -> CompetitorTorques:  # fmt: skip
-    """Efforts in ``[g_lo, g_hi]`` for which ``mode`` is feasible for some friction in the set.
+                       rtol: float = PRECLUSION_RTOL, max_cells: int = MAX_CELLS, *, disturbance=None) -> CompetitorTorques:  # fmt: skip
+    """Efforts in ``[g_lo, g_hi]`` for which ``mode`` is feasible for some friction in the set (and some wrench of
+    the disturbance box).
 
     Parameters
     ----------
@@ -361,6 +264,9 @@ def competitor_torques(scene, mode, lo, hi, g_lo, g_hi, shared=False, tol: Toler
         :data:`PRECLUSION_RTOL`.
     max_cells : int
         :data:`MAX_CELLS`.
+    disturbance : WrenchBox or (array-like, array-like), optional
+        A box of external wrenches on the workpiece (N, N, N m, added to ``g_obj``): the wrench is three
+        more sides of every cell (:mod:`qsplan.mechanics.bands.disturbance`, :mod:`qsplan.mechanics.bands.cells`).
 
     Returns
     -------
@@ -368,6 +274,7 @@ def competitor_torques(scene, mode, lo, hi, g_lo, g_hi, shared=False, tol: Toler
     """
     mode = mode_from_letters(mode)
     n_c = scene.n_contacts
+    box = check_wrench_box(disturbance)
     lo_a, hi_a = friction_set(lo, hi, n_c, shared)
     if not g_lo <= g_hi:
         raise SceneError(f"effort interval: expected g_lo <= g_hi; got {g_lo}, {g_hi}")
@@ -376,7 +283,7 @@ def competitor_torques(scene, mode, lo, hi, g_lo, g_hi, shared=False, tol: Toler
         return CompetitorTorques(mode.letters, np.nan, np.nan, True, True, f"kinematics: {mk.status}")
     if shared and hi_a == lo_a:
         shared, lo_a, hi_a = False, np.full(n_c, lo_a), np.full(n_c, hi_a)
-    cells = _Cells(scene, mk, lo_a, hi_a, shared, tol)
+    cells = FrictionCells(scene, mk, lo_a, hi_a, shared, tol, box)
     finite = [abs(x) for x in (g_lo, g_hi) if np.isfinite(x)]
     atol = rtol * max(finite + [1.0])
     low, ex1, n1, st1 = _search(cells, g_lo, g_hi, False, atol, max_cells, tol)

@@ -12,6 +12,9 @@ coefficient), :func:`robust_band` returns the efforts that
    branch and bound) are cut out; where a competitor's hull lies strictly inside, the larger
    piece is kept.
 
+With a ``disturbance`` (a box of external wrenches on the workpiece, :mod:`qsplan.mechanics.bands.disturbance`)
+both hold for every wrench of the box as well.
+
 This is the one implementation: the band sweeps along a segment
 (:func:`qsplan.planner.torque.pointwise.guaranteed_sweep`) call it at every sample.  Efforts
 are N m (revolute) or N (prismatic); unbounded sides are ``inf``.
@@ -23,6 +26,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from qsplan.mechanics.bands.disturbance import WrenchBox, check_wrench_box
 from qsplan.mechanics.bands.effort import Band, band_kinematics
 from qsplan.mechanics.bands.guaranteed import guaranteed_band_box, guaranteed_band_shared
 from qsplan.mechanics.bands.preclusion import CompetitorTorques, competitor_torques
@@ -71,6 +75,8 @@ class RobustBand:
     mu_range : (float, float)
     shared : bool
         One coefficient shared by all contacts (else each contact's independently).
+    disturbance : WrenchBox or None
+        The box of external wrenches the band withstands (:mod:`qsplan.mechanics.bands.disturbance`); None: none.
     """
 
     mode: str
@@ -85,6 +91,7 @@ class RobustBand:
     reason: str | None
     mu_range: tuple
     shared: bool
+    disturbance: WrenchBox | None = None
 
     @property
     def width(self) -> float:
@@ -131,8 +138,10 @@ def check_mu_pair(mu_range):
     return check_mu_range(lo, hi)
 
 
-def robust_band(scene, mode, mu_range, *, shared: bool = False, competitors=None, force_margin=None) -> RobustBand:
-    """The efforts that guarantee ``mode`` and preclude every competitor for all friction in the set.
+def robust_band(scene, mode, mu_range, *, shared: bool = False, competitors=None, force_margin=None,
+                disturbance=None) -> RobustBand:  # fmt: skip
+    """The efforts that guarantee ``mode`` and preclude every competitor for all friction in the set
+    (and every wrench of the disturbance box).
 
     Parameters
     ----------
@@ -149,6 +158,10 @@ def robust_band(scene, mode, mu_range, *, shared: bool = False, competitors=None
     force_margin : ForceMargin or (float, float), optional
         Minimum normal force and Coulomb slack (N) the desired mode keeps for every friction in the set
         (:class:`qsplan.mechanics.bands.effort.ForceMargin`; competitors are precluded without one).
+    disturbance : WrenchBox or (array-like, array-like), optional
+        A box of external wrenches on the workpiece (N, N, N m, about the point of ``g_obj`` and added to it):
+        the desired mode is kept and every competitor precluded for each one (exact or conservative and
+        labelled, :mod:`qsplan.mechanics.bands.disturbance`).  None or zeros: no disturbance.
 
     Returns
     -------
@@ -157,7 +170,7 @@ def robust_band(scene, mode, mu_range, *, shared: bool = False, competitors=None
     Raises
     ------
     QsplanError
-        Bad friction range, or the scene has not exactly one effort-controlled joint.
+        Bad friction range or disturbance box, or the scene has not exactly one effort-controlled joint.
 
     References
     ----------
@@ -165,24 +178,27 @@ def robust_band(scene, mode, mu_range, *, shared: bool = False, competitors=None
     """
     lo, hi = check_mu_pair(mu_range)
     mode = check_mode_fits(scene, mode)
+    box = check_wrench_box(disturbance)
     comps = admissible_competitors([scene], mode) if competitors is None else tuple(competitors)
     guaranteed = guaranteed_band_shared if shared else guaranteed_band_box
-    desired = guaranteed(scene, mode, lo, hi, force_margin=force_margin)
+    desired = guaranteed(scene, mode, lo, hi, force_margin=force_margin, disturbance=box)
     torques = {}
     if desired.feasible:
         g_lo, g_hi = desired.lower + 0.0, desired.upper + 0.0  # + 0.0: no negative zero
-        torques = {c: competitor_torques(scene, c, lo, hi, g_lo, g_hi, shared=shared) for c in comps}
-    return assemble_robust_band(mode, desired, comps, torques, (lo, hi), shared)
+        torques = {c: competitor_torques(scene, c, lo, hi, g_lo, g_hi, shared=shared, disturbance=box) for c in comps}
+    return assemble_robust_band(mode, desired, comps, torques, (lo, hi), shared, box)
 
 
-def assemble_robust_band(mode, desired: Band, comps, torques: dict, mu_range, shared) -> RobustBand:
+def assemble_robust_band(mode, desired: Band, comps, torques: dict, mu_range, shared, disturbance=None) -> RobustBand:
     """The :class:`RobustBand` from the desired mode's guaranteed band and each competitor's
     :class:`CompetitorTorques` inside it (``torques``: competitor letters to their hulls; empty
     when ``desired`` is infeasible).  The one place :func:`robust_band` and its batched twin
-    (:func:`qsplan.mechanics.bands.batched_robust.robust_bands`) cut the competitors out.
+    (:func:`qsplan.mechanics.bands.batched_robust.robust_bands`) cut the competitors out.  ``disturbance``: the
+    (checked) wrench box both were computed for, recorded.
     """
     mode = mode_from_letters(mode)
-    common = dict(mode=mode.letters, desired=desired, competitors=tuple(comps), mu_range=tuple(mu_range), shared=bool(shared))
+    common = dict(mode=mode.letters, desired=desired, competitors=tuple(comps), mu_range=tuple(mu_range), shared=bool(shared),
+                  disturbance=disturbance)  # fmt: skip
     if not desired.feasible:
         return RobustBand(lower=np.nan, upper=np.nan, feasible=False, exact=bool(desired.exact), split=False,
                           precluded={}, reason=desired.reason, **common)  # fmt: skip
@@ -215,7 +231,7 @@ def assemble_robust_band(mode, desired: Band, comps, torques: dict, mu_range, sh
             notes.append(f"{c} possible inside the band: kept the larger piece")
     feasible = not np.isnan(a)
     if not feasible:
-        notes.append("competitors possible over the whole band")
+        notes.append("competitors possible over the whole band" + (" (with the disturbance box)" if disturbance is not None else ""))
         a = b = np.nan
     return RobustBand(lower=a, upper=b, feasible=feasible, exact=exact, split=split, precluded=hulls,
                       reason="; ".join(notes) or desired.reason, **common)  # fmt: skip
