@@ -27,7 +27,7 @@ import tomllib
 
 import numpy as np
 
-from qsplan.hands.described import make_described_hand
+from qsplan.hands.described_build import make_described_hand
 from qsplan.hands.description import load_hand
 from qsplan.mechanics.bands.batched import LazyScenes, batch_from_arrays
 from qsplan.mechanics.bands.batched_robust import robust_band_arrays

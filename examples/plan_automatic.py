@@ -18,8 +18,8 @@ def main(out="out/examples/automatic"):
     task = make_task(hand, start_x=0.0, goal={"x": -0.03, "left": "vertex:3"}, mu_range=(0.0, 0.2),
                      torque_resolution=0.02, name="automatic: 3 cm left")  # fmt: skip
     run = run_plan(task, out, verify=3, force=True)  # plan, export, certify, re-simulate, plots
-    for step in run.plan.sequence[:-1]:  # the sequence the planner chose
-        print(step)
+    for step in run.plan.sequence[:-1]:  # the steps the planner chose (qsplan.planner.plan.steps)
+        print(step.as_dict())
     print(run.certificate.summary())
     print(f"narrowest band {run.plan.narrowest()[2]:.4g} N m; wrote {out}/ (plan.csv, plan_card.png, ...)")
 

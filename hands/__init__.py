@@ -99,10 +99,11 @@ _LAZY = {
     "FingerContact": "qsplan.hands.protocol",
     "STATE_REASONS": "qsplan.hands.protocol",
     "DescribedHand": "qsplan.hands.described",
-    "make_described_hand": "qsplan.hands.described",
-    "described_from_two_finger": "qsplan.hands.described",
-    "described_from_chain": "qsplan.hands.described",
-    "hand_from_metadata": "qsplan.hands.described",
+    "make_described_hand": "qsplan.hands.described_build",
+    "as_hand": "qsplan.hands.described_build",
+    "described_from_two_finger": "qsplan.hands.described_build",
+    "described_from_chain": "qsplan.hands.described_build",
+    "hand_from_metadata": "qsplan.hands.described_build",
 }
 
 __all__ = list(_LAZY)

@@ -9,25 +9,29 @@ description is of the paper's form (two single-link revolute fingers, Fig. 9;
 instead (:mod:`qsplan.hands.paper_accelerator`): decided once at construction, ``accelerated=False``
 forces the generic path (the tests compare the two).
 
-Build one with :func:`make_described_hand` (a description and a workpiece), or convert today's hands:
-:func:`described_from_two_finger` (the paper's :class:`~qsplan.hands.two_finger.TwoFingerHand`, given by
-its parameters), :func:`described_from_chain` (a :class:`~qsplan.hands.chain_hand.ChainHand`).
-:meth:`DescribedHand.metadata` and :func:`hand_from_metadata` round-trip (the paper hand by today's
+Build one with :func:`qsplan.hands.described_build.make_described_hand` (a description and a workpiece), or convert today's hands:
+:func:`~qsplan.hands.described_build.described_from_two_finger` (the paper's :class:`~qsplan.hands.two_finger.TwoFingerHand`, given by
+its parameters), :func:`~qsplan.hands.described_build.described_from_chain` (a :class:`~qsplan.hands.chain_hand.ChainHand`).
+:meth:`DescribedHand.metadata` and :func:`~qsplan.hands.described_build.hand_from_metadata` round-trip (the paper hand by today's
 keys).  Units SI (m, kg, rad, N, N m).
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from functools import lru_cache
 
 import numpy as np
 
 from qsplan.hands.formations import FORMATIONS, Formation, formation as registered_formation
 from qsplan.mechanics.errors import QsplanError
 
-__all__ = ["DescribedHand", "described_from_chain", "described_from_two_finger", "hand_from_metadata",
-           "make_described_hand"]
+__all__ = ["DescribedHand"]
+
+
+#: The parameters of the paper hand's form (:class:`qsplan.hands.two_finger.TwoFingerHand`) a described hand of that
+#: form answers (:meth:`DescribedHand.__getattr__`).
+_PAPER_PARAMETERS = frozenset({"finger_base", "finger_length", "finger_width", "finger_mass", "palm_halfwidth",
+                               "palm_thickness", "pivots"})
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -73,6 +77,15 @@ class DescribedHand:
     user_vertices: np.ndarray
     user_edges: np.ndarray
     closings: dict = field(default_factory=dict, repr=False)
+
+    def __getattr__(self, name):
+        """The paper form's parameters (``finger_length``, ``finger_base``, ``pivots``, ...), read from its record: a
+        described hand of the paper's form answers them as the hand of Fig. 9 always did."""
+        if name in _PAPER_PARAMETERS:
+            paper = object.__getattribute__(self, "paper")
+            if paper is not None:
+                return getattr(paper, name)
+        raise AttributeError(f"{type(self).__name__!r} object has no attribute {name!r}")
 
     @property
     def name(self) -> str:
@@ -142,13 +155,14 @@ class DescribedHand:
 
         return hand_body_polygons(self.paper if self.accelerated else self.chain, pose, q)
 
-    def grasp_candidates(self, formation="palm_edge", free=None) -> tuple:
+    def grasp_candidates(self, formation="palm_edge", free=None, xs=None) -> tuple:
         """The grasps the planner's tables consider.
 
         The paper's closed forms: :func:`qsplan.hands.grasp_geometry.candidate_grasps`.  The generic path
         (:func:`qsplan.hands.described_candidates.chain_candidates`): along the palm, from each row of ``free``
         (m, n_free; default the free joints mid-range), the distinct contact pairs the closing gives (both fingers
-        touching, neither flush), as :class:`~qsplan.hands.protocol.ChainGrasp`, by ``free``'s rows then contact keys.
+        touching, neither flush) at ``xs`` (default along the palm), as :class:`~qsplan.hands.protocol.ChainGrasp`, by
+        ``free``'s rows then contact keys.
         """
         from qsplan.hands.described_candidates import chain_candidates
 
@@ -157,7 +171,7 @@ class DescribedHand:
             from qsplan.hands.grasp_geometry import candidate_grasps
 
             return candidate_grasps(self.paper)
-        return chain_candidates(self, formation, free)
+        return chain_candidates(self, formation, free, xs)
 
     def grasp_states(self, formation, grasp, xs, free=None):
         """The grasp at workpiece ``xs`` (n,) (m): :class:`qsplan.hands.protocol.GraspStates`.
@@ -204,6 +218,33 @@ class DescribedHand:
 
         return state_scene_of(self, arrays, s, effort_controlled, velocity, effort, mu)
 
+    @property
+    def simulation_travel(self) -> float | None:
+        """Largest workpiece travel (m) per step of a finite-motion simulation of this hand, or None (no bound): the
+        polygon search finds a described hand's contacts at every stage of a step and refuses a penetration beyond
+        the contact tolerance (1e-6 m), which a stage's Euler-like prediction reaches at about travel^2 / (2 R); at
+        0.1 mm it stays within it for contact paths of radius down to 5 mm.  The paper's closed forms need none."""
+        return None if self.accelerated else 1e-4
+
+    def reclose(self, pose, q_planned, planned_pose) -> np.ndarray:
+        """The plan's grasp (joints ``q_planned`` at ``planned_pose``) closed on the workpiece at ``pose`` (n_j,):
+        :func:`qsplan.hands.reclose.reclose`."""
+        from qsplan.hands.reclose import reclose
+
+        return reclose(self, pose, q_planned, planned_pose)
+
+    def closed_configuration(self, formation, grasp, x, free=None) -> np.ndarray:
+        """The joints (n_j,) of ``grasp`` closed at ``x`` (m): :func:`qsplan.hands.motion.closed_configuration`."""
+        from qsplan.hands.motion import closed_configuration
+
+        return closed_configuration(self, _formation(formation), grasp, x, free)
+
+    def slide_motion(self, formation, grasp, xs, xdot, effort_joint: int, free=None, free_rates=None):
+        """The grasp held while the workpiece slides at ``xdot`` (m/s): :func:`qsplan.hands.motion.slide_motion`."""
+        from qsplan.hands.motion import slide_motion
+
+        return slide_motion(self, _formation(formation), grasp, _positions(xs), xdot, effort_joint, free, free_rates)
+
     def scene(self, pose, q, effort_controlled, velocity, effort=None, mu=None, method: str = "auto"):
         """One :class:`qsplan.mechanics.Scene` (contacts palm, palm, left, right) at ``pose`` (3,) and ``q`` (n_j,).
 
@@ -239,6 +280,8 @@ class DescribedHand:
         """
         from qsplan.hands.grasps import Grasp
 
+        if self.accelerated and grasp is None:  # the default grasp, both inner edges: the left finger opens
+            return np.array([1.0, -1.0])  # counter-clockwise, the right one clockwise
         if self.accelerated and isinstance(grasp, Grasp):
             from qsplan.hands.paper_accelerator import paper_opening
 
@@ -271,113 +314,3 @@ def _positions(xs) -> np.ndarray:
     if xs.ndim != 1 or not np.all(np.isfinite(xs)):
         raise QsplanError(f"xs: expected a finite 1-D array of workpiece x (m); got shape {xs.shape}")
     return xs
-
-
-def _user_maps(chain) -> tuple:
-    from qsplan.hands.grasps import user_edge, user_vertex
-
-    k = len(chain.workpiece)
-    return (np.array([user_vertex(chain, i) for i in range(k)], dtype=int),
-            np.array([user_edge(chain, i) for i in range(k)], dtype=int))  # fmt: skip
-
-
-def described_from_chain(chain, accelerated: bool = True, own_limits="description") -> DescribedHand:
-    """A :class:`~qsplan.hands.chain_hand.ChainHand` as a :class:`DescribedHand` (the paper's closed forms where its
-    description has the paper's form and ``accelerated``).  ``own_limits``: the description's by default."""
-    from qsplan.hands.described_scenes import contact_view
-    from qsplan.hands.description.two_finger_form import two_finger_parameters
-    from qsplan.hands.two_finger import TwoFingerHand
-
-    desc = chain.description
-    params = two_finger_parameters(desc)
-    paper = None if params is None else TwoFingerHand(chain.workpiece, chain.workpiece_mass, mu=chain.mu,
-                                                      vertex_order=chain.vertex_order,
-                                                      vertex_of_user=chain.vertex_of_user, **params)  # fmt: skip
-    limits = (desc.joint_limits, desc.joint_speeds) if own_limits == "description" else own_limits
-    return DescribedHand(desc, chain.workpiece, chain.workpiece_mass, chain.mu, chain.vertex_order, chain.vertex_of_user,
-                         limits, bool(accelerated and paper is not None), chain, paper, contact_view(desc),
-                         *_user_maps(chain))  # fmt: skip
-
-
-def make_described_hand(description, workpiece, workpiece_mass=0.2, mu=0.2, palm_edge=None,
-                        accelerated: bool = True) -> DescribedHand:  # fmt: skip
-    """Validate and build a :class:`DescribedHand`.
-
-    Parameters
-    ----------
-    description : qsplan.hands.description.HandDescription
-    workpiece : array-like, shape (k, 2)
-        Convex polygon (m) (:func:`qsplan.hands.workpiece.prepare_workpiece`).
-    workpiece_mass : float
-        kg, positive.
-    mu : float
-        Friction coefficient, nonnegative.
-    palm_edge : int, optional
-        The edge, as written, that rests on the palm.
-    accelerated : bool
-        Let the paper's closed forms answer where the description has the paper's form.
-
-    Raises
-    ------
-    SceneError
-        Naming the field.
-    """
-    from qsplan.hands.chain_hand import make_chain_hand
-
-    return described_from_chain(make_chain_hand(description, workpiece, workpiece_mass, mu, palm_edge), accelerated)
-
-
-@lru_cache(maxsize=1)
-def _paper_file_limits() -> tuple:
-    """The bundled paper hand file's joint range (rad) and speed (rad/s) (``hands/data/paper_hand.toml``)."""
-    from qsplan.hands.description.files import load_hand
-
-    desc = load_hand("paper_hand")
-    return tuple(float(v) for v in desc.joint_limits[0]), float(desc.joint_speeds[0])
-
-
-def described_from_two_finger(hand, joint_limits=None, joint_speed=None, accelerated: bool = True) -> DescribedHand:
-    """The paper's :class:`~qsplan.hands.two_finger.TwoFingerHand` (its parameters) as a :class:`DescribedHand`.
-
-    Parameters
-    ----------
-    hand : TwoFingerHand
-    joint_limits : array-like, shape (2,) or (2, 2), optional
-        The fingers' ranges (rad) the generic closing closes within; default the bundled paper hand file's.
-    joint_speed : float or array-like, shape (2,), optional
-        rad/s; default the bundled paper hand file's.
-    accelerated : bool
-
-    Notes
-    -----
-    ``own_limits`` is None: a hand given by its parameters has none (a task's ``[limits]`` give them).
-    """
-    from qsplan.hands.chain_hand import ChainHand
-    from qsplan.hands.described_scenes import contact_view
-    from qsplan.hands.description.two_finger_form import describe_two_finger_hand
-
-    lim, speed = _paper_file_limits()
-    desc = describe_two_finger_hand(hand, lim if joint_limits is None else joint_limits,
-                                    speed if joint_speed is None else joint_speed, name="paper hand")  # fmt: skip
-    k = len(hand.workpiece)
-    order = hand.vertex_order if hand.vertex_order is not None else tuple(range(k))
-    of_user = hand.vertex_of_user if hand.vertex_of_user is not None else tuple(range(k))
-    chain = ChainHand(desc, hand.workpiece, hand.workpiece_mass, hand.mu, order, of_user)
-    return DescribedHand(desc, hand.workpiece, hand.workpiece_mass, hand.mu, order, of_user, None, bool(accelerated),
-                         chain, hand, contact_view(desc), *_user_maps(chain))  # fmt: skip
-
-
-def hand_from_metadata(meta, accelerated: bool = True) -> DescribedHand:
-    """The hand a plan's ``metadata["hand"]`` records (:meth:`DescribedHand.metadata`).
-
-    Raises
-    ------
-    QsplanError
-        Naming the field (:func:`qsplan.hands.interface.hand_from_metadata`).
-    """
-    from qsplan.hands.interface import hand_from_metadata as recorded, is_chain_hand
-
-    hand = recorded(meta)
-    if is_chain_hand(hand):
-        return described_from_chain(hand, accelerated)
-    return described_from_two_finger(hand, accelerated=accelerated)

@@ -41,7 +41,7 @@ def free_rows(hand, free=None) -> np.ndarray:
     return rows
 
 
-def chain_candidates(hand, formation, free=None) -> tuple:
+def chain_candidates(hand, formation, free=None, xs=None) -> tuple:
     """The :class:`~qsplan.hands.protocol.ChainGrasp` candidates of a described hand (see the module docstring).
 
     Parameters
@@ -50,6 +50,9 @@ def chain_candidates(hand, formation, free=None) -> tuple:
     formation : qsplan.hands.formations.Formation
     free : array-like, shape (m, n_free), optional
         Free-joint values (rad or m), one grasp family per row.
+    xs : array-like, shape (k,), optional
+        The workpiece positions (m) to close at (default :data:`CANDIDATE_SAMPLES` along the palm; one x: the grasps
+        there, as a planner asks at a start or a goal).
 
     Returns
     -------
@@ -60,7 +63,7 @@ def chain_candidates(hand, formation, free=None) -> tuple:
 
     check_formation(formation)
     rows = free_rows(hand, free)
-    xs = np.linspace(*hand.palm_range, CANDIDATE_SAMPLES)
+    xs = np.linspace(*hand.palm_range, CANDIDATE_SAMPLES) if xs is None else np.atleast_1d(np.asarray(xs, float))
     m, n = len(rows), len(xs)
     _, _, _, (left, right) = close_states(hand, np.tile(xs, m), np.repeat(rows, n, axis=0))
     good = left.found & right.found & ~left.flush & ~right.flush

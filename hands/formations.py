@@ -102,6 +102,13 @@ class Formation:
     def contact_names(self) -> tuple:
         return tuple(c.name for c in self.contacts)
 
+    def as_dict(self) -> dict:
+        """The formation as ``plan.json`` metadata records it: ``name``, ``mode`` and each contact's ``name``,
+        ``body``, ``feature`` (and ``workpiece_vertex`` for a palm contact), in scene order."""
+        contacts = [{"name": c.name, "body": c.body, "feature": c.feature,
+                     **({} if c.index is None else {"workpiece_vertex": c.index})} for c in self.contacts]  # fmt: skip
+        return {"name": self.name, "mode": self.mode, "contacts": contacts}
+
     def bodies(self, body: str) -> tuple:
         """Indices of the contacts on ``body`` (``"palm"``, ``"left"``, ``"right"``), in scene order."""
         return tuple(i for i, c in enumerate(self.contacts) if c.body == body)

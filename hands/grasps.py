@@ -31,7 +31,10 @@ __all__ = [
     "parse_goal",
     "parse_grasp",
     "parse_placement",
+    "grasp_meets",
+    "no_placement_words",
     "placement_matches",
+    "touch_words",
     "user_edge",
     "user_vertex",
 ]
@@ -200,3 +203,43 @@ def parse_grasp(text, field: str = "grasp") -> Grasp:
         raise SceneError(f"{field}: expected 'L <placement> / R <placement>'; got {text!r}")
     left, right = (parse_placement(s[1], f"{field}.{name}") for s, name in zip(sides, JOINT_NAMES))
     return Grasp(left, right)
+
+
+def touch_words(hand, grasp, finger: int, touched: int) -> str:
+    """What finger ``finger`` (0 left, 1 right) of ``grasp`` touches, in words and the polygon's numbering as written:
+    a paper :class:`Grasp` by its placement and the feature ``touched`` (the hand's numbering), a
+    :class:`~qsplan.hands.protocol.ChainGrasp` by its contact (``touched`` unused)."""
+    side = ("left", "right")[finger]
+    placement = (grasp.left, grasp.right)[finger]
+    if isinstance(placement, TipOnEdge):
+        return f"the {side} fingertip on edge {user_edge(hand, touched)}"
+    if isinstance(placement, OnVertex):
+        return f"the {side} finger's inner edge on vertex {user_vertex(hand, touched)}"
+    return f"the {side} finger's {placement}"
+
+
+def no_placement_words(grasp, finger: int) -> str:
+    """Why ``finger`` (0 left, 1 right) has no contact of a paper ``grasp``'s placement, in words."""
+    side = ("left", "right")[finger]
+    placement = (grasp.left, grasp.right)[finger]
+    if isinstance(placement, TipOnEdge):
+        return (f"the {side} fingertip cannot rest on edge {placement.edge} (out of reach, at an end of the edge, "
+                "or the finger would cross the workpiece)")  # fmt: skip
+    return (f"the {side} finger's inner edge cannot rest on a workpiece vertex (the vertex of tangency lies beyond "
+            "the finger's length, or the finger would cross the workpiece)")  # fmt: skip
+
+
+def grasp_meets(hand, grasp, touched, feats) -> bool:
+    """Whether ``grasp`` touching ``touched`` (per finger, :meth:`qsplan.hands.protocol.GraspStates.touching`) meets the
+    features ``feats`` (left, right: ``"vertex"``, ``"vertex:K"``, ``"edge:K"`` or None; the user's numbering): its
+    placements (or contacts) match, and a paper placement's ``"vertex:K"`` is the vertex it touches there."""
+    if not grasp.matches(*feats):
+        return False
+    if not isinstance(grasp, Grasp):  # contact keys: matches() compared the features themselves
+        return True
+    for k, f in enumerate(feats):
+        if f is not None and f.startswith("vertex:"):
+            t = int(touched[k])
+            if t < 0 or user_vertex(hand, t) != int(f.split(":")[1]):
+                return False
+    return True

@@ -42,6 +42,7 @@ __all__ = [
     "link_width",
     "manipulator_of",
     "palm_thickness",
+    "range_fields",
     "scene_at",
 ]
 
@@ -50,17 +51,26 @@ JOINT_UNITS = {"revolute": {"q": "rad", "qd": "rad/s", "tau": "N m"},
                "prismatic": {"q": "m", "qd": "m/s", "tau": "N"}}  # fmt: skip
 
 
+def _record(hand):
+    """The record the implementations below answer from: a described hand's (:class:`qsplan.hands.described.
+    DescribedHand`) paper record where its closed forms answer (accelerated), else its chain record; today's records
+    as they are.  (Read by attribute, so that this module does not import the described hand, which builds on it.)"""
+    if hasattr(hand, "accelerated") and hasattr(hand, "chain"):
+        return hand.paper if hand.accelerated else hand.chain
+    return hand
+
+
 def _two_finger(hand) -> bool:
     from qsplan.hands.two_finger import TwoFingerHand
 
-    return isinstance(hand, TwoFingerHand)
+    return isinstance(_record(hand), TwoFingerHand)
 
 
 def is_chain_hand(hand) -> bool:
-    """Whether ``hand`` is a :class:`~qsplan.hands.chain_hand.ChainHand` (a described hand)."""
+    """Whether ``hand`` answers as a described chain hand (not by the paper's closed forms)."""
     from qsplan.hands.chain_hand import ChainHand
 
-    return isinstance(hand, ChainHand)
+    return isinstance(_record(hand), ChainHand)
 
 
 def _check(hand) -> bool:
@@ -74,6 +84,7 @@ def _check(hand) -> bool:
 
 def manipulator_of(hand):
     """The hand's :class:`~qsplan.mechanics.model.manipulator.Manipulator` (palm as the base, one link per joint)."""
+    hand = _record(hand)
     if _check(hand):
         return hand.manipulator
     from qsplan.hands.two_finger_scene import hand_manipulator
@@ -83,6 +94,7 @@ def manipulator_of(hand):
 
 def joint_names(hand) -> tuple:
     """Joint names in the hand's joint order (``("left", "right")`` for the paper's hand)."""
+    hand = _record(hand)
     if _check(hand):
         return tuple(hand.joint_names)
     from qsplan.hands.two_finger import JOINT_NAMES
@@ -92,6 +104,7 @@ def joint_names(hand) -> tuple:
 
 def joint_kinds(hand) -> tuple:
     """``"revolute"`` or ``"prismatic"`` per joint, in joint order."""
+    hand = _record(hand)
     if _check(hand):
         return tuple(hand.description.joint_kinds)
     return ("revolute", "revolute")
@@ -107,6 +120,7 @@ def joint_units(hand, quantity: str = "q") -> tuple:
 
 def finger_joint_names(hand) -> tuple:
     """``(left finger's joints, right finger's joints)``, each a tuple of names from the palm to the tip."""
+    hand = _record(hand)
     if _check(hand):
         names = hand.joint_names
         return tuple(tuple(names[j] for j in hand.finger_joints(f)) for f in range(2))
@@ -128,6 +142,7 @@ def hand_body_polygons(hand, pose, q) -> dict:
     q : array-like, shape (n_j,)
         Joint positions (rad or m); for the paper's hand None gives the fingers' tangency angles.
     """
+    hand = _record(hand)
     if _check(hand):
         from qsplan.hands.chain_hand import chain_polygons
 
@@ -166,6 +181,7 @@ def scene_at(hand, pose, q, effort_controlled, velocity, effort=None, mu=None, m
     SceneError
         Naming the field: the polygons give another contact set, or bad inputs.
     """
+    hand = _record(hand)
     if _check(hand):
         from qsplan.hands.chain_hand import chain_scene
 
@@ -193,6 +209,7 @@ def contacts_at(hand, pose, q) -> list:
     SceneError
         When the polygons give another contact set.
     """
+    hand = _record(hand)
     if _check(hand):
         from qsplan.hands.chain_hand import chain_contacts, chain_geometric_scene
 
@@ -203,8 +220,27 @@ def contacts_at(hand, pose, q) -> list:
     return hand_contacts(hand_geometric_scene(hand, pose, q))
 
 
+def range_fields(hand) -> list:
+    """``[(field, value, kind)]``: the hand's numbers a task checks against its plausible ranges (``kind`` a key of
+    ``qsplan.planner.task.fields.TASK_RANGES``): the paper's parameters when given so (finger sizes and mass, the
+    palm), and for every hand the workpiece's span, mass, gravity and friction (a described hand's own numbers are
+    checked by its file's ranges, :data:`qsplan.hands.description.model.HAND_RANGES`)."""
+    hand = _record(hand)
+    out = []
+    if not _check(hand):
+        out += [(f"hand.{name}", float(getattr(hand, name)), "size")
+                for name in ("finger_base", "finger_length", "finger_width", "palm_halfwidth", "palm_thickness")]  # fmt: skip
+    out.append(("hand.workpiece (its width or height)", float(np.max(np.ptp(hand.workpiece, axis=0))), "size"))
+    out.append(("hand.workpiece_mass", float(hand.workpiece_mass), "mass"))
+    if not _check(hand):
+        out.append(("hand.finger_mass", float(hand.finger_mass), "finger_mass"))
+    out += [("hand.gravity", float(hand.gravity), "gravity"), ("hand.mu", float(hand.mu), "friction")]
+    return out
+
+
 def palm_thickness(hand) -> float:
     """How far (m) the palm reaches below its top ``y = 0``: ``-min y`` of the palm polygon."""
+    hand = _record(hand)
     if _check(hand):
         return float(-np.asarray(hand.description.palm)[:, 1].min())
     return float(hand.palm_thickness)
@@ -225,6 +261,7 @@ def _width(polygon) -> float:
 def link_width(hand) -> float:
     """A characteristic link width (m): the paper's finger width; for a chain hand the narrowest width of its
     narrowest link polygon (the scale of the marks drawn on links)."""
+    hand = _record(hand)
     if _check(hand):
         return min(_width(j.link_shape) for j in hand.manipulator.joints if j.link_shape is not None)
     return float(hand.finger_width)
@@ -233,6 +270,7 @@ def link_width(hand) -> float:
 def finger_reach(hand) -> float:
     """A characteristic finger length (m): the paper's finger length; for a chain hand the longer finger's sum, over
     its links, of the farthest link vertex from the link's frame origin (the scale of the drawn contact normals)."""
+    hand = _record(hand)
     if _check(hand):
         joints = hand.manipulator.joints
         return max(sum(float(np.max(np.hypot(*np.asarray(joints[j].link_shape, dtype=float).T)))
@@ -243,6 +281,7 @@ def finger_reach(hand) -> float:
 def joint_axes(hand, q) -> np.ndarray:
     """World position (m) of each joint's frame origin at ``q``, shape (n_j, 2): a revolute joint's axis, where a
     prismatic joint's link frame sits at ``q_i = 0``.  The paper's fingers turn about fixed pivots."""
+    hand = _record(hand)
     if _check(hand):
         from qsplan.hands.description.model import joint_frames
 
@@ -284,6 +323,7 @@ def hand_metadata(hand) -> dict:
     ``description`` (:func:`description_table`), ``description_source``, ``workpiece_vertices_m`` (internal
     form: about the centroid, counter-clockwise from the bottom edge's left end), ``workpiece_mass_kg``, ``mu``.
     """
+    hand = _record(hand)
     if _check(hand):
         return {"description": description_table(hand), "description_source": hand.description.source,
                 "workpiece_vertices_m": hand.workpiece.tolist(), "workpiece_mass_kg": float(hand.workpiece_mass),

@@ -24,7 +24,8 @@ import numpy as np
 
 from qsplan.hands.grasps import parse_goal
 
-__all__ = ["CONTACT_KINDS", "ChainGrasp", "FingerContact", "GraspSceneArrays", "GraspStates", "Hand", "STATE_REASONS",
+__all__ = ["CONTACT_KINDS", "ChainGrasp", "FingerContact", "GraspSceneArrays", "GraspStates", "Hand", "SlideMotion",
+           "STATE_REASONS",
            "NO_CONTACT", "OTHER_CONTACT", "FLUSH", "NO_PLACEMENT", "SINGULAR"]
 
 #: A finger contact's kind: ``"vertex"``, a workpiece vertex on a link edge; ``"edge"``, a link vertex (a corner)
@@ -198,8 +199,23 @@ class GraspStates:
         return replace(self, **{f.name: getattr(self, f.name)[rows] for f in fields(self) if f.name not in fixed})
 
     def why(self, k: int) -> str | None:
-        """Why state ``k`` is not ok, in words (None where it is)."""
+        """Why state ``k`` is not ok, in words (None where it is): a paper placement without a configuration names the
+        finger and how (:func:`qsplan.hands.grasps.no_placement_words`)."""
+        if int(self.reason[k]) == NO_PLACEMENT and not isinstance(self.grasp, ChainGrasp):
+            from qsplan.hands.grasps import no_placement_words
+
+            return no_placement_words(self.grasp, int(np.argmin(self.finger_ok[k])))
         return STATE_REASONS.get(int(self.reason[k]))
+
+    def touching(self) -> np.ndarray:
+        """What each finger touches, as an integer per finger and state that changes when its contact changes, shape
+        (n, 2): a paper placement's feature (the hand's numbering), a chain contact's ``(link, kind, feature)`` code."""
+        if not isinstance(self.grasp, ChainGrasp):
+            return self.touched
+        left, right = self.formation.finger_contacts
+        link = self.bodies[:, [left[0], right[0]]]
+        kind = np.broadcast_to(np.asarray(self.tip, dtype=int), self.touched.shape)
+        return (link * 2 + kind) * 1000 + self.touched
 
     def matches(self, goal_left=None, goal_right=None) -> np.ndarray:
         """Where the grasp meets the goal placements (strings as :meth:`qsplan.hands.grasps.Grasp.matches` takes them),
@@ -260,6 +276,30 @@ class GraspSceneArrays:
     closed_form: bool = False
 
 
+@dataclass(frozen=True, slots=True, eq=False)
+class SlideMotion:
+    """A grasp at ``n`` workpiece positions of a slide.
+
+    Attributes
+    ----------
+    poses : ndarray, shape (n, 3)
+        Workpiece poses (m, m, rad).
+    q, qd : ndarray, shape (n, n_j)
+        Joint positions (rad or m) and rates (rad/s or m/s): the velocity-controlled joints' commands; the
+        effort-controlled joint's rate is the one the contacts give it (its command is an effort).
+    touching : ndarray of int, shape (n, 2)
+        What each finger touches, as a code that changes when the contact changes (the paper's hand: the workpiece
+        vertex; any hand: :func:`touch_codes`).
+    scenes : tuple of Scene, length n
+    """
+
+    poses: np.ndarray
+    q: np.ndarray
+    qd: np.ndarray
+    touching: np.ndarray
+    scenes: tuple
+
+
 @runtime_checkable
 class Hand(Protocol):
     """A planar hand holding a workpiece (Section 5.2): what the planner, export, certifier, replay and plots ask.
@@ -316,8 +356,9 @@ class Hand(Protocol):
     def body_polygons(self, pose, q) -> dict:
         """World polygons (m): ``{"palm", "workpiece", <joint name>...}`` -> (k, 2), at ``pose`` (3,) and ``q`` (n_j,)."""
 
-    def grasp_candidates(self, formation, free=None) -> tuple:
-        """The grasps the planner's tables consider; ``free`` (m, n_free): free-joint values to close from."""
+    def grasp_candidates(self, formation, free=None, xs=None) -> tuple:
+        """The grasps the planner's tables consider; ``free`` (m, n_free): free-joint values to close from, at workpiece
+        positions ``xs`` (default along the palm)."""
 
     def grasp_states(self, formation, grasp, xs, free=None) -> GraspStates:
         """The grasp at every workpiece x of ``xs`` (n,) (``free`` (n, n_free): per-state free joints)."""
@@ -327,6 +368,15 @@ class Hand(Protocol):
 
     def state_scene(self, arrays: GraspSceneArrays, s: int, effort_controlled, velocity, effort=None, mu=None):
         """The :class:`qsplan.mechanics.Scene` of state ``s`` of ``arrays`` under the given joint inputs."""
+
+    def closed_configuration(self, formation, grasp, x, free=None) -> np.ndarray:
+        """The joints (n_j,) of ``grasp`` closed onto the workpiece at ``x`` (m), geometry only (raises
+        :class:`~qsplan.mechanics.errors.SceneError` where it has none)."""
+
+    def slide_motion(self, formation, grasp, xs, xdot, effort_joint: int, free=None, free_rates=None):
+        """A slide's configurations, joint rates, contacts and scenes at ``xs`` (n,) moving at ``xdot`` (m/s):
+        :class:`qsplan.hands.motion.SlideMotion` (raises :class:`~qsplan.mechanics.errors.SceneError` naming the first
+        x without a configuration)."""
 
     def scene(self, pose, q, effort_controlled, velocity, effort=None, mu=None, method: str = "auto"):
         """One :class:`qsplan.mechanics.Scene` at ``pose`` (3,) and ``q`` (n_j,); ``"generic"``: the polygon search."""

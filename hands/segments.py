@@ -83,7 +83,9 @@ class ManipulationSegment:
 
     @property
     def effort_index(self) -> int:
-        return JOINT_NAMES.index(self.effort_joint)
+        from qsplan.hands.interface import joint_names
+
+        return joint_names(self.hand).index(self.effort_joint)
 
     @property
     def velocity_index(self) -> int:

@@ -255,6 +255,55 @@ def test_the_ompl_check_finds_importers(tmp_path):
                                         "qsplan.planner.search": ["qsplan.planner.search.b"]}  # fmt: skip
 
 
+#: The hands' and grasps' classes: outside ``qsplan.hands`` nothing asks which of them a value is (the planner asks the
+#: :class:`qsplan.hands.protocol.Hand` protocol; the paper's closed forms are the hand's accelerator, its own business).
+HAND_CLASSES = frozenset({"TwoFingerHand", "ChainHand", "DescribedHand", "Hand", "Grasp", "ChainGrasp", "OnVertex",
+                          "TipOnEdge", "FingerContact"})
+#: Calls and attributes that branch on a hand's type or reach into its accelerator.
+HAND_TYPE_CALLS = frozenset({"is_chain_hand"})
+HAND_INTERNALS = frozenset({"accelerated", "paper", "chain", "paper_form"})
+
+
+def _hand_type_branches(modules=None) -> list:
+    """Every place outside ``qsplan.hands`` that branches on a hand's or grasp's type (``isinstance``/``issubclass`` with
+    a hand class, :data:`HAND_TYPE_CALLS`) or reads a hand's accelerator (:data:`HAND_INTERNALS`), as ``module:line``."""
+    out = []
+    for name, path in (MODULES if modules is None else modules).items():
+        if name.startswith("qsplan.hands"):
+            continue
+        for node in ast.walk(ast.parse(path.read_text(), filename=str(path))):
+            if isinstance(node, ast.Call):
+                f = node.func
+                fname = getattr(f, "id", getattr(f, "attr", ""))
+                if fname in ("isinstance", "issubclass") and len(node.args) == 2:
+                    kinds = node.args[1].elts if isinstance(node.args[1], ast.Tuple) else [node.args[1]]
+                    if any(getattr(k, "id", getattr(k, "attr", "")) in HAND_CLASSES for k in kinds):
+                        out.append(f"{name}:{node.lineno} {fname}(..., {ast.unparse(node.args[1])})")
+                elif fname in HAND_TYPE_CALLS:
+                    out.append(f"{name}:{node.lineno} {fname}()")
+            elif isinstance(node, ast.Attribute) and node.attr in HAND_INTERNALS and isinstance(node.ctx, ast.Load):
+                out.append(f"{name}:{node.lineno} .{node.attr}")
+    return out
+
+
+def test_no_hand_type_branch_outside_hands():
+    assert _hand_type_branches() == []
+
+
+def test_the_hand_type_check_finds_branches(tmp_path):
+    sources = {"qsplan.planner.plan.a": "def f(h):\n    return isinstance(h, (int, ChainHand))\n",
+               "qsplan.planner.plan.b": "def f(h):\n    return h.paper.finger_length\n",
+               "qsplan.planner.plan.c": "def f(h):\n    return is_chain_hand(h)\n",
+               "qsplan.hands.d": "def f(h):\n    return isinstance(h, TwoFingerHand)\n",
+               "qsplan.planner.plan.e": "def f(h):\n    return isinstance(h, dict) and h.joint_names\n"}  # fmt: skip
+    modules = {}
+    for name, text in sources.items():
+        modules[name] = tmp_path / f"{name}.py"
+        modules[name].write_text(text)
+    assert [b.split(":")[0] for b in _hand_type_branches(modules)] == ["qsplan.planner.plan.a", "qsplan.planner.plan.b",
+                                                                       "qsplan.planner.plan.c"]  # fmt: skip
+
+
 def test_no_private_name_crosses_a_module_boundary():
     crossings = [
         f"{name} imports {imported} from {target}"

@@ -118,7 +118,8 @@ def _stated(claim, truth, path: str) -> str | None:
 def metadata_checks(meta, task, cols) -> list:
     """Every fact ``plan.json``'s metadata states, against the task and the rows."""
     from qsplan.hands.interface import hand_metadata
-    from qsplan.planner.export.plan_files import plan_metadata_limits, task_tables
+    from qsplan.planner.export.plan_files import plan_metadata_limits
+    from qsplan.planner.task.record import task_record, task_tables
 
     if not isinstance(meta, dict):
         return [(None, "metadata", "plan.json has no metadata object")]
@@ -141,10 +142,15 @@ def metadata_checks(meta, task, cols) -> list:
               and _close(fm["min_coulomb_slack_N"], task.force_margin.slack),
               f"force margin {fm['min_normal_force_N']} / {fm['min_coulomb_slack_N']} N is not the task's "
               f"{task.force_margin.normal:g} / {task.force_margin.slack:g} N")  # fmt: skip
-        for key, truth in (("limits", plan_metadata_limits(task)), ("hand", hand_metadata(task.hand)),
-                           ("task_tables", task_tables(task))):
+        hand = hand_metadata(task.hand)
+        hand.pop("description_source", None)  # where the description was read from: not a fact of the plan
+        for key, truth in (("limits", plan_metadata_limits(task)), ("hand", hand),
+                           ("task_tables", task_tables(task)), ("formation", task.formation.as_dict()),
+                           ("task_record", task_record(task))):
             if key in meta:
-                where = _stated(meta[key], _plain(truth), f"metadata.{key}")
+                claimed = {k: v for k, v in meta[key].items() if k != "description_source"} \
+                    if key == "hand" and isinstance(meta[key], dict) else meta[key]
+                where = _stated(claimed, _plain(truth), f"metadata.{key}")
                 claim(where is None, f"{where} is not the task's")
         out += _phase_claims(meta["phases"], cols)
         contact = np.flatnonzero(cols["mode"] != "free")

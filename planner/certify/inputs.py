@@ -216,17 +216,25 @@ def read_plan(path, joints=None) -> tuple:
 def task_from_metadata(meta, cols=None):
     """The :class:`~qsplan.planner.task.task.Task` a plan's ``plan.json`` metadata records.
 
-    The metadata records the hand (the paper's hand by its parameters, but not its palm thickness: the default
-    is used; a described hand by its description and workpiece, fully), the friction set, the limits and the
-    torque resolution; the start and the waypoints are read from the rows (``cols``) when given.
+    Since the task record (``metadata.task_record``, :mod:`qsplan.planner.task.record`) the task is read from it,
+    checked as a task file is.  Older plans: the metadata records the hand (the paper's hand by its parameters,
+    but not its palm thickness: the default is used; a described hand by its description and workpiece), the
+    friction set, the limits and the torque resolution; the start and the waypoints are read from its
+    ``task_tables``, or from the rows (``cols``) when it has none.
 
     Raises
     ------
     QsplanError
         Naming ``task`` when the metadata does not record the task.
     """
-    from qsplan.planner.task.task import make_task
+    from qsplan.planner.task.task import make_task, task_from_record
 
+    if isinstance(meta, dict) and "task_record" in meta:  # the one round trip (qsplan.planner.task.record)
+        try:
+            return task_from_record(meta["task_record"])
+        except QsplanError as exc:
+            raise QsplanError(f"task: the plan's metadata.task_record is not a task ({exc}); name the task file") from None
+    # plans written before the record: the task rebuilt from the metadata's other tables
     if isinstance(meta, dict) and isinstance(meta.get("hand"), dict) and "description" in meta["hand"]:
         return _chain_task_from_metadata(meta, cols)
     try:

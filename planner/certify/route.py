@@ -122,17 +122,17 @@ def _finger_claims(task, bodies, wanted, where: str, row: int) -> list:
 
 def endpoint_checks(task, cols, first_bodies, last_bodies) -> list:
     """The first row is the task's start, the last its goal; a scripted task's stretches end at its waypoints."""
-    from qsplan.hands.interface import is_chain_hand, joint_names
+    from qsplan.hands.interface import joint_names
 
     x, n = cols["x_workpiece"], cols["t"].size
     out = []
     if abs(x[0] - task.start_x) > ENDPOINT_TOL:
         out.append((0, "start", f"the workpiece starts at x = {x[0]:.9g} m; the task starts it at {task.start_x:.9g} m"))
-    chain = is_chain_hand(task.hand)
-    out += _finger_claims(task, first_bodies, (None, None) if chain else task.start_features, "start", 0)
-    if chain and task.start_joints is not None:
+    free = bool(task.hand.free_joints)  # a hand with free joints starts from them; the others from features
+    out += _finger_claims(task, first_bodies, (None, None) if free else task.start_features, "start", 0)
+    if free and task.start_joints is not None:
         names = joint_names(task.hand)
-        for j in task.hand.free_joints():
+        for j in task.hand.free_joints:
             q0 = cols[f"q_{names[j]}"][0]
             if abs(q0 - task.start_joints[j]) > ENDPOINT_TOL:
                 out.append((0, "start", f"joint {names[j]} starts at {q0:.9g}; the task's [start] gives "

@@ -95,12 +95,8 @@ def joint_housings(hand) -> dict:
     """
     from shapely.geometry import Point
 
-    from qsplan.hands.interface import is_chain_hand, joint_axes, manipulator_of
+    from qsplan.hands.interface import joint_axes, manipulator_of
 
-    if not is_chain_hand(hand):
-        housing = JOINT_HOUSING * hand.finger_width
-        return {side: ("palm", j, housing, Point(p).buffer(housing, 64))
-                for j, (side, p) in enumerate(zip(("left", "right"), hand.pivots))}  # fmt: skip
     man = manipulator_of(hand)
     axes = joint_axes(hand, np.zeros(man.n_joints))
     out = {}

@@ -68,14 +68,11 @@ def run_task(task, args, out, inputs=()) -> int:
               f"regrasps, {plan.duration:.4g} s of motion\n")  # fmt: skip
     out.write(f"planning: {plan.seconds:.3g} s, {plan.validity_checks} states judged "
               f"({plan.checks_per_second:.4g} per second: band tables, dense sweeps and the regrasps' OMPL checks)\n")  # fmt: skip
-    search = plan.sequence[-1] if plan.sequence else {}
-    if search.get("kind") == "manifold search":  # a described hand: grasps and slides on the contact manifold
-        out.write(f"sequence found on the contact manifold: {search['start_grasps']} start and {search['goal_grasps']} "
-                  f"goal grasps, slides planned by OMPL {search['planner']} and judged densely\n")  # fmt: skip
-    elif search:
-        out.write(f"sequence found by the {search['planner']!r} search on band tables of {search['grasps']} grasps x "
-                  f"{search['grid_points']} positions ({search['table_states']} configurations, {search['band_states']} "
-                  f"guaranteed bands in {search['table_seconds']:.3g} s; search {search['search_seconds']:.3g} s)\n")  # fmt: skip
+    search = plan.search
+    if search is not None:
+        out.write(f"sequence found by the {search.planner!r} search on band tables of {search.grasps} grasps x "
+                  f"{search.grid_points} positions ({search.table_states} configurations, {search.band_states} "
+                  f"guaranteed bands in {search.table_seconds:.3g} s; search {search.search_seconds:.3g} s)\n")  # fmt: skip
     from qsplan.hands.interface import joint_names, joint_units
 
     seg = next((s for s in plan.segments if s.name == name), None)

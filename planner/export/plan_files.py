@@ -52,6 +52,7 @@ import numpy as np
 
 from qsplan.planner.export.files import atomic_write, check_out_dir, check_outputs, csv_cell, json_value
 from qsplan.planner.export.schedule import FORMAT, VERSION
+from qsplan.planner.task.record import task_record, task_tables
 
 __all__ = ["PLAN_COLUMNS", "PLAN_FORMAT", "column_meanings", "export_plan", "plan_columns", "plan_joints",
            "plan_metadata", "plan_metadata_limits", "plain_json", "read_plan_csv", "task_tables"]
@@ -180,16 +181,15 @@ def column_meanings(names, kinds=None) -> dict:
 def plan_metadata(plan) -> dict:
     """What a controller engineer needs to trust the plan (all SI).
 
-    Reads ``Plan``'s public fields; ``sequence`` (the planned sequence, a tuple of plain dicts) is
-    written under ``"sequence"`` when the plan has one.
+    Reads ``Plan``'s public fields; ``sequence`` (the planned steps and the search's summary,
+    :mod:`qsplan.planner.plan.steps`) is written under ``"sequence"`` when the plan has one.
     """
     from qsplan.planner.plan.results import ContactSegmentPlan
     from qsplan.planner.torque.command import MAX_MARGIN_RESOLUTIONS
 
-    from qsplan.hands.interface import hand_metadata, is_chain_hand
+    from qsplan.hands.interface import hand_metadata
 
     task = plan.task
-    chain = is_chain_hand(task.hand)
     name, t, w = plan.narrowest()
     phases = []
     for i, ph in enumerate(plan.phases):
@@ -201,8 +201,8 @@ def plan_metadata(plan) -> dict:
                      narrowest_band={"t_s": float(ph.t[k]), "width_N_m": _num(ph.width[k])},
                      command={"margin_N_m": _num(np.min(ph.margin)), "half_narrowest_band_N_m": _num(0.5 * ph.width[k]),
                               "max_N_m": _num(np.max(ph.command)), "lower_edge_max_N_m": _num(np.max(ph.lower))})  # fmt: skip
-            if chain:  # a prismatic joint's effort is a force: its numbers under *_N_m are in N
-                d["effort_unit"] = _joint_units(task.hand)[ph.effort_joint]["tau"]
+            # the effort's unit: N m, or N for a prismatic joint (then its numbers under *_N_m are in N)
+            d["effort_unit"] = _joint_units(task.hand)[ph.effort_joint]["tau"]
         else:
             d.update(kind="regrasp", x_workpiece_m=float(np.ravel(ph.x)[0]))
         phases.append(d)
@@ -224,15 +224,19 @@ def plan_metadata(plan) -> dict:
                     "velocity_controlled_torque_cells": "nan in CSV, null in JSON"},
         "limits": plan_metadata_limits(task),
         "task_tables": task_tables(task),
+        "task_record": task_record(task),
         "narrowest_band": {"phase": name, "t_s": _num(t), "width_N_m": _num(w)},
+        "formation": task.formation.as_dict(),
         "planner": {"name": plan.options.planner, "seed": plan.options.seed, "seconds": plan.seconds,
+                    "route_search": plan.search.planner if plan.search is not None else "scripted",
                     "validity_checks": plan.validity_checks, "checks_per_second": _num(plan.checks_per_second)},
         "phases": phases,
         "hand": hand_metadata(task.hand),
     }  # fmt: skip
-    sequence = getattr(plan, "sequence", None)
-    if sequence is not None:
-        doc["sequence"] = plain_json(list(sequence))
+    if plan.sequence:
+        from qsplan.planner.plan.steps import step_dicts
+
+        doc["sequence"] = plain_json(step_dicts(plan.sequence))
     return doc
 
 
@@ -243,44 +247,20 @@ def _joint_units(hand) -> dict:
     return {n: JOINT_UNITS[k] for n, k in zip(joint_names(hand), joint_kinds(hand))}
 
 
-def task_tables(task) -> dict:
-    """Where the task starts and ends, as its file's ``[motion]``, ``[start]`` and ``[goal]`` tables say it (features
-    ``"edge:K"``/``"vertex:K"``/``"inner"`` in the polygon's numbering as written; a described hand's ``[start]`` by
-    joint name), so that the certifier can check a plan against the task it records, not against its own rows."""
-    from qsplan.hands.interface import is_chain_hand
-
-    def feature(f):
-        return "inner" if f is None or f[0] == "inner" else f"{f[0]}:{f[1]}"
-
-    out = {"motion": {"start_x": float(task.start_x)}}
-    if task.goal is None:
-        out["motion"]["waypoints"] = [float(v) for v in task.waypoints]
-    else:
-        out["goal"] = {"x": float(task.goal.x), **{side: feature(f) for side, f in (("left", task.goal.left),
-                                                                                  ("right", task.goal.right)) if f}}
-    if is_chain_hand(task.hand):
-        if task.start_joints is not None:
-            out["start"] = {task.hand.joint_names[j]: float(task.start_joints[j]) for j in task.hand.free_joints()}
-    else:
-        out["start"] = {side: feature(f) for side, f in zip(("left", "right"), task.start_features)}
-    return out
-
-
 def plan_metadata_limits(task) -> dict:
-    """The task's limits as ``metadata.limits`` records them: the paper's hand as always (``joints_rad``, one
-    ``joint_speed_rad_s``, and per finger ``joint_speeds_rad_s``); a described hand per joint by name (``joints``:
-    range, speed and their units)."""
-    from qsplan.hands.interface import is_chain_hand
-
-    if not is_chain_hand(task.hand):  # joint_speed_rad_s: the slowest finger's (the planner's one speed); per finger beside it
-        return {"joints_rad": task.joint_limits.tolist(), "joint_speed_rad_s": task.joint_speed,
-                "joint_speeds_rad_s": [float(v) for v in task.joint_speeds],
-                "workpiece_speed_m_s": task.workpiece_speed}  # fmt: skip
+    """The task's limits as ``metadata.limits`` records them, the same keys for every hand: per joint by name
+    (``joints``: range, speed and their units) and the workpiece's speed; a hand of revolute joints only also as the
+    paper's hand always recorded them (``joints_rad``; ``joint_speed_rad_s``, the slowest joint's, the one speed of
+    the paper hand's planner; ``joint_speeds_rad_s`` per joint)."""
     units = _joint_units(task.hand)
     speeds = np.asarray(task.joint_speeds, dtype=float)
     joints = {n: {"range": [float(v) for v in task.joint_limits[j]], "unit": units[n]["q"], "speed": float(speeds[j]),
                   "speed_unit": units[n]["qd"]} for j, n in enumerate(units)}  # fmt: skip
-    return {"joints": joints, "workpiece_speed_m_s": task.workpiece_speed}
+    out = {"joints": joints, "workpiece_speed_m_s": task.workpiece_speed}
+    if all(k == "revolute" for k in task.hand.joint_kinds):
+        out = {"joints_rad": task.joint_limits.tolist(), "joint_speed_rad_s": task.joint_speed,
+               "joint_speeds_rad_s": [float(v) for v in speeds], **out}
+    return out
 
 
 def plain_json(value):

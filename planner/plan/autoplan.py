@@ -30,48 +30,71 @@ from dataclasses import replace
 
 import numpy as np
 
+from qsplan.hands.interface import JOINT_UNITS
 from qsplan.mechanics.errors import QsplanError
 
 from qsplan.planner.plan.results import ContactSegmentPlan, Plan, PlanFailure
+from qsplan.planner.plan.steps import RegraspStep, SearchSummary, SlideStep
 from qsplan.planner.search.ompl_search import search_route
 from qsplan.planner.search.tables import band_tables, table_grid
 
-__all__ = ["MAX_ROUNDS", "goal_nodes", "plan_automatic", "route_phases", "start_nodes"]
+__all__ = ["FREE_GRID", "FREE_SEARCH_MARGIN", "MAX_GOAL_GRASPS", "MAX_ROUNDS", "grasp_rows", "goal_nodes",
+           "plan_automatic", "route_phases", "start_nodes"]
 
 #: Rounds of search and realisation: each failed round closes a table cell or forbids a regrasp, so a
 #: handful suffices; the bound keeps a pathological task from looping.
 MAX_ROUNDS = 12
 
-_FINGERS = ("left", "right")
+#: Values per free joint of the grid from which a described hand's grasps are sought where the task names no
+#: ``[start]`` (and its goal grasps always): 13 values of a 3 rad range are 0.22 rad apart, about 2 cm at the tip of
+#: a 7 cm link; two-link fingers then close from 13 x 13 = 169 rows (each closing batched over the whole palm).
+FREE_GRID = 13
+
+#: Most goal grasps a described hand's tables keep (a spread of the valid ones): each adds two rows (held at the goal,
+#: sloped from each start grasp) to tables whose every state is judged.
+MAX_GOAL_GRASPS = 6
+
+#: How far (m) beyond the start and the goal a described hand's tables reach: its rows are straight lines between
+#: start and goal grasps, so detours matter less than to the paper hand's (qsplan.planner.search.tables.SEARCH_MARGIN)
+#: and every grid point costs a band per row and effort joint.
+FREE_SEARCH_MARGIN = 0.01
+
+#: Two free-joint vectors closer than this (rad or m) in every joint are the same start (a task's [start] as written
+#: against a grid row).
+SAME_FREE = 1e-9
 
 
 def _feature_text(feature):
-    """A task's feature as :meth:`qsplan.hands.grasps.Grasp.matches` reads it: None (any), ``"vertex"`` (the start's
-    ``"inner"``: the inner edge on whichever vertex), ``"edge:K"``, ``"vertex:K"``."""
+    """A task's feature as a grasp's ``matches`` reads it: None (any), ``"vertex"`` (the start's ``"inner"``: the
+    inner edge on whichever vertex), ``"edge:K"``, ``"vertex:K"``."""
     if feature is None:
         return None
     return "vertex" if feature[0] == "inner" else f"{feature[0]}:{feature[1]}"
 
 
 def _start_grasps(tables, task, i):
-    """Indices of the valid grasps that meet the task's start features at grid index ``i``."""
-    feats = [_feature_text(f) for f in task.start_features]
-    return [g for g in range(len(tables.grasps)) if tables.graph.valid[g, i] and _meets(tables, task, g, i, feats)]
+    """Indices of the valid rows that meet the task's start at grid index ``i``: its features (a hand without free
+    joints) or its ``[start]`` free joints (a hand with them, where given)."""
+    free = bool(task.hand.free_joints)  # a hand with free joints starts from them ([start] by name), not features
+    feats = [None, None] if free else [_feature_text(f) for f in task.start_features]
+    out = []
+    for g in range(len(tables.grasps)):
+        if not (tables.graph.valid[g, i] and _meets(tables, task, g, i, feats)):
+            continue
+        if task.start_joints is not None and task.hand.free_joints:
+            free = list(task.hand.free_joints)
+            if np.any(np.abs(tables.q[g, i, free] - task.start_joints[free]) > SAME_FREE):
+                continue
+        out.append(g)
+    return out
 
 
 def _meets(tables, task, g, i, feats) -> bool:
-    """Whether grasp ``g`` at grid index ``i`` touches the features ``feats`` (left, right: text or None): its
-    placements match, and a ``"vertex:K"`` is the vertex touched there."""
-    from qsplan.hands.grasps import user_vertex
+    """Whether row ``g`` at grid index ``i`` touches the features ``feats`` (left, right: text or None)
+    (:func:`qsplan.hands.grasps.grasp_meets`)."""
+    from qsplan.hands.grasps import grasp_meets
 
-    if not tables.grasps[g].matches(*feats):
-        return False
-    for k, f in enumerate(feats):
-        if f is not None and f.startswith("vertex:"):
-            touched = int(tables.graph.touched[g, i, k])
-            if touched < 0 or user_vertex(task.hand, touched) != int(f.split(":")[1]):
-                return False
-    return True
+    return grasp_meets(task.hand, tables.grasps[g].grasp, tables.graph.touched[g, i, :2], feats)
 
 
 def _goal_grasps(tables, task, i):
@@ -80,20 +103,20 @@ def _goal_grasps(tables, task, i):
 
 
 def start_nodes(tables, task) -> list:
-    """The search's start nodes ``(grasp, i)``: the valid grasps meeting the task's start features at its start."""
+    """The search's start nodes ``(grasp, i)``: the valid rows meeting the task's start at its start."""
     i = tables.index(task.start_x)
     return [(g, i) for g in _start_grasps(tables, task, i)]
 
 
 def goal_nodes(tables, task) -> list:
-    """The search's goal nodes ``(grasp, i)``: the valid grasps meeting the goal's features at the goal x."""
+    """The search's goal nodes ``(grasp, i)``: the valid rows meeting the goal's features at the goal x."""
     i = tables.index(task.goal.x)
     return [(g, i) for g in _goal_grasps(tables, task, i) if tables.graph.valid[g, i]]
 
 
 def route_phases(route) -> list:
     """The route's steps grouped into phases: ``("slide", grasp, i0, i1, effort)`` (a run of steps in one grasp,
-    effort finger and direction) and ``("regrasp", from grasp, to grasp, i)``."""
+    effort joint and direction) and ``("regrasp", from grasp, to grasp, i)``."""
     out = []
     for s in route.steps:
         if s.kind == "regrasp":
@@ -108,20 +131,54 @@ def route_phases(route) -> list:
     return out
 
 
-def _opening(task, grasp, x):
-    """Each finger's opening direction at ``x`` (m): the sign of the joint rate that moves its contact point out
-    of the workpiece, ``-sign(j_n)`` with ``j_n = n . (e_z x (p - a))`` (eq. 5), shape (2,)."""
-    from qsplan.hands.grasp_geometry import grasp_configurations
+def grasp_rows(task, x0: float, x1: float) -> tuple:
+    """The tables' rows for a task from ``x0`` to ``x1`` (m): every grasp candidate of a hand without free joints,
+    held; for a hand with free joints, the grasps of the start (its ``[start]``, else a grid of the free joints) and of
+    the goal (a grid), each held, and for every start and goal grasp touching the same features the straight line
+    between them (the free joints sloping from one to the other as the workpiece slides: the contact manifold's
+    simplest path)."""
+    from qsplan.planner.plan.phases import FreePath
+    from qsplan.planner.search.tables import GraspRow
 
-    conf = grasp_configurations(task.hand, grasp, np.array([x]))
-    pivots = task.hand.pivots
-    out = np.empty(2)
-    for k in range(2):
-        p, n = conf.points[0, 2 + k], conf.normals[0, 2 + k]
-        r = p - pivots[k]
-        jn = n[0] * (-r[1]) + n[1] * r[0]
-        out[k] = -np.sign(jn) if jn != 0 else (1.0 if k == 0 else -1.0)
-    return out
+    hand, formation = task.hand, task.formation
+    if not hand.free_joints:
+        return tuple(GraspRow(g) for g in hand.grasp_candidates(formation))
+    free = list(hand.free_joints)
+    lim = task.joint_limits[free]
+    axes = [np.linspace(lo, hi, FREE_GRID + 2)[1:-1] for lo, hi in lim]
+    grid = np.stack(np.meshgrid(*axes, indexing="ij"), axis=-1).reshape(-1, len(free))
+    starts = task.start_joints[free][None] if task.start_joints is not None else grid
+    start = _valid_at(task, hand.grasp_candidates(formation, starts, [x0]), x0)
+    goal_feats = (None, None) if task.goal is None else (_feature_text(task.goal.left), _feature_text(task.goal.right))
+    at_goal = _valid_at(task, hand.grasp_candidates(formation, grid, [x1]), x1)
+    goals = _spread([g for g in at_goal if g.matches(*goal_feats)])
+    keys = {s.keys for s in start}  # grasps at the goal the start's contacts slide to (then a regrasp if need be)
+    ends = _spread([g for g in at_goal if g.keys in keys and g not in goals]) + goals
+    rows = [GraspRow(g) for g in start] + [GraspRow(g) for g in goals]
+    zero = np.zeros(len(hand.joint_names))
+    for s in start:
+        for g in ends:
+            if g.keys == s.keys and x1 != x0:
+                slope = zero.copy()
+                slope[free] = (np.asarray(g.free) - np.asarray(s.free)) / (x1 - x0)
+                rows.append(GraspRow(s, FreePath(float(x0), np.asarray(s.free, float), slope, tuple(free))))
+    return tuple(rows)
+
+
+def _spread(grasps) -> list:
+    """At most :data:`MAX_GOAL_GRASPS` of ``grasps``, spread over the list (the grid's order)."""
+    return list(grasps[:: max(1, int(np.ceil(len(grasps) / MAX_GOAL_GRASPS)))])
+
+
+def _valid_at(task, grasps, x: float) -> list:
+    """The grasps of ``grasps`` that are configurations at ``x`` (their contacts, inside the limits, no overlap)."""
+    hand, lim = task.hand, task.joint_limits
+    states = [hand.grasp_states(task.formation, g, np.array([x])) for g in grasps]
+    ok = [k for k, st in enumerate(states) if st.ok[0] and np.all((st.q[0] >= lim[:, 0]) & (st.q[0] <= lim[:, 1]))]
+    if not ok:
+        return []
+    hit = hand.collide(np.vstack([states[k].poses for k in ok]), np.vstack([states[k].q for k in ok]))
+    return [grasps[k] for k, h in zip(ok, hit) if not h]
 
 
 def _realise(task, tables, route, options, progress, counters):
@@ -130,6 +187,7 @@ def _realise(task, tables, route, options, progress, counters):
     from qsplan.planner.states.contact import check_contact_state, contact_samples
     from qsplan.planner.torque.sweep import competing_modes
 
+    hand = task.hand
     x, q_tab = tables.x, tables.q
     phases, seq, t0 = [], [], 0.0
     q_now = None
@@ -139,36 +197,45 @@ def _realise(task, tables, route, options, progress, counters):
             _, g, h, i = ph
             n_regrasp += 1
             q_from = q_now if q_now is not None else q_tab[g, i]
-            name = (f"regrasp {n_regrasp}: release at x = {x[i]:.4g} m and grasp {tables.grasps[h].label} "
-                    f"(from {tables.grasps[g].label})")  # fmt: skip
+            rg, rh = tables.grasps[g], tables.grasps[h]
+            name = f"regrasp {n_regrasp}: release at x = {x[i]:.4g} m and grasp {rh.label} (from {rg.label})"
             try:
                 r = regrasp_phase(task, name, float(x[i]), q_from, q_tab[h, i], t0, options, progress, counters,
-                                  _opening(task, tables.grasps[g], x[i]), _opening(task, tables.grasps[h], x[i]))  # fmt: skip
+                                  hand.opening(rg.grasp, x[i], q_from), hand.opening(rh.grasp, x[i], q_tab[h, i]))  # fmt: skip
             except PlanFailure as exc:
                 raise _Rejected(("regrasp", g, h, i), exc) from None
             phases.append(r)
-            seq.append({"kind": "regrasp", "x": float(x[i]), "from": tables.grasps[g].label, "to": tables.grasps[h].label})
+            seq.append(RegraspStep(float(x[i]), rg.label, rh.label))
             q_now, t0 = r.q[-1], float(r.t[-1])
             continue
         _, g, i0, i1, e = ph
         n_slide += 1
-        grasp, effort, d = tables.grasps[g], _FINGERS[e], float(np.sign(i1 - i0))
+        row, effort, d = tables.grasps[g], tables.efforts[e], float(np.sign(i1 - i0))
         name = (f"segment {n_slide}: slide the workpiece {'left' if d < 0 else 'right'} from x = {x[i0]:.4g} to "
-                f"{x[i1]:.4g} m, grasp {grasp.label}")  # fmt: skip
-        line = contact_samples(task, np.linspace(x[i0], x[i1], 9), effort, d * task.workpiece_speed, grasp=grasp)
+                f"{x[i1]:.4g} m, grasp {row.label}")  # fmt: skip
+        xs = np.linspace(x[i0], x[i1], 9)
+        path = row.path
+        line = contact_samples(task, xs, effort, d * task.workpiece_speed, grasp=row.grasp,
+                               free=None if path is None else path.at(xs),
+                               free_rates=None if path is None else path.rates(len(xs), d * task.workpiece_speed))  # fmt: skip
         comps = competing_modes(line)
         touching = line.touching[0]
         try:
             seg = slide_phase(task, name, float(x[i0]), float(x[i1]), effort, d, touching, comps, t0, options,
-                              progress, counters, grasp)  # fmt: skip
+                              progress, counters, row.grasp, path)  # fmt: skip
         except PlanFailure as exc:
             step = 1 if i1 > i0 else -1
-            bad = next((i for i in range(i0, i1 + step, step)
-                        if not check_contact_state(task, x[i], effort, d, touching, comps, grasp).ok), i1)  # fmt: skip
-            raise _Rejected(("cell", g, e, int(d > 0), bad), exc) from None
+
+            def bad(i):
+                free = None if path is None else path.at([x[i]])[0]
+                return not check_contact_state(task, x[i], effort, d, touching, comps, row.grasp, free,
+                                               None if path is None else path.slope).ok  # fmt: skip
+
+            worst = next((i for i in range(i0, i1 + step, step) if bad(i)), i1)
+            raise _Rejected(("cell", g, e, int(d > 0), worst), exc) from None
         phases.append(seg)
-        seq.append({"kind": "slide", "grasp": grasp.label, "x_from": float(x[i0]), "x_to": float(x[i1]),
-                    "effort_joint": effort, "narrowest_band": float(np.min(seg.width))})  # fmt: skip
+        seq.append(SlideStep(row.label, float(x[i0]), float(x[i1]), effort, float(np.min(seg.width)),
+                             JOINT_UNITS[hand.joint_kinds[hand.joint_names.index(effort)]]["tau"]))  # fmt: skip
         q_now, t0 = seg.q[-1], float(seg.t[-1])
     return phases, seq
 
@@ -206,9 +273,9 @@ def plan_automatic(task, options=None, progress=None, planner: str = "widest", t
     PlanFailure
         No route, with the report of what blocks it.
     """
-    from qsplan.hands.grasp_geometry import candidate_grasps
     from qsplan.planner.plan.obstacles import no_route_report, unreachable_goal_report
     from qsplan.planner.plan.phases import DEFAULT_OPTIONS
+    from qsplan.planner.search.tables import SEARCH_MARGIN
 
     if task.goal is None:
         raise QsplanError("goal: the task has no [goal] (a scripted task: plan it with plan_task)")
@@ -216,10 +283,11 @@ def plan_automatic(task, options=None, progress=None, planner: str = "widest", t
     progress = progress or (lambda line: None)
     t_start = time.perf_counter()
     if tables is None:
-        grasps = candidate_grasps(task.hand)
         from qsplan.planner.task.goal import palm_x_range
 
-        grid = table_grid(task.start_x, task.goal.x, palm_x_range(task.hand))  # never the workpiece off the palm
+        grasps = grasp_rows(task, task.start_x, task.goal.x)
+        margin = FREE_SEARCH_MARGIN if task.hand.free_joints else SEARCH_MARGIN
+        grid = table_grid(task.start_x, task.goal.x, palm_x_range(task.hand), margin=margin)  # never off the palm
         progress(f"band tables: {len(grasps)} candidate grasps x {len(grid)} workpiece positions "
                  f"({grid[0]:.4g} to {grid[-1]:.4g} m)")  # fmt: skip
         tables = band_tables(task, grasps, grid)
@@ -238,7 +306,9 @@ def plan_automatic(task, options=None, progress=None, planner: str = "widest", t
     while True:
         rounds += 1
         graph = replace(tables.graph, width=width)
-        results = [search_route(graph, (s, i_start), goals, planner, forbidden) for s in starts]
+        # the widest search runs once from every start; a sampling planner from each start in turn
+        nodes = [[(s, i_start) for s in starts]] if planner == "widest" and len(starts) > 1 else [(s, i_start) for s in starts]
+        results = [search_route(graph, node, goals, planner, forbidden) for node in nodes]
         search_s += sum(r.seconds for r in results)
         evaluations += sum(r.evaluations for r in results)
         found = [r for r in results if r.route is not None]
@@ -261,11 +331,10 @@ def plan_automatic(task, options=None, progress=None, planner: str = "widest", t
             else:
                 _, g, e, d, i = what
                 width[g, e, d, i] = -np.inf
-    meta = {"kind": "search", "planner": planner, "rounds": rounds, "grasps": len(tables.grasps), "grid_points": int(len(tables.x)),
-            "grid_step_m": float(np.min(np.abs(np.diff(tables.x)))) if len(tables.x) > 1 else 0.0,
-            "table_states": int(tables.states), "band_states": int(tables.band_states),
-            "table_seconds": float(tables.seconds), "search_seconds": float(search_s),
-            "search_evaluations": int(evaluations), "route_width": float(route.width)}  # fmt: skip
+    meta = SearchSummary(planner, rounds, len(tables.grasps), int(len(tables.x)),
+                         float(np.min(np.abs(np.diff(tables.x)))) if len(tables.x) > 1 else 0.0, int(tables.states),
+                         int(tables.band_states), float(tables.seconds), float(search_s), int(evaluations),
+                         float(route.width))  # fmt: skip
     # states judged: every in-contact state check of the tables (a scene and a guaranteed band with competitors
     # precluded, per configuration, torque-controlled finger and direction), then the dense sweeps and OMPL's checks
     plan = Plan(task, tuple(phases), time.perf_counter() - t_start, counters[0] + tables.band_states,

@@ -74,6 +74,8 @@ class FailureReport:
     mu_closes : float or None
         At the narrowest point: the upper end of the friction range at which the band is exactly the resolution
         (None if it is narrower even for the range's lower end alone, or the cause is not the band).
+    mode_name : str
+        The desired mode's name (the paper's: ``"4S"``).
     """
 
     segment: str
@@ -86,20 +88,21 @@ class FailureReport:
     closed: tuple
     narrowest: ClosedPoint | None
     mu_closes: float | None
+    mode_name: str = "4S"
 
     @property
     def message(self) -> str:
         n = self.narrowest
         head = f"no plan: {self.segment}"
-        if n is None:
-            return f"{head}: OMPL found no path ({self.planner_status}) though the straight line is valid"
+        if n is None:  # every sample valid on its own: the sweep refused what only the whole slide shows
+            return f"{head}: refused ({self.planner_status}) though every configuration is valid on its own"
         xs = [p.x for p in self.closed]
         where = f"x in [{min(xs):.4g}, {max(xs):.4g}] m ({len(xs)} of {REPORT_SAMPLES} configurations)"
         why = n.reason
         if n.competitors:
             why += f"; closed by competing mode {', '.join(n.competitors)}"
         elif np.isfinite(n.desired_width) and n.desired_width < self.resolution:
-            why += "; closed by the 4S band itself"
+            why += f"; closed by the {self.mode_name} band itself"
         if n.mu_lower_edge is not None:
             why += f" (edges attained at mu = {list(n.mu_lower_edge)} and {list(n.mu_upper_edge)})"
         if self.mu_closes is not None:
@@ -231,7 +234,6 @@ def palm_report(task) -> PalmReport | None:
 def configuration_report(task, phase, where, x, q, reason=None, planner_status=None) -> ConfigurationReport:
     """The report of configuration ``q`` (rad, or None) at workpiece ``x`` (m): ``reason`` if given, else what
     :func:`qsplan.planner.states.contact.configuration_problem` finds (with the colliding bodies)."""
-    from qsplan.hands.collision import find_collisions
     from qsplan.planner.states.contact import limit_problem
 
     kw = {} if planner_status is None else {"planner_status": planner_status}
@@ -242,7 +244,7 @@ def configuration_report(task, phase, where, x, q, reason=None, planner_status=N
     if reason is None:
         reason = limit_problem(task, q)
     if reason is None:
-        hit = find_collisions(task.hand, task.pose(x), q, first=True)
+        hit = task.hand.collisions(task.pose(x), q, first=True)
         if hit:
             c = hit[0]
             return ConfigurationReport(phase, where, float(x), qt, c.message, c.bodies, c.area, c.depth, **kw)
@@ -254,18 +256,21 @@ def _num(v):
     return float(v) if np.isfinite(v) else None
 
 
-def _edge_corners(task, x, effort, direction, grasp=None):
+def _edge_corners(task, x, effort, direction, grasp=None, path=None):
     """Box corners where the desired band's lower and upper edges are attained (vertex theory)."""
     from qsplan.mechanics.bands.effort import effort_bands
     from qsplan.mechanics.modes.contact_mode import ContactMode
 
-    from qsplan.planner.states.contact import MODE, contact_samples
+    from qsplan.planner.states.contact import contact_samples
 
     lo, hi = task.mu_range
-    scene = contact_samples(task, [x], effort, direction * task.workpiece_speed, grasp=grasp).scenes[0]
+    speed = direction * task.workpiece_speed
+    free = None if path is None else path.at([x])
+    rates = None if path is None else path.rates(1, speed)
+    scene = contact_samples(task, [x], effort, speed, grasp=grasp, free=free, free_rates=rates).scenes[0]
     n = scene.n_contacts
     rows = np.array([[lo] * n, [hi] * n]) if task.shared_mu else np.array(list(product((lo, hi), repeat=n)))
-    low, up, ok = effort_bands(scene, ContactMode(MODE), rows, force_margin=task.force_margin)
+    low, up, ok = effort_bands(scene, ContactMode(task.formation.mode), rows, force_margin=task.force_margin)
     if not np.any(ok):
         return None, None
     i = int(np.nanargmax(np.where(ok, low, -np.inf)))
@@ -273,16 +278,25 @@ def _edge_corners(task, x, effort, direction, grasp=None):
     return tuple(float(m) for m in rows[i]), tuple(float(m) for m in rows[j])
 
 
-def failure_report(task, name, x0, x1, effort, direction, competitors, result=None, xs=None,
-                   grasp=None) -> FailureReport:  # fmt: skip
-    """The report for a segment from ``x0`` to ``x1`` (m) with no plan (see the module docstring); ``grasp``
-    (:class:`qsplan.hands.grasps.Grasp`) the features the fingers touch (default both inner edges)."""
+def _check(task, x, effort, direction, competitors, grasp, path):
     from qsplan.planner.states.contact import check_contact_state
+
+    free = None if path is None else path.at([x])[0]
+    return check_contact_state(task, x, effort, direction, None, competitors, grasp, free,
+                               None if path is None else path.slope)  # fmt: skip
+
+
+def failure_report(task, name, x0, x1, effort, direction, competitors, result=None, xs=None,
+                   grasp=None, path=None) -> FailureReport:  # fmt: skip
+    """The report for a segment from ``x0`` to ``x1`` (m) with no plan (see the module docstring); ``grasp`` the
+    features the fingers touch (default the paper hand's inner edges), ``path`` a described hand's free joints along
+    it (:class:`qsplan.planner.plan.phases.FreePath`; default held)."""
+    from qsplan.planner.states.contact import mode_name
 
     xs = np.linspace(x0, x1, REPORT_SAMPLES) if xs is None else np.asarray(xs, float)
     if xs.size > REPORT_SAMPLES:
         xs = xs[np.linspace(0, xs.size - 1, REPORT_SAMPLES).astype(int)]
-    checks = [check_contact_state(task, x, effort, direction, None, competitors, grasp) for x in xs]
+    checks = [_check(task, x, effort, direction, competitors, grasp, path) for x in xs]
     closed = []
     for c in checks:
         if c.ok:
@@ -297,24 +311,22 @@ def failure_report(task, name, x0, x1, effort, direction, competitors, result=No
         if narrowest.reason.startswith(("band", "no guaranteed band")):
             # box corners of the edges mean nothing where the mode is degenerate (Q_AI singular inside the box)
             if "degenerate" not in narrowest.reason:
-                lo_e, hi_e = _edge_corners(task, narrowest.x, effort, direction, grasp)
+                lo_e, hi_e = _edge_corners(task, narrowest.x, effort, direction, grasp, path)
                 narrowest = replace(narrowest, mu_lower_edge=lo_e, mu_upper_edge=hi_e)
-            mu_closes = _mu_closes(task, narrowest.x, effort, direction, competitors, grasp)
+            mu_closes = _mu_closes(task, narrowest.x, effort, direction, competitors, grasp, path)
     status = "not run (start or goal invalid)" if result is None else result.status
     return FailureReport(name, float(x0), float(x1), effort, task.torque_resolution, task.mu_range, status,
-                         tuple(closed), narrowest, mu_closes)  # fmt: skip
+                         tuple(closed), narrowest, mu_closes, mode_name(task.formation.mode))  # fmt: skip
 
 
-def _mu_closes(task, x, effort, direction, competitors, grasp=None, iterations=30):
+def _mu_closes(task, x, effort, direction, competitors, grasp=None, path=None, iterations=30):
     """The friction upper bound at which the band at ``x`` shrinks to the resolution (bisection), or None."""
     from dataclasses import replace as dc_replace
-
-    from qsplan.planner.states.contact import check_contact_state
 
     lo, hi = task.mu_range
 
     def ok(m):
-        return check_contact_state(dc_replace(task, mu_range=(lo, m)), x, effort, direction, None, competitors, grasp).ok
+        return _check(dc_replace(task, mu_range=(lo, m)), x, effort, direction, competitors, grasp, path).ok
 
     if not ok(lo) or ok(hi):
         return None

@@ -22,6 +22,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from qsplan.planner.plan.failure import ConfigurationReport, failure_report
+from qsplan.planner.states.contact import mode_name
 from qsplan.planner.search.widest import SearchGraph, slide_widths, widest_route
 
 __all__ = ["NoRouteReport", "no_route_report", "unreachable_goal_report"]
@@ -59,17 +60,17 @@ class NoRouteReport:
 
 
 def _touching(task, tables, g, i) -> str:
-    """What grasp ``g`` touches at grid index ``i``, in the polygon's numbering as written."""
-    from qsplan.hands.grasps import TipOnEdge, user_edge, user_vertex
+    """What row ``g`` touches at grid index ``i``, in the polygon's numbering as written."""
+    from qsplan.hands.grasps import touch_words
 
-    parts = []
-    for k, (side, placement) in enumerate(zip(("left", "right"), (tables.grasps[g].left, tables.grasps[g].right))):
-        t = int(tables.graph.touched[g, i, k])
-        if isinstance(placement, TipOnEdge):
-            parts.append(f"the {side} fingertip on edge {user_edge(task.hand, t)}")
-        else:
-            parts.append(f"the {side} finger's inner edge on vertex {user_vertex(task.hand, t)}")
-    return " and ".join(parts)
+    grasp = tables.grasps[g].grasp
+    return " and ".join(touch_words(task.hand, grasp, k, int(tables.graph.touched[g, i, k])) for k in range(2))
+
+
+def _joint_words(task, name: str) -> str:
+    """A joint in words: the paper's one-joint fingers ``"left finger"``, any other ``"joint left_distal"``."""
+    k = task.hand.joint_names.index(name)
+    return f"{name} finger" if any(f == (k,) for f in task.hand.finger_joints) else f"joint {name}"
 
 
 def unreachable_goal_report(task, tables, i, which, grasps_at) -> ConfigurationReport:
@@ -93,8 +94,10 @@ def _blocking(task, tables, g, i0, i1) -> str:
     for i in range(i0, i1 + step, step):
         if not tables.graph.valid[g, i]:
             return f"at x = {tables.x[i]:.4g} m: {tables.reason(task, g, i)}"
-        if np.any(tables.graph.touched[g, i] != touched0):
+        if np.any(tables.graph.touched[g, i, :2] != touched0[:2]):
             return f"at x = {tables.x[i]:.4g} m a finger's contact moves to another feature"
+        if np.any(tables.graph.touched[g, i] != touched0):
+            return f"at x = {tables.x[i]:.4g} m a sliding contact's direction reverses (a mode change, eq. 16)"
     return "nothing blocks its geometry"
 
 
@@ -109,14 +112,14 @@ def no_route_report(task, tables, graph, starts, i_start, goals, forbidden) -> N
     if routes:
         route = max(routes, key=lambda r: r.width)
         narrow = min((s for s in route.steps if s.kind == "slide"), key=lambda s: s.width)
-        grasp = tables.grasps[narrow.grasp]
-        e, d = ("left", "right")[narrow.effort], float(np.sign(narrow.to_i - narrow.i))
+        row = tables.grasps[narrow.grasp]
+        e, d = tables.efforts[narrow.effort], float(np.sign(narrow.to_i - narrow.i))
         x0, x1 = float(tables.x[narrow.i]), float(tables.x[narrow.to_i])
-        band = failure_report(task, f"the widest route's narrowest slide (grasp {grasp.label})", x0, x1, e, d, None,
-                              xs=np.array([x0, x1]), grasp=grasp)  # fmt: skip
+        band = failure_report(task, f"the widest route's narrowest slide (grasp {row.label})", x0, x1, e, d, None,
+                              xs=np.array([x0, x1]), grasp=row.grasp, path=row.path)  # fmt: skip
         summary = (f"every route's guaranteed band is narrower than the torque resolution "
                    f"({task.torque_resolution:g} N m): the widest route's narrowest band is {route.width:.4g} N m "
-                   f"at x = {x0:.4g} m (grasp {grasp.label}, {e} finger torque-controlled)")  # fmt: skip
+                   f"at x = {x0:.4g} m (grasp {row.label}, {_joint_words(task, e)} torque-controlled)")  # fmt: skip
         return NoRouteReport("band closes", summary, (), band)
     geo = [r for r in (widest_route(geometric, (s, i_start), goals, forbidden) for s in starts) if r is not None]
     details = tuple(f"grasp {tables.grasps[s].label} from x = {tables.x[i_start]:.4g} m toward {tables.x[i_goal]:.4g} m: "
@@ -126,15 +129,17 @@ def no_route_report(task, tables, graph, starts, i_start, goals, forbidden) -> N
         allowed = slide_widths(anyband)
         step = next(st for st in route.steps if st.kind == "slide"
                     and allowed[st.grasp, :, int(st.to_i > st.i), min(st.i, st.to_i)].max() == -np.inf)  # fmt: skip
-        grasp, d = tables.grasps[step.grasp], float(np.sign(step.to_i - step.i))
+        row, d = tables.grasps[step.grasp], float(np.sign(step.to_i - step.i))
         x0, x1 = float(tables.x[step.i]), float(tables.x[step.to_i])
-        reports = [failure_report(task, f"the slide from x = {x0:.4g} to {x1:.4g} m (grasp {grasp.label}, {e} finger "
-                                  "torque-controlled)", x0, x1, e, d, None, xs=np.array([x0, x1]), grasp=grasp)
-                   for e in ("left", "right")]  # fmt: skip
+        reports = [failure_report(task, f"the slide from x = {x0:.4g} to {x1:.4g} m (grasp {row.label}, "
+                                  f"{_joint_words(task, e)} torque-controlled)", x0, x1, e, d, None,
+                                  xs=np.array([x0, x1]), grasp=row.grasp, path=row.path)
+                   for e in tables.efforts]  # fmt: skip
         band = max(reports, key=lambda r: -1.0 if r.mu_closes is None else r.mu_closes)
-        summary = (f"the geometry allows a route, but at x = {x0:.4g} m (grasp {grasp.label}, sliding "
-                   f"{'right' if d > 0 else 'left'}) 4S has no guaranteed band for the whole friction range "
-                   f"{list(task.mu_range)} with either finger torque-controlled")  # fmt: skip
+        which = "either finger" if len(tables.efforts) == 2 else "any joint"
+        summary = (f"the geometry allows a route, but at x = {x0:.4g} m (grasp {row.label}, sliding "
+                   f"{'right' if d > 0 else 'left'}) {mode_name(task.formation.mode)} has no guaranteed band for the "
+                   f"whole friction range {list(task.mu_range)} with {which} torque-controlled")  # fmt: skip
         return NoRouteReport("band closes", summary, details + tuple(r.message for r in reports), band)
     regrasps = f"; {len(forbidden)} regrasps OMPL could not realise" if forbidden else ""
     summary = ("no sequence of slides and regrasps joins the start and the goal: " + "; ".join(details)

@@ -1,15 +1,19 @@
-"""The two kinds of phase of a two-finger plan: in-contact 4S slides and regrasps (Section 5.2, Fig. 9).
+"""The two kinds of phase of a two-finger plan: in-contact slides and regrasps (Section 5.2, Fig. 9), for any hand.
 
 :func:`slide_phase` judges every sample of a slide (the dense sweep, :func:`sweep_contact_segment`) and chooses
 its commands; :func:`regrasp_phase` plans the fingers' release, move and re-closing through OMPL.  Both serve the
 scripted sequence (:func:`qsplan.planner.plan.scripted.plan_task`) and the sequence the planner finds
-(:mod:`qsplan.planner.plan.autoplan`); a ``grasp`` (:class:`qsplan.hands.grasps.Grasp`) says which features the
-fingers touch (default both inner edges, as the scripted tasks).  Units SI (m, rad, s, N m).
+(:mod:`qsplan.planner.plan.autoplan`), for every hand (:class:`qsplan.hands.protocol.Hand`): a ``grasp`` says which
+features the fingers touch (default the paper hand's inner edges, as its scripted tasks), a :class:`FreePath`
+where a described hand's free joints are while the workpiece slides.  The desired mode is the task's
+formation's (:attr:`qsplan.planner.task.task.Task.formation`).  Units SI (m, rad, s, N m; m, m/s and N for a
+prismatic joint).
 """
 
 from __future__ import annotations
 
 import time
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -18,23 +22,66 @@ from qsplan.mechanics.errors import NoAnswerError, QsplanError
 from qsplan.planner.plan.failure import configuration_report, failure_report
 from qsplan.planner.plan.results import ContactSegmentPlan, PlanFailure, RegraspPlan
 from qsplan.planner.search.ompl_bridge import PlannerOptions, plan_path
-from qsplan.planner.states.contact import MODE, check_contact_state, check_free_state, configuration_problem, contact_samples, free_state_problem
+from qsplan.planner.states.contact import (check_contact_state, check_free_state, configuration_problem, contact_samples,
+                                           free_state_problem, mode_name)  # fmt: skip
 
-__all__ = ["DEFAULT_OPTIONS", "REGRASP_OPENING", "SWEEP_STEP", "densify", "densify_rows", "regrasp_phase", "slide_phase", "straight_path",
-           "sweep_contact_segment"]
+__all__ = ["DEFAULT_OPTIONS", "FreePath", "OPENING", "REGRASP_OPENING", "SLIP_RTOL", "SWEEP_STEP", "densify",
+           "densify_rows", "regrasp_phase", "slide_phase", "slip_reversal", "straight_path", "sweep_contact_segment"]
 
 #: Angle (rad) each finger opens by to release the workpiece between segments: about 1.5 cm
 #: at the tip of a 0.16 m finger, clear of the workpiece's corners.
 REGRASP_OPENING = 0.1
 
+#: How far each finger's closing joint opens to let go, by joint kind (rad, m): :data:`REGRASP_OPENING` for a
+#: revolute joint (0.1 rad is 7 mm at the tip of a 7 cm link), 5 mm of jaw travel for a prismatic one.  Both far
+#: above the contact tolerance and small beside the fingers.
+OPENING = {"revolute": REGRASP_OPENING, "prismatic": 0.005}
+
 #: Distance (m) between the samples of the dense band sweep of a segment (0.5 mm: 80 per 4 cm).
 SWEEP_STEP = 5e-4
+
+#: Tangential speed, relative to the workpiece's, below which a contact counts as not sliding when sliding
+#: directions are compared: a rolling contact's computes as ~1e-16 of the speed; a sliding finger contact of the
+#: bundled hands slips at 1e-3 of it or more.
+SLIP_RTOL = 1e-9
 
 #: The regrasps' OMPL queries (in-contact segments need no search): RRTConnect, deterministic, seed 1;
 #: edges checked every 2 % of the joint box, then the exported lines every SWEEP_STEP at the fingertips.
 #: The iteration budget decides (same inputs, same plan); the time limit per OMPL query (s) is a
 #: safety net well above the few seconds a query takes, so a loaded machine does not change the answer.
 DEFAULT_OPTIONS = PlannerOptions(validity_resolution=0.02, iterations=2_000, time_limit=120.0)
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class FreePath:
+    """A described hand's free joints along a slide: straight in ``x`` (their values at ``x0`` and their slope).
+
+    Attributes
+    ----------
+    x0 : float
+        m.
+    values : ndarray, shape (n_free,)
+        The free joints at ``x0`` (rad or m), in joint order.
+    slope : ndarray, shape (n_j,)
+        Every joint's rate per metre of workpiece travel (rad/m or m/m): the free joints' slope, 0 at the closing
+        joints (their rates follow from the contacts).
+    free : tuple of int
+        The free joints' indices.
+    """
+
+    x0: float
+    values: np.ndarray
+    slope: np.ndarray
+    free: tuple
+
+    def at(self, x) -> np.ndarray:
+        """The free joints at workpiece ``x`` (n,): shape (n, n_free)."""
+        dx = np.asarray(x, dtype=float).reshape(-1, 1) - self.x0
+        return np.asarray(self.values, dtype=float)[None, :] + dx * np.asarray(self.slope, dtype=float)[list(self.free)]
+
+    def rates(self, n: int, speed: float) -> np.ndarray:
+        """Every joint's rate (n, n_j) at workpiece speed ``speed`` (m/s): the free joints', the closing ones 0."""
+        return np.broadcast_to(np.asarray(self.slope, dtype=float) * float(speed), (n, len(self.slope))).copy()
 
 
 def densify(path_x, step):
@@ -47,10 +94,11 @@ def densify(path_x, step):
 
 
 def densify_rows(path, step):
-    """``path`` (n, d) with states added on each straight edge, at most ``step`` apart in every coordinate."""
+    """``path`` (n, d) with states added on each straight edge, at most ``step`` apart in every coordinate (``step``:
+    one number, or one per coordinate, shape (d,))."""
     out = [path[:1]]
     for a, b in zip(path[:-1], path[1:]):
-        n = max(1, int(np.ceil(np.max(np.abs(b - a)) / step)))
+        n = max(1, int(np.ceil(np.max(np.abs(b - a) / step))))
         out.append(a + np.linspace(0.0, 1.0, n + 1)[1:, None] * (b - a))
     return np.vstack(out)
 
@@ -61,10 +109,25 @@ def straight_path(x0, x1):
     return np.array([[x0], [x1]], dtype=float)
 
 
-def sweep_contact_segment(task, name, x, effort, direction, touching, comps, grasp=None):
+def _samples(task, x, effort, speed, name, grasp, path):
+    """:func:`contact_samples` of a slide at ``speed`` (m/s, signed) along ``path``."""
+    free = None if path is None else path.at(x)
+    rates = None if path is None else path.rates(len(x), speed)
+    return contact_samples(task, x, effort, speed, name, grasp=grasp, free=free, free_rates=rates)
+
+
+def _state(task, x, effort, direction, touching, comps, grasp, path):
+    """:func:`check_contact_state` at ``x`` of a slide along ``path``."""
+    free = None if path is None else path.at([x])[0]
+    return check_contact_state(task, x, effort, direction, touching, comps, grasp, free,
+                               None if path is None else path.slope)  # fmt: skip
+
+
+def sweep_contact_segment(task, name, x, effort, direction, touching, comps, grasp=None, path=None):
     """Judge every sample of an in-contact segment once, with the validity conditions of
-    :func:`check_contact_state` (the same contacts, no overlap, joint limits, 4S kinematics, a guaranteed band
-    at least ``task.torque_resolution`` wide), the band batched over the samples as the plan needs it anyway.
+    :func:`check_contact_state` (the same contacts, no overlap, joint limits, the formation's mode's kinematics, a
+    guaranteed band at least ``task.torque_resolution`` wide) and every sliding contact keeping its direction
+    (:func:`slip_reversal`), the band batched over the samples as the plan needs it anyway.
 
     Parameters
     ----------
@@ -74,26 +137,32 @@ def sweep_contact_segment(task, name, x, effort, direction, touching, comps, gra
     x : ndarray, shape (n,)
         Workpiece x of the samples (m), in the order of motion.
     effort : str
-        The effort-controlled finger, ``"left"`` or ``"right"``.
+        The effort-controlled joint's name.
     direction : float
         Sign of the workpiece's velocity.
     touching : ndarray, shape (2,)
-        The workpiece vertices the fingertips touch at the segment's start (a change is invalid).
+        What the fingers touch at the segment's start (:attr:`qsplan.hands.motion.SlideMotion.touching`; a change is
+        invalid).
     comps : tuple of str
         The competing modes to preclude (:func:`qsplan.planner.torque.sweep.competing_modes`).
-    grasp : qsplan.hands.grasps.Grasp, optional
-        The features the fingers touch (default: both inner edges, the scripted tasks).
+    grasp : optional
+        The grasp (:meth:`qsplan.hands.protocol.Hand.grasp_candidates`; default the paper hand's inner edges).
+    path : FreePath, optional
+        A described hand's free joints along the slide (default: the grasp's, held).
 
     Returns
     -------
     k : int or None
-        Index of the first invalid sample (the first ``k`` where :func:`check_contact_state` is not ok), or None.
+        Index of the first invalid sample, or None.
     samples : qsplan.hands.segments.SegmentSamples or None
-        When every sample is valid: the samples moving at ``speed``.
+        When every sample is valid: the samples moving at ``speed``; else None.
     band : qsplan.mechanics.bands.effort.Band or None
-        Their guaranteed band (N m), competitors precluded.
+        Their guaranteed band (N m or N), competitors precluded.
     speed : float or None
-        Workpiece speed (m/s): the fastest within the workpiece and joint speed limits.
+        Workpiece speed (m/s): the fastest within the workpiece and every joint's speed limit.
+    why : str or None
+        Why sample ``k`` is invalid where the one-state check (:func:`check_contact_state`) cannot see it (a sliding
+        direction reversing between samples); None otherwise.
     """
     from qsplan.mechanics.bands.effort import band_kinematics
     from qsplan.mechanics.modes.contact_mode import ContactMode
@@ -101,31 +170,54 @@ def sweep_contact_segment(task, name, x, effort, direction, touching, comps, gra
     from qsplan.planner.torque.pointwise import guaranteed_sweep
 
     try:
-        S = contact_samples(task, x, effort, direction, grasp=grasp)
+        S = _samples(task, x, effort, direction, "segment", grasp, path)
     except QsplanError:  # no grasp somewhere: the first sample without one
-        k = next((k for k, xk in enumerate(x)
-                  if not check_contact_state(task, xk, effort, direction, touching, comps, grasp).ok), 0)  # fmt: skip
-        return k, None, None, None
-    rate = np.max(np.abs(S.qd))
-    speed = min(task.workpiece_speed, task.joint_speed / rate) if rate > 0 else task.workpiece_speed
-    S = contact_samples(task, x, effort, direction * speed, name, grasp=grasp)
-    mode = ContactMode(MODE)
+        k = next((k for k, xk in enumerate(x) if not _state(task, xk, effort, direction, touching, comps, grasp, path).ok),
+                 0)  # fmt: skip
+        return k, None, None, None, None
+    rate = np.max(np.abs(S.qd) / np.asarray(task.joint_speeds, dtype=float)[None, :])  # per joint, its own limit
+    speed = min(task.workpiece_speed, 1.0 / rate) if rate > 0 else task.workpiece_speed
+    S = _samples(task, x, effort, direction * speed, name, grasp, path)
+    mode = ContactMode(task.formation.mode)
     for k in range(len(x)):
         if (np.any(S.touching[k] != touching) or configuration_problem(task, S.pose[k], S.q[k])
                 or not band_kinematics(S.scenes[k], mode).ok):  # fmt: skip
-            return k, None, None, None
-    band = guaranteed_sweep(S, task.mu_range, task.shared_mu, MODE, comps, force_margin=task.force_margin).band
+            return k, None, None, None, None
+    k = slip_reversal(S, mode.letters, direction * speed)
+    if k is not None:
+        why = "a sliding contact's direction reverses here (it would roll in between: a mode change, eq. 16)"
+        return k, None, None, None, why
+    band = guaranteed_sweep(S, task.mu_range, task.shared_mu, mode.letters, comps, force_margin=task.force_margin).band
     bad = ~np.asarray(band.feasible) | (band.upper - band.lower < task.torque_resolution)
     if bad.any():
-        return int(np.argmax(bad)), None, None, None
-    return None, S, band, float(speed)
+        return int(np.argmax(bad)), None, None, None, None
+    return None, S, band, float(speed), None
+
+
+def slip_reversal(samples, mode: str, xdot: float):
+    """The first sample where a contact the mode slides moves the other way than at the first sample (it stops
+    sliding in between: eq. 16, a mode change the letters would not show), or None.  Tangential velocities
+    ``W_t^T nu - J_t qdot`` (eq. 6) of the workpiece translating at ``xdot`` (m/s) along x and the joints at the
+    samples' rates (the velocity-controlled joints' commands, the effort-controlled joint's rate the contacts give)."""
+    sliding = np.array([c == "S" for c in mode])
+    nu = np.array([float(xdot), 0.0, 0.0])
+    first = None
+    for k, scene in enumerate(samples.scenes):
+        v = scene.Wt.T @ nu - scene.Jt @ np.asarray(samples.qd[k], dtype=float)
+        sign = np.where(np.abs(v) > SLIP_RTOL * abs(float(xdot)), np.sign(v), 0.0)
+        if first is None:
+            first = sign
+        elif np.any(sliding & (sign * first < 0)):
+            return k
+    return None
 
 
 def slide_phase(task, name, x0, x1, effort, direction, touching, comps, t0, options, progress, counters,
-                grasp=None) -> ContactSegmentPlan:  # fmt: skip
-    """The in-contact phase sliding the workpiece from ``x0`` to ``x1`` (m) in 4S: the dense sweep judges every
-    sample (:func:`sweep_contact_segment`), then the commands are chosen (the largest margin kept along the
-    whole segment, :func:`qsplan.planner.torque.command.choose_command`).
+                grasp=None, path=None) -> ContactSegmentPlan:  # fmt: skip
+    """The in-contact phase sliding the workpiece from ``x0`` to ``x1`` (m) in the formation's mode: the dense sweep
+    judges every sample (:func:`sweep_contact_segment`), then the commands are chosen (the largest margin kept
+    along the whole segment, :func:`qsplan.planner.torque.command.choose_command`).  ``path``: a described hand's
+    free joints along it (:class:`FreePath`; default held).
 
     Raises
     ------
@@ -135,55 +227,63 @@ def slide_phase(task, name, x0, x1, effort, direction, touching, comps, t0, opti
     from qsplan.planner.search.ompl_bridge import PlanResult
     from qsplan.planner.torque.command import choose_command, default_safety_margin
 
-    # the configuration is the workpiece's x alone (the fingers follow the grasp's closed form): the only path
-    # is the straight line, and its dense sweep is the whole check
-    path = straight_path(x0, x1)
-    x = densify(path[:, 0], SWEEP_STEP)
+    # the configuration is the workpiece's x (the fingers follow the grasp, a described hand's free joints their
+    # path): the only path is the straight line, and its dense sweep is the whole check
+    line = straight_path(x0, x1)
+    x = densify(line[:, 0], SWEEP_STEP)
     t_check = time.perf_counter()
-    k, S, band, speed = sweep_contact_segment(task, name, x, effort, direction, touching, comps, grasp)
+    k, S, band, speed, why = sweep_contact_segment(task, name, x, effort, direction, touching, comps, grasp, path)
     seconds = time.perf_counter() - t_check
     counters[0] += len(x) if k is None else k + 1
     counters[1] += seconds
     if k is not None:
-        why = check_contact_state(task, x[k], effort, direction, touching, comps, grasp).reason or "band narrower than the resolution"
-        status = f"dense sweep: state {k + 1} of {len(x)} invalid, at x = {x[k]:.4g} m: {why}"
-        res = PlanResult(path[:k + 1], False, status, k + 1, seconds, options)
-        raise PlanFailure(failure_report(task, name, x0, x1, effort, direction, comps, res, grasp=grasp))
-    res = PlanResult(path, True, f"dense sweep: all {len(x)} states valid", len(x), seconds, options)
-    progress(f"  {res.status} (overlaps, limits, contacts, 4S kinematics, guaranteed band) in {seconds:.2f} s")
+        why = why or _state(task, x[k], effort, direction, touching, comps, grasp, path).reason
+        status = f"dense sweep: state {k + 1} of {len(x)} invalid, at x = {x[k]:.4g} m: {why or 'band narrower than the resolution'}"
+        res = PlanResult(line[:k + 1], False, status, k + 1, seconds, options)
+        raise PlanFailure(failure_report(task, name, x0, x1, effort, direction, comps, res, grasp=grasp, path=path))
+    res = PlanResult(line, True, f"dense sweep: all {len(x)} states valid", len(x), seconds, options)
+    mode = task.formation.mode
+    progress(f"  {res.status} (overlaps, limits, contacts, {mode_name(mode)} kinematics, guaranteed band) in {seconds:.2f} s")
     try:
         safety = default_safety_margin(band, task.torque_resolution)
     except NoAnswerError:  # unbounded everywhere: keep the controller's resolution from the finite edge
         safety = task.torque_resolution
     command, margin = choose_command(band.lower, band.upper, safety, max_margin=safety)
     s = np.concatenate([[0.0], np.cumsum(np.abs(np.diff(x)))])
-    v = 1 - (0 if effort == "left" else 1)
     qd = S.qd.copy()
-    qd[:, 1 - v] = np.nan  # the effort-controlled joint gets no velocity command
-    return ContactSegmentPlan(name, effort, MODE, path[:, 0].copy(), t0 + s / speed, x, S.q.copy(), qd,
+    qd[:, task.hand.joint_names.index(effort)] = np.nan  # the effort-controlled joint gets no velocity command
+    return ContactSegmentPlan(name, effort, mode, line[:, 0].copy(), t0 + s / speed, x, S.q.copy(), qd,
                               band.lower.copy(), band.upper.copy(), command, margin, comps, speed, res)  # fmt: skip
 
 
+def _opened(task, q, opening) -> np.ndarray:
+    """``q`` with each joint moved by its opening amount (:data:`OPENING` by kind) in direction ``opening`` (-1, 0, 1)."""
+    amount = np.array([OPENING[k] for k in task.hand.joint_kinds])
+    return np.asarray(q, float) + amount * np.asarray(opening, float)
 
 
-def regrasp_phase(task, name, x, q_from, q_to, t0, options, progress, counters, opening_from=(1.0, -1.0),
-                  opening_to=(1.0, -1.0)) -> RegraspPlan:  # fmt: skip
-    """Both fingers release the workpiece at ``x`` (m) from joints ``q_from`` and close on it at ``q_to`` (rad,
-    shape (2,)), through OMPL in joint space: each finger opens by :data:`REGRASP_OPENING` in the direction
-    ``opening_from`` (the sign of the joint rate that moves its contact out of the workpiece; the default is the
-    inner edges': the left finger counter-clockwise), moves to the opened ``q_to`` and closes; the workpiece
-    rests on the palm meanwhile.  Every leg is collision-free (:func:`check_free_state`), and the straight lines
-    between OMPL's states are checked again every :data:`SWEEP_STEP` at the fingertips.
+def regrasp_phase(task, name, x, q_from, q_to, t0, options, progress, counters, opening_from=None,
+                  opening_to=None) -> RegraspPlan:  # fmt: skip
+    """Both fingers release the workpiece at ``x`` (m) from joints ``q_from`` and close on it at ``q_to`` (rad or m,
+    shape (n_j,)), through OMPL in joint space: each finger's closing joint opens by its :data:`OPENING` in the
+    direction ``opening_from`` (per joint -1, 0 or +1, :meth:`qsplan.hands.protocol.Hand.opening`; default the paper
+    hand's inner edges': the left finger counter-clockwise), every joint moves to the opened ``q_to`` and the
+    fingers close; the workpiece rests on the palm meanwhile.  Every leg is collision-free
+    (:func:`check_free_state`), and the straight lines between OMPL's states are checked again every
+    :data:`SWEEP_STEP` of a link's travel (:func:`qsplan.hands.interface.finger_reach` sets the joint step).
 
     Raises
     ------
     PlanFailure
         With a :class:`qsplan.planner.plan.failure.ConfigurationReport` naming the leg and what blocks it.
     """
+    from qsplan.hands.interface import finger_reach
+
     progress(name)
     q, q_to = np.asarray(q_from, float), np.asarray(q_to, float)
-    q_open = q + REGRASP_OPENING * np.asarray(opening_from, float)
-    q_to_open = q_to + REGRASP_OPENING * np.asarray(opening_to, float)
+    default = task.hand.opening(None, x, q) if opening_from is None or opening_to is None else None
+    q_open = _opened(task, q, default if opening_from is None else opening_from)
+    q_to_open = _opened(task, q_to, default if opening_to is None else opening_to)
     lim = task.joint_limits
     results, path = [], [q[None, :]]
     legs = [(q, q_open, "the opening"), (q_open, q_to_open, "the move to the new grasp"), (q_to_open, q_to, "the closing")]
@@ -203,17 +303,17 @@ def regrasp_phase(task, name, x, q_from, q_to, t0, options, progress, counters, 
         path.append(res.path[1:])
     path = np.vstack(path)
     # OMPL checked its edges at validity_resolution; the fingers move on straight lines between the rows
-    # exported, so check those lines again every SWEEP_STEP at the fingertips
-    dense = densify_rows(path, SWEEP_STEP / task.hand.finger_length)
+    # exported, so check those lines again every SWEEP_STEP of travel at the fingertips (m for a prismatic joint)
+    reach = finger_reach(task.hand)
+    steps = np.array([SWEEP_STEP / reach if k == "revolute" else SWEEP_STEP for k in task.hand.joint_kinds])
+    dense = densify_rows(path, steps)
     for qk in dense:
         why = free_state_problem(task, x, qk)
         if why:
             raise PlanFailure(configuration_report(task, name, "a state between OMPL's states", x, qk, why,
                                                    results[-1].status))  # fmt: skip
-    steps = np.max(np.abs(np.diff(path, axis=0)), axis=1)
-    t = t0 + np.concatenate([[0.0], np.cumsum(steps / task.joint_speed)])
+    moves = np.max(np.abs(np.diff(path, axis=0)) / np.asarray(task.joint_speeds, float)[None, :], axis=1)
+    t = t0 + np.concatenate([[0.0], np.cumsum(moves)])
     seg_qd = np.diff(path, axis=0) / np.maximum(np.diff(t), 1e-12)[:, None]
-    qd = np.vstack([seg_qd, np.zeros((1, 2))])
+    qd = np.vstack([seg_qd, np.zeros((1, path.shape[1]))])
     return RegraspPlan(name, float(x), t, path, qd, tuple(results))
-
-

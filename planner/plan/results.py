@@ -120,10 +120,10 @@ class Plan:
         Time judging them (s): the in-contact dense sweeps (scenes, overlaps, guaranteed bands)
         plus the regrasps' OMPL queries; ``checks_per_second`` is their ratio.
     options : PlannerOptions
-    sequence : tuple of dict
-        The sequence the planner chose (automatic planning, :mod:`qsplan.planner.search`): one plain dict per
-        phase (``kind`` "slide" or "regrasp", the grasp's features, ``x`` from and to (m), the effort-controlled
-        finger, the narrowest band (N m)), and the search's figures; empty for a scripted task.
+    sequence : tuple
+        The sequence the planner chose (automatic planning, :mod:`qsplan.planner.search`): one typed step per
+        phase (:class:`qsplan.planner.plan.steps.SlideStep`, :class:`~qsplan.planner.plan.steps.RegraspStep`),
+        then the search's :class:`~qsplan.planner.plan.steps.SearchSummary`; empty for a scripted task.
     """
 
     task: Task
@@ -141,6 +141,13 @@ class Plan:
     @property
     def duration(self) -> float:
         return float(self.phases[-1].t[-1])
+
+    @property
+    def search(self):
+        """The route search's :class:`~qsplan.planner.plan.steps.SearchSummary`, None for a scripted plan."""
+        from qsplan.planner.plan.steps import search_summary
+
+        return search_summary(self.sequence)
 
     @property
     def checks_per_second(self) -> float:

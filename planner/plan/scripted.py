@@ -66,7 +66,6 @@ from qsplan.planner.states.contact import (
     configuration_problem,
     contact_samples,
     free_state_problem,
-    hand_scene_at,
 )
 from qsplan.planner.task.task import Task
 
@@ -90,13 +89,38 @@ __all__ = [
 ]
 
 
-
-
 # ---------------------------------------------------------------------------------------------- planning
 
 
 def _segment_name(i, x0, x1):
     return f"segment {i + 1}: slide the workpiece {'left' if x1 < x0 else 'right'} from x = {x0:.4g} to {x1:.4g} m"
+
+
+def _held(task):
+    """A scripted task's free joints along every segment: the ``[start]`` ones held (None for a hand without free
+    joints).
+
+    Raises
+    ------
+    QsplanError
+        A hand with free joints and no ``[start]``: scripted waypoints start from the joints the task names.
+    """
+    from qsplan.planner.plan.phases import FreePath
+
+    hand = task.hand
+    if not hand.free_joints:
+        return None
+    if task.start_joints is None:
+        raise QsplanError(f"start: a scripted task (motion.waypoints) of a hand with free joints names them in [start] "
+                          f"({', '.join(hand.joint_names[j] for j in hand.free_joints)}); or give a [goal] instead")  # fmt: skip
+    free = list(hand.free_joints)
+    return FreePath(float(task.start_x), np.asarray(task.start_joints, float)[free], np.zeros(len(hand.joint_names)),
+                    tuple(free))  # fmt: skip
+
+
+def _grasp_q(task, x, path):
+    """The scripted grasp's joints at ``x`` (m), shape (n_j,) (the paper hand's tangency; any hand's closing)."""
+    return task.hand.closed_configuration(task.formation, None, x, None if path is None else path.at([x])[0])
 
 
 def check_configurations(task: Task) -> None:
@@ -109,80 +133,85 @@ def check_configurations(task: Task) -> None:
         With a :class:`qsplan.planner.plan.failure.ConfigurationReport` naming the configuration, the
         colliding bodies and their overlap, or the joint beyond its limit.
     """
-    from qsplan.hands.two_finger import finger_angles
+    from qsplan.planner.plan.phases import OPENING
 
+    path = _held(task)
     xs = [task.start_x, *task.waypoints.tolist()]
     last = len(xs) - 1
+    amount = np.array([OPENING[k] for k in task.hand.joint_kinds])
     for i, x in enumerate(xs):
         seg = _segment_name(max(i - 1, 0), xs[max(i - 1, 0)], xs[max(i - 1, 0) + 1])
         where = "the start" if i == 0 else ("the goal" if i == last else f"the end of segment {i}")
         try:
-            q = finger_angles(task.hand, task.pose(x))[0]
+            q = _grasp_q(task, x, path)
         except QsplanError as exc:
             report = configuration_report(task, seg, where, x, None, f"no four-contact grasp: {exc}")
             raise PlanFailure(report) from None
         if configuration_problem(task, task.pose(x), q):
             raise PlanFailure(configuration_report(task, seg, where, x, q))
         if 0 < i < last:
-            q_open = q + np.array([REGRASP_OPENING, -REGRASP_OPENING])
+            q_open = q + amount * task.hand.opening(None, x, q)
             if free_state_problem(task, x, q_open):
                 name = f"regrasp {i}: both fingers release and regrasp at x = {x:.4g} m"
                 raise PlanFailure(configuration_report(task, name, f"the opened fingers of regrasp {i}", x, q_open))
 
 
-def _effort_joint(task, x0, x1, progress):
-    """The effort-controlled finger of a segment: admitted by the partitioner (eq. 32), widest narrowest band."""
-    from qsplan.hands.two_finger import JOINT_NAMES
+def _effort_joint(task, x0, x1, progress, path):
+    """The effort-controlled joint of a segment: admitted by the partitioner (eq. 32), widest narrowest band."""
     from qsplan.mechanics.modes.contact_mode import ContactMode
     from qsplan.mechanics.modes.partition import effort_partitions
 
+    names = task.hand.joint_names
     d = np.sign(x1 - x0)
     xs = np.linspace(x0, x1, 7)
     try:
-        scene = hand_scene_at(task, x0, "right", 0.0)[3]
-        admitted = {JOINT_NAMES[p.effort_joints[0]] for p in effort_partitions(scene, ContactMode(MODE))
+        scene = contact_samples(task, [x0], names[-1], 0.0, free=None if path is None else path.at([x0])).scenes[0]
+        admitted = {names[p.effort_joints[0]] for p in effort_partitions(scene, ContactMode(task.formation.mode))
                     if len(p.effort_joints) == 1}  # fmt: skip
     except QsplanError:
-        admitted = set(JOINT_NAMES)
+        admitted = set(names)
     best, best_w = None, -np.inf
-    for joint in JOINT_NAMES:
+    for joint in names:
         if joint not in admitted:
             continue
-        w = [check_contact_state(task, x, joint, d) for x in xs]
+        w = [check_contact_state(task, x, joint, d, free=None if path is None else path.at([x])[0]) for x in xs]
         worst = min((c.width if np.isfinite(c.width) else -np.inf) for c in w)
         if worst > best_w:
             best, best_w = joint, worst
-    return best or "right"
+    return best or names[-1]
 
 
-def _segment(task, i, x0, x1, t0, options, progress, counters):
-    from qsplan.hands.two_finger import finger_angles
+def _segment(task, i, x0, x1, t0, options, progress, counters, path):
     from qsplan.planner.torque.sweep import competing_modes
 
     name = _segment_name(i, x0, x1)
     direction = float(np.sign(x1 - x0))
-    effort = _effort_joint(task, x0, x1, progress)
+    effort = _effort_joint(task, x0, x1, progress, path)
     progress(f"{name}: effort-controlled finger {effort}; one configuration variable: checking the straight line "
              f"every {SWEEP_STEP * 1e3:g} mm (no search)")  # fmt: skip
+    xs = np.linspace(x0, x1, 9)
     try:
-        line = contact_samples(task, np.linspace(x0, x1, 9), effort, direction * task.workpiece_speed)
+        line = contact_samples(task, xs, effort, direction * task.workpiece_speed,
+                               free=None if path is None else path.at(xs))  # fmt: skip
     except QsplanError as exc:
         raise PlanFailure(configuration_report(task, name, "the straight line of the segment", x0, None,
                                                f"no four-contact grasp: {exc}")) from None  # fmt: skip
     comps = competing_modes(line)
     touching = line.touching[0]
     for x_end, where in ((x0, "the start of the segment"), (x1, "its goal")):
-        c = check_contact_state(task, x_end, effort, direction, touching, comps)
+        free = None if path is None else path.at([x_end])[0]
+        c = check_contact_state(task, x_end, effort, direction, touching, comps, free=free)
         if c.ok:
             continue
         if not c.reason.startswith(("band", "no guaranteed band")):  # refused for its geometry: named here
             try:
-                q_end = finger_angles(task.hand, task.pose(x_end))[0]
+                q_end = _grasp_q(task, x_end, path)
             except QsplanError:
                 q_end = None
             raise PlanFailure(configuration_report(task, name, where, x_end, q_end, c.reason))
-        raise PlanFailure(failure_report(task, name, x0, x1, effort, direction, comps, None))  # for its band
-    return slide_phase(task, name, x0, x1, effort, direction, touching, comps, t0, options, progress, counters)
+        raise PlanFailure(failure_report(task, name, x0, x1, effort, direction, comps, None, path=path))  # for its band
+    return slide_phase(task, name, x0, x1, effort, direction, touching, comps, t0, options, progress, counters,
+                       path=path)  # fmt: skip
 
 
 def _regrasp(task, i, x, q, t0, options, progress, counters):
@@ -218,17 +247,11 @@ def plan_task(task: Task, options: PlannerOptions | None = None, progress=None, 
     """
     if options is None:
         options = DEFAULT_OPTIONS
-    from qsplan.hands.chain_hand import ChainHand
     from qsplan.planner.plan.failure import palm_report
 
     beyond = palm_report(task)  # from the task's geometry alone, before any table or grid is built
     if beyond is not None:
         raise PlanFailure(beyond)
-
-    if isinstance(task.hand, ChainHand):  # a described hand: slides planned on the contact manifold
-        from qsplan.planner.plan.chain_plan import plan_chain_task
-
-        return plan_chain_task(task, options, progress)
     if task.goal is not None:  # the planner finds the sequence
         from qsplan.planner.plan.autoplan import plan_automatic
 
@@ -236,6 +259,7 @@ def plan_task(task: Task, options: PlannerOptions | None = None, progress=None, 
     progress = progress or (lambda line: None)
     t_start = time.perf_counter()
     check_configurations(task)
+    path = _held(task)
     counters = [0, 0.0]
     phases, t0 = [], 0.0
     xs = [task.start_x, *task.waypoints.tolist()]
@@ -244,7 +268,7 @@ def plan_task(task: Task, options: PlannerOptions | None = None, progress=None, 
             prev = phases[-1]
             phases.append(_regrasp(task, i - 1, x0, prev.q[-1], t0, options, progress, counters))
             t0 = float(phases[-1].t[-1])
-        seg = _segment(task, i, x0, x1, t0, options, progress, counters)
+        seg = _segment(task, i, x0, x1, t0, options, progress, counters, path)
         phases.append(seg)
         t0 = float(seg.t[-1])
     plan = Plan(task, tuple(phases), time.perf_counter() - t_start, counters[0], counters[1], options)

@@ -129,9 +129,7 @@ def snapshot_legend_handles(effort: bool = True, hand=None) -> list:
 
     from matplotlib.patches import Patch
 
-    from qsplan.hands.interface import is_chain_hand
-
-    chain = hand is not None and is_chain_hand(hand)
+    chain = hand is not None and any(len(f) > 1 for f in hand.finger_joints)  # fingers of several links
     out = [Patch(fc=body_style(n)[0], ec=body_style(n)[1], label=f"{n} finger" + ("'s links" if chain else ""))
            for n in ("left", "right")]  # fmt: skip
     out += [Line2D([], [], ls="none", marker="o", ms=4, color="k", label="contact"),

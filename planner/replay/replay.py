@@ -19,8 +19,8 @@ effort-controlled joint its torque column, both interpolated linearly in time be
 scenes come from :func:`qsplan.hands.interface.scene_at`.  Between segments the plan's regrasp
 puts both fingers back on the workpiece where it is, so each segment starts from the simulated
 end of the previous one (errors carry over): the paper's fingers by tangency with the planned
-grasp (:func:`grasp_angles`), a described chain hand's by closing each finger's last joint onto
-the workpiece from the plan's free joints (:func:`qsplan.hands.chain_hand.close_grasp`).
+grasp, any other described hand's by closing each finger's last joint onto the workpiece from the plan's free
+joints (:meth:`qsplan.hands.described.DescribedHand.reclose`).
 """
 
 from __future__ import annotations
@@ -30,10 +30,9 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from qsplan.mechanics.errors import QsplanError
-from qsplan.planner.replay.grasp import chain_grasp, grasp_angles
 
-__all__ = ["ReplaySystem", "SegmentReplay", "Replay", "chain_grasp", "grasp_angles", "replay_plan", "replay_segments",
-           "friction_samples", "CHAIN_REPLAY_TRAVEL", "REPLAY_STEP"]
+__all__ = ["ReplaySystem", "SegmentReplay", "Replay", "replay_plan", "replay_segments",
+           "friction_samples", "REPLAY_STEP"]
 
 #: Step of the replay (s).  Mode changes are located by root finding, not by the step; 0.05 s is
 #: 0.5 mm of workpiece travel at the default 1 cm/s, the spacing of the plan's rows (its band sweep),
@@ -45,15 +44,6 @@ REPLAY_STEP = 0.05
 MAX_CACHED_SCENES = 10_000
 
 
-#: Largest workpiece travel (m) per step when replaying a described chain hand.  Its scenes find the contacts in
-#: the polygons at every stage of the RK4 step, and refuse a penetration beyond the contact tolerance (1e-6 m); a
-#: stage is an Euler-like prediction, off the contact constraint by about travel^2 / (2 R) for a contact path of
-#: radius R.  The two-link hand's fingertip contacts (R ~ 0.1 m) penetrate 1.3e-6 m at REPLAY_STEP's 0.5 mm; at
-#: 0.1 mm, 25 times less (5e-8 m), and still within the tolerance for radii down to 5 mm.  The paper's hand builds
-#: its scenes from the grasp's closed form and keeps REPLAY_STEP.
-CHAIN_REPLAY_TRAVEL = 1e-4
-
-
 def _default_options(max_step=REPLAY_STEP):
     from qsplan.mechanics.motion.simulator import MotionOptions
 
@@ -62,12 +52,12 @@ def _default_options(max_step=REPLAY_STEP):
     return MotionOptions(max_step=max_step, max_switches=0)
 
 
-def _chain_step(t, x) -> float:
-    """A chain hand's replay step (s) for a segment's rows (times ``t`` s, workpiece ``x`` m): at most
-    :data:`CHAIN_REPLAY_TRAVEL` of workpiece travel, at most :data:`REPLAY_STEP`."""
+def _travel_step(t, x, travel) -> float:
+    """A replay step (s) for a segment's rows (times ``t`` s, workpiece ``x`` m): at most ``travel`` (m) of workpiece
+    travel (:attr:`qsplan.hands.described.DescribedHand.simulation_travel`), at most :data:`REPLAY_STEP`."""
     dt, dx = np.diff(t), np.abs(np.diff(x))
     speed = float(np.max(dx[dt > 0] / dt[dt > 0], initial=0.0))
-    return min(REPLAY_STEP, CHAIN_REPLAY_TRAVEL / speed) if speed > 0 else REPLAY_STEP
+    return min(REPLAY_STEP, travel / speed) if speed > 0 else REPLAY_STEP
 
 
 def _stop_message(motion, planned) -> str | None:
@@ -85,7 +75,7 @@ class ReplaySystem:
 
     Attributes
     ----------
-    hand : qsplan.hands.two_finger.TwoFingerHand or qsplan.hands.chain_hand.ChainHand
+    hand : qsplan.hands.protocol.Hand
     effort_controlled : ndarray of bool, shape (n_j,)
         The torque-controlled joint(s); every other joint is velocity-controlled.
     t : ndarray, shape (n,)
@@ -289,12 +279,12 @@ def replay_plan(columns, hand, mu, options=None, scenes=None) -> Replay:
     ----------
     columns : dict
         The plan's columns as read by :func:`qsplan.planner.export.plan_files.read_plan_csv`.
-    hand : qsplan.hands.two_finger.TwoFingerHand or qsplan.hands.chain_hand.ChainHand
+    hand : qsplan.hands.protocol.Hand
         The task's hand.
     mu : float or array-like, shape (4,)
         Friction of the contacts palm:0, palm:1, left, right (static = kinetic).
     options : qsplan.mechanics.motion.simulator.MotionOptions, optional
-        Default ``max_step`` :data:`REPLAY_STEP` (a chain hand's: at most :data:`CHAIN_REPLAY_TRAVEL` of workpiece
+        Default ``max_step`` :data:`REPLAY_STEP` (a described hand's: at most its ``simulation_travel`` of workpiece
         travel per step) and ``max_switches = 0`` (stop at the first mode change).
     scenes : dict, optional
         A cache of the scenes built, to pass again to the replays of the same ``columns`` and
@@ -304,12 +294,12 @@ def replay_plan(columns, hand, mu, options=None, scenes=None) -> Replay:
     -------
     Replay
     """
-    from qsplan.hands.interface import is_chain_hand, joint_names
+    from qsplan.hands.described_build import as_hand
     from qsplan.mechanics.motion.simulator import simulate
     from qsplan.mechanics.motion.system import make_friction
 
-    names = joint_names(hand)
-    chain = is_chain_hand(hand)
+    hand = as_hand(hand)
+    names = hand.joint_names
     missing = [f"{c}_{n}" for n in names for c in ("q", "qd", "tau") if f"{c}_{n}" not in columns]
     if missing:
         raise QsplanError(f"plan: column {missing[0]!r} missing; expected the columns of every joint of the hand")
@@ -335,11 +325,11 @@ def replay_plan(columns, hand, mu, options=None, scenes=None) -> Replay:
         if x_prev is not None:
             pose = x_prev[:3]  # the regrasp leaves the workpiece where the simulation put it
         q_planned = np.array([columns[f"q_{n}"][k] for n in names], float)
-        close = chain_grasp if chain else grasp_angles
-        q = close(hand, pose, q_planned, rows_pose(columns, k))
+        q = hand.reclose(pose, q_planned, rows_pose(columns, k))
         x0 = np.concatenate([pose, q, [t[0]]])
-        if chain and given is None:
-            options = _default_options(_chain_step(t, np.asarray(columns["x_workpiece"], float)[rows]))
+        if hand.simulation_travel is not None and given is None:
+            x_rows = np.asarray(columns["x_workpiece"], float)[rows]
+            options = _default_options(_travel_step(t, x_rows, hand.simulation_travel))
         start = _start_modes(system, x0, mu)
         if start != (seg["mode"],):
             why = f"at t = {t[0]:.6g} s the feasible modes are {', '.join(start) or 'none (jam)'}"

@@ -98,7 +98,8 @@ def search_route(graph: SearchGraph, start, goals, planner: str = "widest", forb
     Parameters
     ----------
     graph : SearchGraph
-    start : (int, int)
+    start : (int, int), or a list of them
+        Several: the route may begin at any (the widest search runs once from all of them).
     goals : sequence of (int, int)
     planner : str
         One of :data:`SEQUENCE_PLANNERS`.
@@ -120,6 +121,7 @@ def search_route(graph: SearchGraph, start, goals, planner: str = "widest", forb
 
         raise QsplanError(f"planner: expected one of {', '.join(SEQUENCE_PLANNERS)}; got {planner!r}")
     G, n = graph.shape
+    starts = [(int(a), int(b)) for a, b in (start if len(start) and not np.isscalar(start[0]) else [start])]
     goals = [tuple(map(int, g)) for g in goals]
     forbidden = frozenset(forbidden)
     edges = slide_widths(graph)
@@ -182,12 +184,12 @@ def search_route(graph: SearchGraph, start, goals, planner: str = "widest", forb
             # the start and goals come from the closure: a state read back through
             # pdef.getStartState() is freed twice at teardown (segfault, ompl 2.0.1)
             pdef = self.getProblemDefinition()
-            s0 = (int(start[0]), int(start[1]))
-            route = widest_route(graph, s0, goals, forbidden)
+            route = widest_route(graph, starts if len(starts) > 1 else starts[0], goals, forbidden)
             found[0] = route
             if route is None:
                 return ob.PlannerStatus(ob.PlannerStatus.TIMEOUT)
             path = og.PathGeometric(si)
+            s0 = (route.steps[0].grasp, route.steps[0].i) if route.steps else starts[0]
             for g, i in [s0] + [(step.to_grasp, step.to_i) for step in route.steps]:
                 st = si.allocState()
                 st[0].value = int(g)
@@ -201,13 +203,17 @@ def search_route(graph: SearchGraph, start, goals, planner: str = "widest", forb
     mover = TableMotions(si)
     si.setMotionValidator(mover)
     start_s = si.allocState()
-    start_s[0].value, start_s[1][0] = int(start[0]), float(start[1])
+    start_s[0].value, start_s[1][0] = starts[0][0], float(starts[0][1])
     goal = ob.GoalStates(si)
     for g, i in goals:
         st = si.allocState()
         st[0].value, st[1][0] = g, float(i)
         goal.addState(st)
     ss.setStartState(start_s)
+    for a, b in starts[1:]:
+        more = si.allocState()
+        more[0].value, more[1][0] = a, float(b)
+        ss.getProblemDefinition().addStartState(more)
     ss.setGoal(goal)
     objective = None
     if planner == "widest":

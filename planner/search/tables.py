@@ -9,7 +9,7 @@ and each direction of the slide the guaranteed 4S band with every competitor pre
 (:func:`qsplan.mechanics.bands.batched_robust.robust_band_arrays`, batched over the grid and the
 grasps; per-state competitors: a mode kinematically impossible at a state cannot occur there).
 The scenes are never built as objects: their arrays come from the grasp's closed form for all
-states at once (:func:`qsplan.planner.states.grasped.grasp_scene_arrays`), a state's scene
+states at once (:meth:`qsplan.hands.protocol.Hand.scene_arrays`), a state's scene
 only where a per-state search needs it.  The tables are
 the search graph of :mod:`qsplan.planner.search.widest`; the plan built from the route is
 judged again sample by sample, so the tables only propose.  Units SI (m, rad, N m).
@@ -25,7 +25,8 @@ import numpy as np
 from qsplan.mechanics.errors import QsplanError
 from qsplan.planner.search.widest import SearchGraph
 
-__all__ = ["BandTables", "band_tables", "table_grid", "GRID_STEP", "OVERLAP", "SEARCH_MARGIN"]
+__all__ = ["BandTables", "GraspRow", "band_tables", "effort_joints", "table_grid", "GRID_STEP", "OVERLAP",
+           "SEARCH_MARGIN"]
 
 #: Grid step (m) of the tables: the plan's dense-sweep step, so that the tables judge the states
 #: the plan will judge (:data:`qsplan.planner.plan.scripted.SWEEP_STEP`).
@@ -43,6 +44,10 @@ _GRID_ROUNDING = 1e-9
 #: the default hand's fingers (0.18 m) minus a workpiece.
 SEARCH_MARGIN = 0.06
 
+#: Tangential speed per unit workpiece speed below which a contact counts as rolling when the tables compare sliding
+#: senses: :data:`qsplan.planner.plan.phases.SLIP_RTOL`'s value (the search layer does not import the plan layer).
+SLIP_RTOL = 1e-9
+
 #: The scene arrays the tables stack (:class:`qsplan.hands.batch_scenes.SceneArrays`).
 _ARRAYS = ("Wn", "Wt", "Jn", "Jt", "g_obj", "g_man")
 
@@ -53,16 +58,17 @@ class BandTables:
 
     Attributes
     ----------
-    grasps : tuple
-        The candidate grasps (:class:`qsplan.hands.grasps.Grasp`), indexed as the tables' first axis.
+    grasps : tuple of GraspRow
+        The rows (a grasp, and a described hand's free joints along x), indexed as the tables' first axis.
     x : ndarray, shape (n,)
         The grid of workpiece x (m).
     graph : SearchGraph
-        ``valid (G, n)``, ``touched (G, n, 2)``, ``width (G, 2, 2, n)`` (N m; ``-inf`` without a band).
-    q : ndarray, shape (G, n, 2)
-        Joint angles (rad; NaN where the grasp has no configuration).
-    lower, upper : ndarray, shape (G, 2, 2, n)
-        The guaranteed bands (N m; NaN without one).
+        ``valid (G, n)``, ``touched (G, n, 2 + n_c)`` (what each finger touches, then each contact's sliding sense
+        toward +x: a slide keeps both), ``width (G, E, 2, n)`` (N m or N; ``-inf`` without a band).
+    q : ndarray, shape (G, n, n_j)
+        Joint positions (rad or m; NaN where the row has no configuration).
+    lower, upper : ndarray, shape (G, E, 2, n)
+        The guaranteed bands (N m or N; NaN without one), per row, effort joint, direction (-x, +x) and x.
     why : ndarray of object, shape (G, n)
         Why a configuration is invalid, in words (None where valid; :data:`OVERLAP` where two bodies overlap,
         :meth:`reason` says which).
@@ -72,6 +78,8 @@ class BandTables:
         of them, band evaluations (valid configurations x effort fingers x directions).
     seconds : float
         Wall time (s) of building the tables.
+    efforts : tuple of str
+        The joints of the effort axis (E of them): every joint the control-mode partitioner admits (eq. 32).
     """
 
     grasps: tuple
@@ -84,6 +92,7 @@ class BandTables:
     states: int
     band_states: int
     seconds: float
+    efforts: tuple = ("left", "right")
 
     def index(self, x: float) -> int:
         """The grid index of ``x`` (m): the nearest grid point."""
@@ -95,9 +104,7 @@ class BandTables:
         why = self.why[g, i]
         if why != OVERLAP:
             return why
-        from qsplan.hands.collision import find_collisions
-
-        hit = find_collisions(task.hand, task.pose(self.x[i]), self.q[g, i], first=True)
+        hit = task.hand.collisions(task.pose(self.x[i]), self.q[g, i], first=True)
         return hit[0].message if hit else "two bodies overlap"
 
 
@@ -131,52 +138,93 @@ def table_grid(start_x: float, goal_x: float, limit, step: float = GRID_STEP, ma
     return np.clip(grid, lo_lim, hi_lim)  # an end point a rounding beyond a limit (_GRID_ROUNDING) is put on it
 
 
-def _no_contact(grasp, finger: int) -> str:
-    """Why ``finger`` (0 left, 1 right) has no contact of ``grasp``'s placement, in words."""
-    from qsplan.hands.grasps import TipOnEdge
+@dataclass(frozen=True, slots=True, eq=False)
+class GraspRow:
+    """One row of the tables: a grasp of the hand (:meth:`qsplan.hands.protocol.Hand.grasp_candidates`) and, for a
+    hand with free joints, where they are along x (:class:`qsplan.planner.plan.phases.FreePath`-like: ``x0``,
+    ``values``, ``slope``, ``free``, ``at(x)``, ``rates(n, speed)``; None: the grasp's own, held).
 
-    side = ("left", "right")[finger]
-    placement = (grasp.left, grasp.right)[finger]
-    if isinstance(placement, TipOnEdge):
-        return (f"the {side} fingertip cannot rest on edge {placement.edge} (out of reach, at an end of the edge, "
-                "or the finger would cross the workpiece)")  # fmt: skip
-    return (f"the {side} finger's inner edge cannot rest on a workpiece vertex (the vertex of tangency lies beyond "
-            "the finger's length, or the finger would cross the workpiece)")  # fmt: skip
+    Attributes
+    ----------
+    grasp : qsplan.hands.grasps.Grasp or qsplan.hands.protocol.ChainGrasp
+    path : object or None
+    """
+
+    grasp: object
+    path: object = None
+
+    @property
+    def label(self) -> str:
+        if self.path is None or not np.any(np.asarray(self.path.slope) != 0):
+            return self.grasp.label
+        return f"{self.grasp.label}, free joints sloping {np.round(np.asarray(self.path.slope)[list(self.path.free)], 4).tolist()} per m"
+
+    def matches(self, left=None, right=None) -> bool:
+        return self.grasp.matches(left, right)
+
+    def free_at(self, x) -> np.ndarray | None:
+        """The free joints (n, n_free) at workpiece ``x`` (n,), or None (the grasp's own)."""
+        return None if self.path is None else self.path.at(x)
 
 
-def _geometry(task, grasp, x):
-    """Configurations of ``grasp`` at ``x`` (n,): ``(conf, valid (n,), why list)``; overlapping configurations get
+def _geometry(task, row, x):
+    """The states of ``row`` at ``x`` (n,): ``(states, valid (n,), why list)``; overlapping configurations get
     :data:`OVERLAP` (their message is measured only when a report asks: :meth:`BandTables.reason`)."""
-    from qsplan.hands.grasp_geometry import grasp_configurations
-    from qsplan.hands.collision import find_collisions_batch
     from qsplan.planner.states.contact import limit_problem
 
-    conf = grasp_configurations(task.hand, grasp, x)
-    valid = np.array(conf.ok, dtype=bool)
+    hand = task.hand
+    states = hand.grasp_states(task.formation, row.grasp, x, row.free_at(x))
+    valid = np.array(states.ok, dtype=bool)
     why = [None] * len(x)
     for k in np.flatnonzero(~valid):
-        why[k] = _no_contact(grasp, int(np.argmin(conf.finger_ok[k])))
+        why[k] = states.why(int(k))
     lim = task.joint_limits
-    inside = np.all((conf.q >= lim[:, 0]) & (conf.q <= lim[:, 1]), axis=1)
+    inside = np.all((states.q >= lim[:, 0]) & (states.q <= lim[:, 1]), axis=1)
     for k in np.flatnonzero(valid & ~inside):
-        why[k] = limit_problem(task, conf.q[k])
+        why[k] = limit_problem(task, states.q[k])
     valid &= inside
     idx = np.flatnonzero(valid)
     hit = np.zeros(len(x), bool)
     if idx.size:
-        hit[idx] = find_collisions_batch(task.hand, conf.poses(task.hand.rest_height)[idx], conf.q[idx])
+        hit[idx] = hand.collide(states.poses[idx], states.q[idx])
     for k in np.flatnonzero(hit):
         why[k] = OVERLAP
-    return conf, valid & ~hit, why
+    return states, valid & ~hit, why
+
+
+def effort_joints(task, rows, x) -> tuple:
+    """The joints the tables make effort-controlled: every joint the control-mode partitioner admits as the one
+    effort-controlled joint of the formation's mode (eq. 32; :func:`qsplan.mechanics.modes.partition.effort_partitions`)
+    at a valid state of some row, in joint order (the paper's hand: both fingers, as always)."""
+    from qsplan.mechanics.modes.partition import effort_partitions
+
+    hand = task.hand
+    if not hand.free_joints and len(hand.joint_names) == 2:
+        return tuple(hand.joint_names)  # one joint per finger: either may be (the paper's tables always had both)
+    n_j = len(hand.joint_names)
+    found = set()
+    for row in rows:
+        states = hand.grasp_states(task.formation, row.grasp, x, row.free_at(x))
+        ok = np.flatnonzero(states.ok)
+        for k in ok[:: max(1, ok.size // 3)][:3]:  # a few states of the row: admission depends on the grasp only
+            arrays = hand.scene_arrays(task.formation, states, [k])
+            if not arrays.ok[0]:
+                continue
+            scene = hand.state_scene(arrays, 0, np.arange(n_j) == 0, np.zeros(n_j))
+            found |= {p.effort_joints[0] for p in effort_partitions(scene, task.formation.mode) if len(p.effort_joints) == 1}
+        if len(found) == n_j:
+            break
+    return tuple(hand.joint_names[j] for j in sorted(found))
 
 
 def band_tables(task, grasps, x, progress=None) -> BandTables:
-    """Judge every grasp of ``grasps`` at every ``x`` (m, shape (n,)) of the grid (see the module docstring).
+    """Judge every row of ``grasps`` at every ``x`` (m, shape (n,)) of the grid (see the module docstring).
 
     Parameters
     ----------
     task : qsplan.planner.task.task.Task
-    grasps : sequence of qsplan.hands.grasps.Grasp
+    grasps : sequence of GraspRow
+        (or grasps, each then its own row with its free joints held).
     x : ndarray, shape (n,)
     progress : callable, optional
 
@@ -184,42 +232,44 @@ def band_tables(task, grasps, x, progress=None) -> BandTables:
     -------
     BandTables
     """
-    from qsplan.planner.states.grasped import grasp_scene_arrays
-
     t0 = time.perf_counter()
+    hand = task.hand
+    rows = tuple(g if isinstance(g, GraspRow) else GraspRow(g) for g in grasps)
     x = np.asarray(x, dtype=float)
-    G, n = len(grasps), len(x)
+    G, n, n_j = len(rows), len(x), len(hand.joint_names)
+    efforts = effort_joints(task, rows, x)
+    E = len(efforts)
+    n_c = task.formation.n_contacts
     valid = np.zeros((G, n), bool)
-    touched = np.full((G, n, 2), -1, dtype=int)
-    q = np.full((G, n, 2), np.nan)
-    lower = np.full((G, 2, 2, n), np.nan)
-    upper = np.full((G, 2, 2, n), np.nan)
+    touched = np.full((G, n, 2 + n_c), -1, dtype=int)  # what each finger touches, then each contact's sliding sense
+    q = np.full((G, n, n_j), np.nan)
+    lower = np.full((G, E, 2, n), np.nan)
+    upper = np.full((G, E, 2, n), np.nan)
     why = np.empty((G, n), dtype=object)
-    parts = []  # per grasp with valid configurations: (g, idx, scene arrays, generic scenes, dq_dx)
-    for g, grasp in enumerate(grasps):
-        conf, ok, reasons = _geometry(task, grasp, x)
-        valid[g], touched[g], q[g] = ok, conf.touched, conf.q
+    parts = []  # per row with valid configurations: (g, idx, scene arrays, the unit-speed joint rates (m, n_j))
+    for g, row in enumerate(rows):
+        states, ok, reasons = _geometry(task, row, x)
+        valid[g], q[g] = ok, states.q
+        touched[g, :, :2] = states.touching()
         why[g] = reasons
         idx = np.flatnonzero(ok)
         if progress:
-            progress(f"  grasp {g + 1}/{G} {grasp.label}: {idx.size} of {n} configurations valid")
+            progress(f"  grasp {g + 1}/{G} {row.label}: {idx.size} of {n} configurations valid")
         if not idx.size:
             continue
-        failed = {}
-        arrays, generic = grasp_scene_arrays(task.hand, conf, idx, failed)  # contacts found once per configuration
-        for k, why_not in failed.items():  # no four-contact scene there: not a configuration of this grasp
+        arrays = hand.scene_arrays(task.formation, states, idx)  # contacts found once per configuration
+        for k in np.flatnonzero(~arrays.ok):  # no four-contact scene there: not a configuration of this row
             valid[g, idx[k]] = False
-            why[g, idx[k]] = why_not
-        keep = np.array([k not in failed for k in range(len(idx))], dtype=bool)
-        if keep.any():
-            rows = np.flatnonzero(keep)
-            renumber = {int(k): j for j, k in enumerate(rows)}
-            parts.append((g, idx[keep], [getattr(arrays, f)[keep] for f in _ARRAYS],
-                          {renumber[k]: s for k, s in generic.items() if k in renumber}, conf.dq_dx[idx[keep]]))  # fmt: skip
+            why[g, idx[k]] = arrays.reasons[k]
+        keep = np.flatnonzero(arrays.ok)
+        if keep.size:
+            rates = _unit_rates(task, row, states, arrays, idx, keep)
+            touched[g, idx[keep], 2:] = _slip_senses(task, arrays, keep, rates)
+            parts.append((g, idx[keep], arrays, keep, rates))
     band_states = 0
-    for e in range(2):  # one batch per effort finger: the states of every grasp and direction
+    for e, name in enumerate(efforts):  # one batch per effort joint: the states of every row and direction
         if parts:
-            b = _effort_bands(task, parts, e)
+            b = _effort_bands(task, parts, hand.joint_names.index(name))
             band_states += b.lower.size
             at = 0
             for d in range(2):
@@ -229,32 +279,61 @@ def band_tables(task, grasps, x, progress=None) -> BandTables:
                     lower[g, e, d, idx], upper[g, e, d, idx] = b.lower[part], b.upper[part]
     width = np.where(np.isnan(lower) | np.isnan(upper), -np.inf, upper - lower)
     graph = SearchGraph(valid, touched, width, float(task.torque_resolution))
-    return BandTables(tuple(grasps), x, graph, q, lower, upper, why, G * n, band_states, time.perf_counter() - t0)
+    return BandTables(rows, x, graph, q, lower, upper, why, G * n, band_states, time.perf_counter() - t0, efforts)
+
+
+def _unit_rates(task, row, states, arrays, idx, keep) -> np.ndarray:
+    """Every joint's rate (m, n_j) per m/s of the workpiece at the states ``idx[keep]``: ``dq_dx`` with the free
+    joints held (the grasp's closed form or the hand's eq. 6), else eq. 6 with the row's free-joint slopes."""
+    from qsplan.hands.motion import closing_rates
+    from qsplan.mechanics.errors import QsplanError
+
+    if row.path is None or not np.any(np.asarray(row.path.slope) != 0):
+        return states.dq_dx[idx[keep]]
+    sub = _take_arrays(arrays, keep)
+    try:
+        return closing_rates(task.hand, task.formation, sub, 1.0, row.path.rates(keep.size, 1.0))
+    except QsplanError:
+        return np.full((keep.size, len(task.hand.joint_names)), np.nan)
+
+
+def _slip_senses(task, arrays, keep, rates) -> np.ndarray:
+    """Each contact's sliding sense (m, n_c) moving toward +x at unit speed: the sign of its tangential velocity
+    ``W_t^T nu - J_t qdot`` (eq. 6), 0 where below :data:`qsplan.planner.plan.phases.SLIP_RTOL` (rolling).  A slide keeps
+    every sense (a reversal passes through rolling: a mode change, eq. 16), so the search graph compares them like the
+    contacts: moving toward -x flips every sense alike."""
+    nu = np.array([1.0, 0.0, 0.0])
+    vt = np.einsum("mik,i->mk", arrays.Wt[keep], nu) - np.einsum("mkj,mj->mk", arrays.Jt[keep], np.nan_to_num(rates))
+    return np.where(np.abs(vt) > SLIP_RTOL, np.sign(vt), 0).astype(int)
+
+
+def _take_arrays(arrays, keep):
+    from dataclasses import replace
+
+    return replace(arrays, **{f: getattr(arrays, f)[keep] for f in ("Wn", "Wt", "Jn", "Jt", "g_obj", "g_man")})
 
 
 def _effort_bands(task, parts, e: int):
-    """The guaranteed 4S bands, competitors precluded, of every configuration of ``parts`` with finger ``e``
-    effort-controlled, moving left (``d = 0``) then right (``d = 1``): one :class:`StateBatch` from the arrays,
-    :func:`qsplan.mechanics.bands.batched_robust.robust_band_arrays` (NaN edges where there is no band)."""
-    from qsplan.hands.two_finger_analytic import scene_from_arrays
+    """The guaranteed bands of the formation's mode, competitors precluded, of every configuration of ``parts`` with
+    joint ``e`` effort-controlled, moving left (``d = 0``) then right (``d = 1``): one :class:`StateBatch` from the
+    arrays, :func:`qsplan.mechanics.bands.batched_robust.robust_band_arrays` (NaN edges where there is no band)."""
     from qsplan.mechanics.bands.batched import LazyScenes, batch_from_arrays
     from qsplan.mechanics.bands.batched_robust import robust_band_arrays
 
-    from qsplan.planner.states.contact import MODE
-    from qsplan.planner.states.grasped import controlled
-
-    effort = np.arange(2) == e
+    hand = task.hand
+    n_j = len(hand.joint_names)
+    effort = np.arange(n_j) == e
     speeds = [(1.0 if d else -1.0) * task.workpiece_speed for d in range(2)]
-    stacked = [np.concatenate([arrays[i] for _ in speeds for _, _, arrays, _, _ in parts]) for i in range(len(_ARRAYS))]
-    velocity = np.concatenate([dq_dx[:, 1 - e] * xdot for xdot in speeds for *_, dq_dx in parts])
-    where = [(generic, k) for _ in speeds for _, idx, _, generic, _ in parts for k in range(idx.size)]
+    stacked = [np.concatenate([getattr(arrays, f)[keep] for _ in speeds for _, _, arrays, keep, _ in parts])
+               for f in _ARRAYS]  # fmt: skip
+    velocity = np.concatenate([rates * xdot for xdot in speeds for *_, rates in parts])  # (m, n_j)
+    where = [(arrays, int(k)) for _ in speeds for _, _, arrays, keep, _ in parts for k in keep]
 
-    def scene(s):  # the scene of state s, as grasp_scenes and controlled build it (a per-state search needs it)
-        generic, k = where[s]
-        if k in generic:
-            return controlled(generic[k], e, velocity[s])
-        return scene_from_arrays(task.hand, *(a[s].copy() for a in stacked), effort, velocity[s], 0.0)
+    def scene(s):  # the scene of state s, as the hand builds it (a per-state search needs it)
+        arrays, k = where[s]
+        return hand.state_scene(arrays, k, effort, np.where(effort, 0.0, velocity[s]))
 
-    joint_velocity = np.where(effort, np.nan, velocity[:, None])
-    batch = batch_from_arrays(LazyScenes(velocity.size, scene), *stacked, joint_velocity)
-    return robust_band_arrays(batch, MODE, task.mu_range, shared=task.shared_mu, force_margin=task.force_margin)
+    joint_velocity = np.where(effort[None, :], np.nan, velocity)
+    batch = batch_from_arrays(LazyScenes(velocity.shape[0], scene), *stacked, joint_velocity)
+    return robust_band_arrays(batch, task.formation.mode, task.mu_range, shared=task.shared_mu,
+                              force_margin=task.force_margin)  # fmt: skip

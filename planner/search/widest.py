@@ -45,7 +45,7 @@ class RouteStep:
     to_grasp, to_i : int
         The node it reaches.
     effort : int
-        Slides: the effort-controlled finger (0 left, 1 right); regrasps: -1.
+        Slides: the effort-controlled joint (an index into the tables' ``efforts``); regrasps: -1.
     width : float
         The edge's width (N m; ``inf`` for regrasps).
     """
@@ -89,8 +89,8 @@ class SearchGraph:
         Grasp ``g`` is a valid configuration at grid point ``i`` (contacts found, joint limits, no overlap).
     touched : ndarray of int, shape (G, n, 2)
         The feature each finger touches (a change between neighbours ends a slide).
-    width : ndarray, shape (G, 2, 2, n)
-        Guaranteed band width (N m) for grasp, effort finger (0 left, 1 right), direction (0: -x, 1: +x);
+    width : ndarray, shape (G, E, 2, n)
+        Guaranteed band width (N m or N) for grasp, effort joint (the tables' ``efforts``), direction (0: -x, 1: +x);
         ``-inf`` where there is none (or the configuration is invalid).
     resolution : float
         The torque resolution (N m): narrower bands do not count.
@@ -107,7 +107,7 @@ class SearchGraph:
 
 
 def slide_widths(graph: SearchGraph) -> np.ndarray:
-    """Width of each slide edge, shape (G, 2, 2, n - 1) [grasp, effort, direction, i -> i + 1 (direction 1) or
+    """Width of each slide edge, shape (G, E, 2, n - 1) [grasp, effort, direction, i -> i + 1 (direction 1) or
     i + 1 -> i (direction 0)]: the narrower end's band, ``-inf`` where the edge is not allowed."""
     w = np.where(graph.width >= graph.resolution, graph.width, -np.inf)
     same = np.all(graph.touched[:, 1:] == graph.touched[:, :-1], axis=-1) & graph.valid[:, 1:] & graph.valid[:, :-1]
@@ -119,7 +119,7 @@ def _neighbours(graph, edges, g, i, forbidden):
     """Edges out of node (g, i): ``(width, to_g, to_i, effort, kind)``."""
     G, n = graph.shape
     out = []
-    for e in range(2):
+    for e in range(edges.shape[1]):
         if i + 1 < n and edges[g, e, 1, i] > -np.inf:
             out.append((edges[g, e, 1, i], g, i + 1, e, "slide"))
         if i > 0 and edges[g, e, 0, i - 1] > -np.inf:
@@ -130,14 +130,15 @@ def _neighbours(graph, edges, g, i, forbidden):
     return out
 
 
-def widest_route(graph: SearchGraph, start: tuple, goals, forbidden=frozenset()) -> Route | None:
+def widest_route(graph: SearchGraph, start, goals, forbidden=frozenset()) -> Route | None:
     """The widest route from ``start`` to any node of ``goals``, fewest regrasps, steps and segments among them.
 
     Parameters
     ----------
     graph : SearchGraph
-    start : (int, int)
-        ``(grasp, i)``.
+    start : (int, int), or a list of them
+        ``(grasp, i)``; several: the route may begin at any (one search from all: every start at an unbounded
+        width and no cost, a multi-source Dijkstra in both stages).
     goals : iterable of (int, int)
     forbidden : set of (int, int, int)
         Regrasps ``(from grasp, to grasp, i)`` not to use.
@@ -150,13 +151,24 @@ def widest_route(graph: SearchGraph, start: tuple, goals, forbidden=frozenset())
     G, n = graph.shape
     goals = {tuple(map(int, g)) for g in goals}
     edges = slide_widths(graph)
-    start = (int(start[0]), int(start[1]))
-    if not graph.valid[start] or not goals:
+    many = len(start) > 0 and not np.isscalar(start[0])
+    starts = [(int(s[0]), int(s[1])) for s in (start if many else [start])]
+    starts = [s for s in starts if graph.valid[s]]
+    if not starts or not goals:
         return None
+    memo = {}
+
+    def neighbours(g, i):  # each node's edges once (both stages ask again and again)
+        if (g, i) not in memo:
+            memo[g, i] = _neighbours(graph, edges, g, i, forbidden)
+        return memo[g, i]
+
     # stage 1: max-min Dijkstra (the largest bottleneck from the start to every node)
     best = np.full((G, n), -np.inf)
-    best[start] = np.inf
-    heap = [(-np.inf, start)]
+    heap = []
+    for s in starts:
+        best[s] = np.inf
+        heap.append((-np.inf, s))
     expanded = 0
     while heap:
         negw, (g, i) = heapq.heappop(heap)
@@ -164,7 +176,7 @@ def widest_route(graph: SearchGraph, start: tuple, goals, forbidden=frozenset())
         if w < best[g, i]:
             continue
         expanded += 1
-        for ew, h, j, _, _ in _neighbours(graph, edges, g, i, forbidden):
+        for ew, h, j, _, _ in neighbours(g, i):
             nw = min(w, ew)
             if nw > best[h, j]:
                 best[h, j] = nw
@@ -175,10 +187,12 @@ def widest_route(graph: SearchGraph, start: tuple, goals, forbidden=frozenset())
     width = max(reached)
     # stage 2: lexicographic Dijkstra (regrasps, steps, segments) on edges at least `width` wide
     # node = (grasp, i, effort, direction) of the last slide (-1, -1 after a regrasp or at the start)
-    s0 = (start[0], start[1], -1, -1)
-    cost = {s0: (0, 0, 0)}
-    parent = {s0: None}
-    heap = [((0, 0, 0), s0)]
+    cost, parent, heap = {}, {}, []
+    for s in starts:
+        s0 = (s[0], s[1], -1, -1)
+        cost[s0], parent[s0] = (0, 0, 0), None
+        heap.append(((0, 0, 0), s0))
+    heapq.heapify(heap)
     done = None
     while heap:
         c, node = heapq.heappop(heap)
@@ -189,7 +203,7 @@ def widest_route(graph: SearchGraph, start: tuple, goals, forbidden=frozenset())
         if (g, i) in goals:
             done = node
             break
-        for ew, h, j, e, kind in _neighbours(graph, edges, g, i, forbidden):
+        for ew, h, j, e, kind in neighbours(g, i):
             if ew < width:
                 continue
             if kind == "regrasp":

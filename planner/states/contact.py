@@ -20,14 +20,22 @@ from qsplan.mechanics.errors import QsplanError
 from qsplan.planner.task.task import Task
 
 __all__ = ["MODE", "TOUCH_AREA", "StateCheck", "check_contact_state", "check_free_state", "configuration_problem",
-           "contact_samples", "free_state_problem", "hand_scene_at", "limit_problem"]
+           "contact_samples", "free_state_problem", "limit_problem", "mode_name"]
 
 #: Intersection area (m^2) below which two polygons only touch (kept for callers; the checks now measure
 #: overlaps by depth: :data:`qsplan.hands.collision.CONTACT_DEPTH_TOL`).
 TOUCH_AREA = 1e-10
 
-#: The in-contact segments' mode: the workpiece slides on the palm and both fingertips (4S).
+#: The in-contact segments' mode of today's formation (:data:`qsplan.hands.formations.FORMATIONS`): the workpiece
+#: slides on the palm and both fingertips (4S); read a task's from ``task.formation.mode``.
 MODE = "SSSS"
+
+
+def mode_name(letters: str) -> str:
+    """The paper's name of a mode (``"SSSS"`` -> ``"4S"``, ``"RBSS"`` -> ``"R1S3"``: :attr:`ContactMode.name`)."""
+    from qsplan.mechanics.modes.contact_mode import ContactMode
+
+    return ContactMode(letters).name
 
 
 @dataclass(frozen=True, slots=True)
@@ -63,22 +71,15 @@ class StateCheck:
         return float(self.upper - self.lower) if np.isfinite(self.lower) or np.isfinite(self.upper) else np.nan
 
 
-def hand_scene_at(task, x, effort_joint, velocity):
-    """``(pose, q, touching, scene)`` of the grasp with the workpiece at ``x`` (m); ``velocity`` (rad/s) of the velocity-controlled joint."""
-    from qsplan.hands.two_finger import finger_angles
-    from qsplan.hands.two_finger_scene import hand_scene
-
-    pose = task.pose(x)
-    q, touching = finger_angles(task.hand, pose)
-    return pose, q, touching, hand_scene(task.hand, pose, q, effort_joint, velocity=velocity, effort=0.0)
-
-
-def contact_samples(task, xs, effort_joint, speed, name="segment", grasp=None):
+def contact_samples(task, xs, effort_joint, speed, name="segment", grasp=None, free=None, free_rates=None):
     """The configurations at workpiece ``xs`` (m, shape (n,)) moving at ``speed`` (m/s, signed) as
-    :class:`qsplan.hands.segments.SegmentSamples` (times 0, 1, ...: bands do not depend on them).
+    :class:`qsplan.hands.segments.SegmentSamples` (times 0, 1, ...: bands do not depend on them), from the hand
+    (:meth:`qsplan.hands.protocol.Hand.slide_motion`).
 
-    ``grasp`` (:class:`qsplan.hands.grasps.Grasp`): the features the fingers touch; default both inner
-    edges on the vertices of tangency (:func:`qsplan.hands.two_finger.finger_angles`, the scripted tasks).
+    ``grasp``: the features the fingers touch (a grasp of :meth:`~qsplan.hands.protocol.Hand.grasp_candidates`);
+    None: the paper hand's default, both inner edges on the vertices of tangency (the scripted tasks).  ``free``
+    (n, n_free) and ``free_rates`` (n, n_j): a described hand's free joints along the slide and their rates
+    (rad/s or m/s at ``speed``; default the grasp's, held).  ``effort_joint``: the effort-controlled joint's name.
 
     Raises
     ------
@@ -86,37 +87,31 @@ def contact_samples(task, xs, effort_joint, speed, name="segment", grasp=None):
         Where a configuration has no four-contact grasp.
     """
     from qsplan.hands.segments import ManipulationSegment, SegmentSamples
-    from qsplan.hands.two_finger import JOINT_NAMES, finger_angle_rates
 
-    v = 1 - JOINT_NAMES.index(effort_joint)
+    hand = task.hand
     xs = np.atleast_1d(np.asarray(xs, float))
-    if grasp is not None:
-        from qsplan.planner.states.grasped import grasp_samples
-
-        poses, qs, qds, touch, scenes = grasp_samples(task.hand, grasp, xs, effort_joint, speed)
-    else:
-        poses, qs, qds, touch, scenes = [], [], [], [], []
-        for x in xs:
-            pose = task.pose(x)
-            qd = finger_angle_rates(task.hand, pose, (speed, 0.0, 0.0))
-            _, q, t, scene = hand_scene_at(task, x, effort_joint, qd[v])
-            poses.append(pose), qs.append(q), qds.append(qd), touch.append(t), scenes.append(scene)
-    n = len(poses)
-    poses = np.array(poses)
-    seg = ManipulationSegment(task.hand, name, poses[0], poses[-1], float(max(n - 1, 1)), MODE, effort_joint)
-    return SegmentSamples(seg, np.arange(n, dtype=float), np.linspace(0.0, 1.0, n), poses, np.array(qs),
-                          np.array(qds), np.array(touch), tuple(scenes))  # fmt: skip
+    m = hand.slide_motion(task.formation, grasp, xs, speed, hand.joint_names.index(effort_joint), free, free_rates)
+    n = len(xs)
+    seg = ManipulationSegment(hand, name, m.poses[0], m.poses[-1], float(max(n - 1, 1)), task.formation.mode,
+                              effort_joint)  # fmt: skip
+    return SegmentSamples(seg, np.arange(n, dtype=float), np.linspace(0.0, 1.0, n), m.poses, m.q, m.qd, m.touching,
+                          tuple(m.scenes))  # fmt: skip
 
 
 def limit_problem(task, q) -> str | None:
-    """Which joint of ``q`` (rad, shape (2,)) is beyond its limit, in words, or None."""
-    from qsplan.hands.two_finger import JOINT_NAMES
+    """Which joint of ``q`` (rad or m, shape (n_j,)) is beyond its limit, in words, or None."""
+    from qsplan.hands.interface import joint_units
 
-    lim = task.joint_limits
-    for k, name in enumerate(JOINT_NAMES):
-        if not lim[k, 0] <= q[k] <= lim[k, 1]:
-            return (f"joint limits: the {name} finger's angle {q[k]:.4g} rad is outside its limits "
-                    f"[{lim[k, 0]:g}, {lim[k, 1]:g}] rad (q = {np.round(q, 4).tolist()} rad)")  # fmt: skip
+    lim, hand = task.joint_limits, task.hand
+    units = joint_units(hand)
+    for k, name in enumerate(hand.joint_names):
+        if lim[k, 0] <= q[k] <= lim[k, 1]:
+            continue
+        u = units[k]
+        finger = any(f == (k,) for f in hand.finger_joints)  # a finger of one joint: the paper's words
+        what = f"the {name} finger's angle" if finger and u == "rad" else f"joint {name} at"
+        return (f"joint limits: {what} {q[k]:.4g} {u} is outside its limits [{lim[k, 0]:g}, {lim[k, 1]:g}] {u} "
+                f"(q = {np.round(q, 4).tolist()}{' rad' if set(units) == {'rad'} else ''})")  # fmt: skip
     return None
 
 
@@ -124,24 +119,23 @@ def configuration_problem(task, pose, q) -> str | None:
     """What is wrong with the hand at workpiece ``pose`` (shape (3,)) and joints ``q`` (rad, shape (2,)),
     in words, or None: a joint beyond its limit, or two bodies overlapping (every pair of the palm, the
     fingers and the workpiece: :func:`qsplan.hands.collision.find_collisions`)."""
-    from qsplan.hands.collision import find_collisions
-
     q = np.asarray(q, float)
     why = limit_problem(task, q)
     if why:
         return why
-    hit = find_collisions(task.hand, pose, q, first=True)
+    hit = task.hand.collisions(pose, q, first=True)
     return hit[0].message if hit else None
 
 
 def check_contact_state(task: Task, x: float, effort_joint: str, direction: float, touching=None,
-                        competitors=None, grasp=None) -> StateCheck:  # fmt: skip
+                        competitors=None, grasp=None, free=None, free_slope=None) -> StateCheck:  # fmt: skip
     """Judge workpiece ``x`` (m) of an in-contact segment moving in ``direction`` (sign of xdot).
 
     Valid when the four contacts are found (the same finger vertices as ``touching``),
     the joints are inside their limits, no two bodies overlap (:func:`configuration_problem`: every
     pair, finger against finger too), the 4S kinematics hold and the guaranteed band, competitors precluded, is at least ``task.torque_resolution`` wide.
-    ``grasp``: as in :func:`contact_samples`.
+    ``grasp``: as in :func:`contact_samples`; ``free`` (n_free,): a described hand's free joints there, and
+    ``free_slope`` (n_j,): their rates per metre of workpiece travel (rad/m or m/m; default held).
     """
     from qsplan.mechanics.bands.effort import band_kinematics
     from qsplan.mechanics.modes.contact_mode import ContactMode
@@ -149,7 +143,10 @@ def check_contact_state(task: Task, x: float, effort_joint: str, direction: floa
     from qsplan.planner.torque.pointwise import guaranteed_sweep
 
     try:
-        S = contact_samples(task, [x], effort_joint, float(np.sign(direction)) * task.workpiece_speed, grasp=grasp)
+        speed = float(np.sign(direction)) * task.workpiece_speed
+        rates = None if free_slope is None else np.asarray(free_slope, float).reshape(1, -1) * speed
+        S = contact_samples(task, [x], effort_joint, speed, grasp=grasp,
+                            free=None if free is None else np.asarray(free, float).reshape(1, -1), free_rates=rates)  # fmt: skip
     except QsplanError as exc:
         return StateCheck(float(x), False, f"no four-contact grasp: {exc}")
     if touching is not None and np.any(S.touching[0] != touching):
@@ -157,15 +154,17 @@ def check_contact_state(task: Task, x: float, effort_joint: str, direction: floa
     why = configuration_problem(task, S.pose[0], S.q[0])
     if why:
         return StateCheck(float(x), False, why)
-    if not band_kinematics(S.scenes[0], ContactMode(MODE)).ok:
-        return StateCheck(float(x), False, "the 4S kinematics fail (eqs. 24-25)")
-    g = guaranteed_sweep(S, task.mu_range, task.shared_mu, MODE, competitors, force_margin=task.force_margin)
+    mode = task.formation.mode
+    if not band_kinematics(S.scenes[0], ContactMode(mode)).ok:
+        return StateCheck(float(x), False, f"the {mode_name(mode)} kinematics fail (eqs. 24-25)")
+    g = guaranteed_sweep(S, task.mu_range, task.shared_mu, mode, competitors, force_margin=task.force_margin)
     b, d = g.band, g.desired
     cut = tuple(c for c, (lo, hi) in g.competitors.items() if np.isfinite(lo[0]))
     lo, hi = float(b.lower[0]), float(b.upper[0])
     common = dict(desired_lower=float(d.lower[0]), desired_upper=float(d.upper[0]), competitors=cut)
     if not b.feasible[0]:
-        return StateCheck(float(x), False, "no guaranteed band: " + (b.reasons[0] or "4S not guaranteed"), **common)
+        return StateCheck(float(x), False, "no guaranteed band: " + (b.reasons[0] or f"{mode_name(mode)} not guaranteed"),
+                          **common)  # fmt: skip
     if hi - lo < task.torque_resolution:
         return StateCheck(float(x), False, f"band {hi - lo:.4g} N m narrower than the resolution", lo, hi, **common)
     return StateCheck(float(x), True, None, lo, hi, **common)

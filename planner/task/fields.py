@@ -87,24 +87,12 @@ def in_task_range(x: float, field: str, kind: str) -> float:
 
 
 def check_hand(hand) -> None:
-    """Every size, mass and coefficient of a hand (and its workpiece) inside :data:`TASK_RANGES`."""
-    from qsplan.hands.chain_hand import ChainHand
+    """Every size, mass and coefficient of a hand (and its workpiece) inside :data:`TASK_RANGES`
+    (:func:`qsplan.hands.interface.range_fields`)."""
+    from qsplan.hands.interface import range_fields
 
-    if isinstance(hand, ChainHand):
-        span = float(np.max(np.ptp(hand.workpiece, axis=0)))
-        in_task_range(span, "hand.workpiece (its width or height)", "size")
-        in_task_range(float(hand.workpiece_mass), "hand.workpiece_mass", "mass")
-        in_task_range(float(hand.gravity), "hand.gravity", "gravity")
-        in_task_range(float(hand.mu), "hand.mu", "friction")
-        return
-    for name in ("finger_base", "finger_length", "finger_width", "palm_halfwidth", "palm_thickness"):
-        in_task_range(float(getattr(hand, name)), f"hand.{name}", "size")
-    span = float(np.max(np.ptp(hand.workpiece, axis=0)))
-    in_task_range(span, "hand.workpiece (its width or height)", "size")
-    in_task_range(float(hand.workpiece_mass), "hand.workpiece_mass", "mass")
-    in_task_range(float(hand.finger_mass), "hand.finger_mass", "finger_mass")
-    in_task_range(float(hand.gravity), "hand.gravity", "gravity")
-    in_task_range(float(hand.mu), "hand.mu", "friction")
+    for field, value, kind in range_fields(hand):
+        in_task_range(value, field, kind)
 
 
 def _paper_hand_from_table(table: dict):
@@ -164,13 +152,16 @@ def hand_from_task_table(table: dict, base_dir=None) -> HandChoice:
     """
     from qsplan.hands.chain_hand import make_chain_hand
     from qsplan.hands.description.files import hand_from_table
+    from qsplan.hands.described_build import as_hand
     from qsplan.hands.description.two_finger_form import two_finger_parameters
     from qsplan.hands.two_finger import make_two_finger_hand
 
     if not isinstance(table, dict):
         raise QsplanError(f"hand: expected a table; got {short_repr(table)}")
     if not any(k in table for k in _DESCRIPTION_KEYS):
-        return HandChoice((_paper_hand_from_table(table), None, None))
+        paper = _paper_hand_from_table(table)
+        check_hand(paper)
+        return HandChoice((as_hand(paper), None, None))
     desc = hand_from_table(table, "hand", extra_keys=frozenset(WORKPIECE_KEYS), base_dir=base_dir)
     _check_workpiece(table)
     kw = {k: table[k] for k in WORKPIECE_KEYS if k in table}
@@ -186,7 +177,8 @@ def hand_from_task_table(table: dict, base_dir=None) -> HandChoice:
     except QsplanError as exc:
         raise QsplanError(f"hand.{exc}") from None
     check_hand(hand)
-    return HandChoice((hand, np.asarray(desc.joint_limits, float), np.asarray(desc.joint_speeds, float)))
+    limits, speeds = np.asarray(desc.joint_limits, float), np.asarray(desc.joint_speeds, float)
+    return HandChoice((as_hand(hand, own_limits=(limits, speeds)), limits, speeds))
 
 
 #: The force margin of plans (task files' ``[controller] min_normal_force`` and

@@ -14,6 +14,7 @@ rest height, ``theta = 0``), so its pose in a task is its centre-of-mass ``x``.
 TOML form (all SI: m, kg, rad, s, N m)::
 
     name = "regrasp like Fig. 9"
+    formation = "palm_edge"      # optional: how the hand holds the workpiece (qsplan.hands.formations)
     [hand]                       # qsplan.hands.two_finger.make_two_finger_hand's arguments
     workpiece = [[0.0, 0.0], [0.080, 0.0], [0.085, 0.080], [0.008, 0.100]]
     workpiece_mass = 0.2         # optional from here on, with make_two_finger_hand's defaults
@@ -36,7 +37,9 @@ TOML form (all SI: m, kg, rad, s, N m)::
     speed = { left = 0.4 }       # optional: a joint's speed by name, in its unit (rad/s, m/s)
     workpiece_speed = 0.01       # m/s
 
-:func:`load_task` reads it; :func:`make_task` is the Python equivalent.  Errors
+:func:`load_task` reads it; :func:`make_task` is the Python equivalent; :func:`task_from_record` reads the same
+tables from a dict (:func:`qsplan.planner.task.record.task_record` writes a task as one: the round trip
+``plan.json`` and the certifier use).  Errors
 are :class:`qsplan.mechanics.QsplanError` naming the field.
 """
 
@@ -53,10 +56,11 @@ from qsplan.mechanics.errors import QsplanError
 from qsplan.mechanics.model.friction import check_mu_range
 from qsplan.planner.task.fields import (PLAN_FORCE_MARGIN, TASK_RANGES, check_hand, field_name, hand_from_task_table,
                                         in_task_range, plan_force_margin, short_repr, task_number)  # fmt: skip
+from qsplan.hands.formations import DEFAULT_FORMATION, FORMATIONS, Formation
 from qsplan.planner.task.goal import Goal, make_goal, make_start_features
 from qsplan.planner.task.limits import LIMIT_KEYS, resolve_limits
 
-__all__ = ["Task", "load_task", "make_task", "demo_task_path", "task_path", "task_paths", "TASK_RANGES", "MAX_WAYPOINTS",
+__all__ = ["Task", "load_task", "make_task", "task_from_record", "demo_task_path", "task_path", "task_paths", "TASK_RANGES", "MAX_WAYPOINTS",
            "MIN_SEGMENT_LENGTH"]
 
 #: Most in-contact segments a task may have: each is one OMPL query of up to its time limit, so
@@ -84,7 +88,8 @@ class Task:
     Attributes
     ----------
     name : str
-    hand : qsplan.hands.two_finger.TwoFingerHand or qsplan.hands.chain_hand.ChainHand
+    hand : qsplan.hands.described.DescribedHand
+        The hand (:class:`qsplan.hands.protocol.Hand`): the paper's form answers with its closed forms.
     start_x : float
         Workpiece centre-of-mass ``x`` at the start (m).
     waypoints : ndarray, shape (k,)
@@ -115,6 +120,9 @@ class Task:
     start_joints : ndarray, shape (n_j,), or None
         A described hand's free joints at the start (``[start]`` by joint name; the closing joints' entries 0);
         None: the planner chooses.
+    formation : qsplan.hands.formations.Formation
+        How the hand holds the workpiece: its contacts, their order, the desired mode (today's one entry of
+        :data:`qsplan.hands.formations.FORMATIONS`, the bottom edge on the palm and a point of each finger, 4S).
     """
 
     name: str
@@ -132,6 +140,7 @@ class Task:
     start_features: tuple = (("inner", None), ("inner", None))
     speeds: np.ndarray | None = None
     start_joints: np.ndarray | None = None
+    formation: Formation = FORMATIONS[DEFAULT_FORMATION]
 
     @property
     def joint_speeds(self) -> np.ndarray:
@@ -159,7 +168,8 @@ def _pair(value, field, unit) -> tuple:
 
 def make_task(hand, start_x, waypoints=None, mu_range=(0.0, 0.2), torque_resolution=0.02, shared_mu=False,
               joint_limits=None, joint_speed=None, workpiece_speed=0.01,
-              name="task", force_margin=None, goal=None, start=None, base_dir=None, joint_speeds=None) -> Task:  # fmt: skip
+              name="task", force_margin=None, goal=None, start=None, base_dir=None, joint_speeds=None,
+              formation=None) -> Task:  # fmt: skip
     """Validate and build a :class:`Task` (parameters as its attributes; ``hand`` a TwoFingerHand or a dict of
     :func:`qsplan.hands.two_finger.make_two_finger_hand` arguments).  Either ``waypoints`` (a scripted
     sequence) or ``goal`` (the ``[goal]`` table as a dict, or a :class:`Goal`: the planner finds the sequence);
@@ -177,21 +187,17 @@ def make_task(hand, start_x, waypoints=None, mu_range=(0.0, 0.2), torque_resolut
     QsplanError
         Naming the field, what was expected and what was received.
     """
-    from qsplan.hands.chain_hand import ChainHand
-    from qsplan.hands.two_finger import TwoFingerHand
+    from qsplan.hands.described_build import as_hand
 
-    own_limits = own_speeds = None
-    hand_label = "the hand"
     if isinstance(hand, dict):
-        hand, own_limits, own_speeds = hand_from_task_table(hand, base_dir)
-        hand_label = "the hand file" if own_limits is not None else hand_label
-    elif isinstance(hand, ChainHand):
-        own_limits, own_speeds = hand.description.joint_limits, hand.description.joint_speeds
-        hand_label = f"the hand {hand.description.name!r}"
-    if not isinstance(hand, (TwoFingerHand, ChainHand)):
-        raise QsplanError(f"hand: expected a TwoFingerHand, a ChainHand or a [hand] table; got {type(hand).__name__}")
-    check_hand(hand)
-    chain = isinstance(hand, ChainHand)
+        hand, *_ = hand_from_task_table(hand, base_dir)
+        hand_label = "the hand file"
+    else:
+        hand = as_hand(hand)  # the door: today's records become described hands
+        check_hand(hand)
+        hand_label = f"the hand {hand.name!r}"
+    own_limits, own_speeds = hand.own_limits if hand.own_limits is not None else (None, None)
+    chain = bool(hand.free_joints)  # a hand with free joints starts from them; the others from features
     if not isinstance(name, str) or len(name) > 200:
         raise QsplanError(f"name: expected a string of at most 200 characters; got {short_repr(name)}")
     start_x = in_task_range(task_number(start_x, "motion.start_x", "m"), "motion.start_x", "position")
@@ -227,8 +233,7 @@ def make_task(hand, start_x, waypoints=None, mu_range=(0.0, 0.2), torque_resolut
     if not lo < hi:
         raise QsplanError(f"friction.range: expected lo < hi (plans are guaranteed over an interval of friction; for "
                           f"one known coefficient give a small interval around it); got [{lo:g}, {hi:g}]")  # fmt: skip
-    names = hand.joint_names if chain else ("left", "right")
-    kinds = hand.description.joint_kinds if chain else ("revolute", "revolute")
+    names, kinds = hand.joint_names, hand.joint_kinds
     resolved = resolve_limits(names, kinds, own_limits, own_speeds, ranges=joint_limits, joint_speed=joint_speed,
                               speeds=joint_speeds, hand_label=hand_label)  # fmt: skip
     limits, speeds = resolved.ranges, resolved.speeds
@@ -247,16 +252,22 @@ def make_task(hand, start_x, waypoints=None, mu_range=(0.0, 0.2), torque_resolut
         force_margin = plan_force_margin(fm.normal, fm.slack, "force_margin")
     else:
         force_margin = PLAN_FORCE_MARGIN
+    if formation is None:
+        formation = FORMATIONS[DEFAULT_FORMATION]
+    elif not isinstance(formation, Formation):
+        from qsplan.hands.formations import formation as registered
+
+        formation = registered(formation)
     return Task(name, hand, start_x, wp, (lo, hi), bool(shared_mu), checked["torque_resolution"], limits,
                 float(np.min(speeds)), checked["workpiece_speed"], force_margin, goal, start_features, speeds,
-                start_joints)  # fmt: skip
+                start_joints, formation)  # fmt: skip
 
 
 def _start_joints(hand, table) -> np.ndarray | None:
     """A described hand's ``[start]``: every free joint by name (rad or m), or none of them (the planner chooses)."""
     if not isinstance(table, dict):
         raise QsplanError(f"start: expected a table of the free joints' positions; got {short_repr(table)}")
-    free = [hand.joint_names[j] for j in hand.free_joints()]
+    free = [hand.joint_names[j] for j in hand.free_joints]
     extra = sorted(set(table) - set(free))
     if extra:
         raise QsplanError(f"start.{field_name(extra[0])}: unknown field; expected the free joints {', '.join(free)} (each finger's "
@@ -267,13 +278,13 @@ def _start_joints(hand, table) -> np.ndarray | None:
     if missing:
         raise QsplanError(f"start.{missing[0]}: missing (give every free joint: {', '.join(free)})")
     q = np.zeros(len(hand.joint_names))
-    for j in hand.free_joints():
+    for j in hand.free_joints:
         q[j] = task_number(table[hand.joint_names[j]], f"start.{hand.joint_names[j]}", "rad or m")
     q.setflags(write=False)
     return q
 
 
-_KNOWN = {"name", "hand", "motion", "friction", "controller", "limits", "goal", "start"}
+_KNOWN = {"name", "hand", "motion", "friction", "controller", "limits", "goal", "start", "formation", "version"}
 
 
 def _table(doc, key):
@@ -302,6 +313,30 @@ def load_task(path) -> Task:
         if isinstance(exc, QsplanError):
             raise
         raise QsplanError(f"task: {str(path)!r} is not valid TOML: {' '.join(str(exc).split())}") from None
+    return task_from_record(doc, base_dir=path.parent, default_name=path.stem)
+
+
+def task_from_record(doc, base_dir=None, default_name: str = "task") -> Task:
+    """The task of a task file's tables (a parsed TOML document, or :func:`qsplan.planner.task.record.task_record`'s
+    record): every field checked as :func:`load_task` checks a file's.
+
+    Parameters
+    ----------
+    doc : dict
+    base_dir : str or Path, optional
+        Folder against which a relative ``[hand] file`` is resolved.
+    default_name : str
+        The task's name when ``doc`` gives none.
+
+    Raises
+    ------
+    QsplanError
+        Naming the field.
+    """
+    from qsplan.planner.task.record import RECORD_VERSION
+
+    if not isinstance(doc, dict):
+        raise QsplanError(f"task: expected a table of the task file's fields; got {short_repr(doc)}")
     unknown = sorted(set(doc) - _KNOWN)
     if unknown:
         raise QsplanError(f"{field_name(unknown[0])}: unknown task field; expected one of {', '.join(sorted(_KNOWN))}")
@@ -331,13 +366,17 @@ def load_task(path) -> Task:
         kw["joint_limits"] = ranges
     if "speed" in limits:
         kw["joint_speeds"] = limits["speed"]
-    kw["base_dir"] = path.parent
+    kw["base_dir"] = base_dir
     for key in ("joint_speed", "workpiece_speed"):
         if key in limits:
             kw[key] = limits[key]
+    if doc.get("version", RECORD_VERSION) != RECORD_VERSION:
+        raise QsplanError(f"version: expected {RECORD_VERSION} (a task record of this qsplan); got {short_repr(doc['version'])}")
+    if "formation" in doc:
+        kw["formation"] = doc["formation"]
     kw["force_margin"] = plan_force_margin(controller.get("min_normal_force"), controller.get("min_coulomb_slack"))
     return make_task(_table(doc, "hand"), motion["start_x"], motion.get("waypoints"),
-                     torque_resolution=controller["torque_resolution"], name=doc.get("name", path.stem), **kw)  # fmt: skip
+                     torque_resolution=controller["torque_resolution"], name=doc.get("name", default_name), **kw)  # fmt: skip
 
 
 def demo_task_path() -> Path:

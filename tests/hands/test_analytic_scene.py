@@ -69,17 +69,17 @@ def test_bundled_tasks_along_their_segments(name):
             for x in xs:
                 pose = task.pose(x)
                 try:
-                    q = finger_angles(task.hand, pose)[0]
+                    q = finger_angles(task.hand.paper, pose)[0]
                 except SceneError:
                     continue
                 total += 1
-                used += _compare(task.hand, pose, q)
+                used += _compare(task.hand.paper, pose, q)
             continue
-        for grasp in candidate_grasps(task.hand):  # the automatic tasks: every grasp the planner may use
-            conf = grasp_configurations(task.hand, grasp, xs)
+        for grasp in task.hand.grasp_candidates(task.formation):  # the automatic tasks: every grasp the planner may use
+            conf = grasp_configurations(task.hand.paper, grasp, xs)
             for k in np.flatnonzero(conf.ok):
                 total += 1
-                used += _compare(task.hand, task.pose(xs[k]), conf.q[k])
+                used += _compare(task.hand.paper, task.pose(xs[k]), conf.q[k])
     assert total > 50 and used >= 0.9 * total
 
 
@@ -151,10 +151,8 @@ def _bits(a, b) -> bool:
 
 
 def _two_finger_tasks():
-    from qsplan.hands.two_finger import TwoFingerHand
-
     tasks = [load_task(p) for p in task_paths().values()]
-    return [t for t in tasks if isinstance(t.hand, TwoFingerHand) and t.goal is not None]
+    return [t for t in tasks if t.hand.accelerated and t.goal is not None]
 
 
 def _assert_batch_is_the_closed_form(hand, poses, q) -> tuple:
@@ -182,14 +180,14 @@ def test_batched_closed_form_is_the_one_state_closed_form_bit_for_bit():
     found = tips = total = 0
     for task in _two_finger_tasks():
         xs = np.linspace(-0.15, 0.15, 121)
-        for grasp in candidate_grasps(task.hand):
-            conf = grasp_configurations(task.hand, grasp, xs)
+        for grasp in task.hand.grasp_candidates(task.formation):
+            conf = grasp_configurations(task.hand.paper, grasp, xs)
             poses, q = conf.poses(task.hand.rest_height)[conf.ok], conf.q[conf.ok]
             dq = rng.choice([0.0, 1e-9, 1e-7, 1e-5, 1e-3], size=q.shape) * rng.choice([-1.0, 1.0], size=q.shape)
             lift = np.column_stack([np.zeros(len(poses)), rng.choice([0.0, 2e-7, 5e-6], len(poses)),
                                     rng.choice([0.0, 1e-4], len(poses))])  # fmt: skip
             for p, a in ((poses, q), (poses, q + dq), (poses + lift, q)):
-                counts = _assert_batch_is_the_closed_form(task.hand, p, a)
+                counts = _assert_batch_is_the_closed_form(task.hand.paper, p, a)
                 found, tips, total = found + counts[0], tips + counts[1], total + len(p)
     hands = [h for h in (_random_hand(rng) for _ in range(30)) if h is not None][:8]
     for hand in hands:
@@ -215,7 +213,7 @@ def test_checked_scene_arrays_are_the_scenes_of_grasp_scenes():
 
     used = 0
     for task in _two_finger_tasks():
-        hand = task.hand
+        hand = task.hand.paper
         for grasp in candidate_grasps(hand):
             conf = grasp_configurations(hand, grasp, np.linspace(-0.12, 0.12, 97))
             arrays, ok = checked_scene_arrays(hand, conf)

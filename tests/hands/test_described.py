@@ -11,7 +11,7 @@ import pytest
 
 from qsplan.hands.chain_hand import chain_scene, close_grasp
 from qsplan.hands.closing import separation
-from qsplan.hands.described import make_described_hand
+from qsplan.hands.described_build import make_described_hand
 from qsplan.hands.formations import formation
 from qsplan.hands.protocol import FLUSH, NO_CONTACT, OTHER_CONTACT, SINGULAR, ChainGrasp, FingerContact
 from qsplan.mechanics.errors import QsplanError

@@ -9,7 +9,7 @@ generic check or the polygon search), and q, contacts, dq_dx and every scene arr
 import numpy as np
 import pytest
 
-from qsplan.hands.described import described_from_two_finger, make_described_hand
+from qsplan.hands.described_build import described_from_two_finger, make_described_hand
 from qsplan.hands.description import load_hand
 from qsplan.hands.grasp_geometry import candidate_grasps
 from qsplan.hands.grasps import Grasp, OnVertex, TipOnEdge

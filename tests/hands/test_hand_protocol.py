@@ -5,7 +5,7 @@ validation branch."""
 import numpy as np
 import pytest
 
-from qsplan.hands.described import (described_from_chain, described_from_two_finger, hand_from_metadata,
+from qsplan.hands.described_build import (described_from_chain, described_from_two_finger, hand_from_metadata,
                                     make_described_hand)  # fmt: skip
 from qsplan.hands.description import load_hand
 from qsplan.hands.formations import ContactSlot, Formation

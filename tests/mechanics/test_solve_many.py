@@ -38,7 +38,7 @@ def _hand_scenes(rng, n):
     task = make_task(default_hand(), 0.0, [0.01])
     for _ in range(n):
         e = str(rng.choice(["left", "right"]))
-        yield hand_scene(task.hand, task.pose(rng.uniform(-0.02, 0.02)), None, e, velocity=rng.uniform(-0.3, 0.3),
+        yield hand_scene(task.hand.paper, task.pose(rng.uniform(-0.02, 0.02)), None, e, velocity=rng.uniform(-0.3, 0.3),
                          effort=rng.uniform(-1.0, 1.0))  # fmt: skip
 
 

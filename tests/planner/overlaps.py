@@ -83,7 +83,7 @@ def _chain_overlaps(hand, pose, q) -> list:
 def row_overlaps(hand, pose, q) -> list:
     """``[(body, body, area m^2, depth m)]`` of every pair overlapping deeper than :data:`DEPTH`; a finger
     and the palm are compared outside a disk of 1.2 finger widths about the joint (the joint housing)."""
-    if hasattr(hand, "description"):  # a described hand
+    if hasattr(hand, "description") and getattr(hand, "paper", None) is None:  # a described hand not of the paper's form
         return _chain_overlaps(hand, pose, q)
     bodies = row_bodies(hand, pose, q)
     out = []

@@ -54,7 +54,7 @@ def kinematic_mode(scene, qd, xdot) -> str:
 def segment(task, name, x0, x1, free, effort_joint, t0=0.0, n=21) -> ContactSegmentPlan:
     """A synthetic in-contact segment sliding the workpiece from ``x0`` to ``x1`` (m) at the task's speed, the free
     joints held at ``free`` (n_j,) or moved as ``free(x)``."""
-    hand = task.hand
+    hand = task.hand.chain
     e = np.array([n_ == effort_joint for n_ in hand.joint_names])
     v = task.workpiece_speed
     xs = np.linspace(x0, x1, n)

@@ -68,7 +68,7 @@ def test_demo_start_to_goals_left_and_right_certified(tmp_path, goal_x):
     assert run.followed and run.certificate.ok
     plan = run.plan
     assert plan.phases[0].x[0] == 0.0 and plan.phases[-1].x[-1] == goal_x
-    assert plan.sequence and plan.sequence[-1]["kind"] == "search"
+    assert plan.sequence and plan.search is plan.sequence[-1] and plan.search.kind == "search"
     assert min(np.min(s.width) for s in plan.segments) >= task.torque_resolution
 
 
@@ -122,14 +122,14 @@ def test_tables_agree_with_the_per_state_check():
 
     for stem in ("demo_task", "pentagon_roof_task"):
         task = load_task(task_paths()[stem])
-        tables = band_tables(task, candidate_grasps(task.hand), table_grid(task.start_x, task.goal.x, 0.16, step=0.004,
+        tables = band_tables(task, task.hand.grasp_candidates(task.formation), table_grid(task.start_x, task.goal.x, 0.16, step=0.004,
                                                                            margin=0.02))  # fmt: skip
         G, n = tables.graph.shape
         for g in range(G):
             for i in range(0, n, 3):
                 for e, d in ((0, 0), (1, 1)):
-                    c = check_contact_state(task, tables.x[i], ("left", "right")[e], (-1.0, 1.0)[d],
-                                            grasp=tables.grasps[g])  # fmt: skip
+                    c = check_contact_state(task, tables.x[i], tables.efforts[e], (-1.0, 1.0)[d],
+                                            grasp=tables.grasps[g].grasp)  # fmt: skip
                     if not tables.graph.valid[g, i]:
                         assert not c.ok
                         continue
@@ -166,13 +166,13 @@ def test_single_link_fingers_have_one_grasp_at_each_x():
     seen = set()
     for path in task_paths().values():
         task = load_task(path)
-        if not hasattr(task.hand, "finger_length"):  # a described hand (multi-link fingers, jaws): other tests
+        if not task.hand.accelerated:  # a described hand (multi-link fingers, jaws): other tests
             continue
-        key = (task.hand.workpiece.tobytes(), task.hand.finger_length, task.hand.finger_base)
+        key = (task.hand.workpiece.tobytes(), task.hand.paper.finger_length, task.hand.paper.finger_base)
         if key in seen:
             continue
         seen.add(key)
-        grasps = candidate_grasps(task.hand)
+        grasps = task.hand.grasp_candidates(task.formation)
         tables = band_tables(task, grasps, table_grid(-0.15, 0.15, 0.16, step=0.001, margin=0.0))
         assert tables.graph.valid.sum(axis=0).max() <= 1, task.name
     assert len(seen) >= 3  # the quadrilateral (16 cm fingers), the pentagon (11 cm), the trapezoid (8 cm)
@@ -200,8 +200,8 @@ def test_random_goal_tasks_plan_or_say_why(seed):
                              goal={"x": x0 + float(rng.choice([-1, 1]) * rng.uniform(0.002, 0.04))})  # fmt: skip
         except QsplanError:
             continue
-        for g in candidate_grasps(task.hand):
-            if grasp_configurations(task.hand, g, np.array([x0])).ok[0]:
+        for g in task.hand.grasp_candidates(task.formation):
+            if grasp_configurations(task.hand.paper, g, np.array([x0])).ok[0]:
                 side = [("inner", None) if isinstance(p, OnVertex) else ("edge", p.edge) for p in (g.left, g.right)]
                 task = replace(task, start_features=tuple(side))
                 break

@@ -36,7 +36,7 @@ def _check_segment(task, seg):
         polys = {n: Polygon(p) for n, p in chain_polygons(hand, task.pose(seg.x[k]), seg.q[k]).items()}
         W = polys["workpiece"]
         for f in range(2):
-            link = hand.joint_names[hand.finger_joints(f)[-1]]
+            link = hand.joint_names[hand.finger_joints[f][-1]]
             assert polys[link].distance(W) < GAP, (k, link)
         names = list(polys)
         for i, a in enumerate(names):
@@ -74,7 +74,7 @@ def test_velocity_commands_keep_the_finger_contacts_closed(two_link_plan):
             polys = chain_polygons(hand, task.pose(seg.x[k] + xdot[k] * dt), seg.q[k] + qd * dt)
             W = Polygon(polys["workpiece"])
             for f in range(2):
-                link = Polygon(polys[hand.joint_names[hand.finger_joints(f)[-1]]])
+                link = Polygon(polys[hand.joint_names[hand.finger_joints[f][-1]]])
                 gap = link.distance(W) - link.intersection(W).area ** 0.5
                 assert abs(gap) < 1e-7, (k, f, gap)
 
@@ -100,7 +100,7 @@ def test_a_regrasp_onto_another_feature_is_planned():
     kinds = [type(p).__name__ for p in plan.phases]
     assert "RegraspPlan" in kinds and "ContactSegmentPlan" in kinds
     _check_rows(plan)
-    hand = task.hand
+    hand = task.hand.chain
     first = close_grasp(hand, task.start_x, plan.phases[0].q[0])[1][0]
     last = close_grasp(hand, task.goal.x, plan.phases[-1].q[-1])[1][0]
     assert first.key == (1, "vertex", 3)  # the start: the distal link's inner edge on the top-left corner
@@ -122,8 +122,10 @@ def test_a_goal_feature_no_finger_can_touch_is_reported():
     from qsplan.planner.task.goal import Goal
 
     task = load_task(task_paths()["two_link_task"])
-    with pytest.raises(PlanFailure, match="no valid grasp of the free joints' grid touches the goal's features"):
+    with pytest.raises(PlanFailure, match="the goal is unreachable on this palm: no grasp meeting it") as info:
         plan_task(replace(task, goal=Goal(-0.03, None, ("vertex", 0))))  # the right finger on the far bottom corner
+    report = info.value.report.as_dict()  # the paper hand's report, fields and all: what is valid there instead
+    assert report["kind"] == "invalid configuration" and "is valid there with the left finger's" in report["reason"]
 
 
 def test_the_paper_hand_file_plans_the_demo_byte_for_byte(tmp_path):
@@ -135,7 +137,7 @@ def test_the_paper_hand_file_plans_the_demo_byte_for_byte(tmp_path):
     text = path.read_text()
     assert 'file = "paper_hand"' in text
     by_file = load_task(path)
-    assert isinstance(by_file.hand, TwoFingerHand)
+    assert by_file.hand.accelerated and isinstance(by_file.hand.paper, TwoFingerHand)
     params = tmp_path / "demo_params.toml"
     params.write_text(text.replace('file = "paper_hand"', "finger_base = 0.09\nfinger_length = 0.16\nfinger_width = 0.012"))
     by_params = load_task(params)

@@ -143,7 +143,7 @@ def test_planned_bands_keep_the_margin_at_their_edges(tmp_path):
         for tau in (d[f"tau_{e}_min"][k] + 1e-9, d[f"tau_{e}_max"][k] - 1e-9):
             if not np.isfinite(tau):
                 continue
-            scene = hand_scene(task.hand, pose, q, e, velocity=float(d[f"qd_{v}"][k]), effort=float(tau))
+            scene = hand_scene(task.hand.paper, pose, q, e, velocity=float(d[f"qd_{v}"][k]), effort=float(tau))
             for mu in product((lo, hi), repeat=4):
                 sol = solve(scene.with_mu(np.array(mu)), residuals=False, workers=1, search="all").solution("SSSS")
                 worst = min(worst, -np.inf if sol is None else float(sol.c_n.min()))

@@ -120,13 +120,13 @@ def test_in_contact_sweeps_are_decided_without_shapely():
     total = 0
     for path in task_paths().values():
         task = load_task(path)
-        if not hasattr(task.hand, "finger_length"):  # a described hand's states: tests/planner/test_chain_plan.py
+        if not task.hand.accelerated:  # a described hand's states: tests/planner/test_chain_plan.py
             continue
         stops = [task.start_x, *task.waypoints]
         poses, qs = [], []
         for x in np.linspace(min(stops) - 0.01, max(stops) + 0.01, 1001):
             try:
-                qs.append(finger_angles(task.hand, task.pose(x))[0])
+                qs.append(finger_angles(task.hand.paper, task.pose(x))[0])
             except QsplanError:  # no grasp there: not a state of the planner
                 continue
             poses.append(task.pose(x))

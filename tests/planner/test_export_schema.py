@@ -86,19 +86,32 @@ def test_metadata_states_the_command_rule_and_the_sequence(small_run):
         if ph["kind"] == "contact":
             assert 0 < ph["command"]["margin_N_m"] <= ph["command"]["half_narrowest_band_N_m"] + 1e-12
 
-    class WithSequence:  # a plan that carries the sequence its planner chose (another issue adds the field)
+    from qsplan.planner.plan.steps import RegraspStep, SearchSummary, SlideStep
+
+    class WithSequence:  # a plan that carries the typed sequence its planner chose
         def __init__(self, plan):
-            self.sequence = ({"kind": "slide", "x": (0.0, -0.02), "narrowest": np.float64(0.2)}, {"kind": "regrasp"})
+            self.sequence = (SlideStep("L vertex / R vertex", 0.0, -0.02, "right", np.float64(0.2)),
+                             RegraspStep(-0.02, "L vertex / R vertex", "L edge:3 / R vertex"),
+                             SearchSummary("widest", 1, 2, 41, 0.0025, 82, 300, 0.1, 0.01, 90, float("inf")))
             self._plan = plan
 
         def __getattr__(self, name):
             return getattr(self._plan, name)
 
+        @property
+        def search(self):
+            return self.sequence[-1]
+
     meta = plan_metadata(WithSequence(small_run.plan))
-    assert meta["sequence"] == [{"kind": "slide", "x": [0.0, -0.02], "narrowest": 0.2}, {"kind": "regrasp"}]
+    slide, regrasp, search = meta["sequence"]
+    assert slide["x_from_m"] == slide["x_from"] == 0.0 and slide["narrowest_band"] == 0.2
+    assert regrasp["x_from_m"] == regrasp["x"] == -0.02 and regrasp["to"] == "L edge:3 / R vertex"
+    assert search["route_width"] is None and meta["planner"]["route_search"] == "widest"
     doc = json.loads((small_run.out_dir / "plan.json").read_text())
     doc["metadata"] = json.loads(json.dumps(meta))
     assert check_schedule_document(doc) == []
+    doc["metadata"]["sequence"][0]["kind"] = "pivot"  # not a step the schema describes
+    assert any("sequence[0]" in e for e in check_schedule_document(doc))
 
 
 @pytest.mark.ompl

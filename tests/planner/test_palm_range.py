@@ -62,14 +62,13 @@ def bundled_variant(tmp_path, name, field, x):
     ("parallel_jaw_task", "start", 0.17, "right", HEXAGON),
 ])  # fmt: skip
 def test_beyond_the_palm_is_refused_from_the_geometry(tmp_path, capsys, monkeypatch, name, field, x, side, polygon):
-    from qsplan.planner.plan import autoplan, chain_plan as manifold, scripted as plan
+    from qsplan.planner.plan import autoplan, scripted as plan
 
     def never(*args, **kwargs):
         raise AssertionError("planned a task whose start or goal is beyond the palm")
 
     # refused by plan_task before any table, grid or grasp is built (by any of its planners)
     monkeypatch.setattr(autoplan, "plan_automatic", never)
-    monkeypatch.setattr(manifold, "plan_chain_task", never)
     monkeypatch.setattr(plan, "check_configurations", never)
     path = bundled_variant(tmp_path, name, field, x)
     out = tmp_path / "out"
@@ -178,14 +177,14 @@ def test_chain_goal_at_its_start_is_one_line_without_warnings(tmp_path):
     argv = ["plan", str(path), "--out", str(tmp_path / "o"), "--no-plots", "--verify", "0", "--quiet"]
     proc = subprocess.run([sys.executable, "-m", "qsplan.planner.cli", *argv], capture_output=True, text=True, timeout=120)
     assert proc.returncode == 2 and proc.stdout == ""
-    assert proc.stderr.count("\n") == 1 and proc.stderr.startswith("qsplan: error: goal.x: ")
-    assert "at least 0.0001 m apart" in proc.stderr and not (tmp_path / "o").exists()
+    assert proc.stderr.count("\n") == 1 and proc.stderr.startswith("qsplan: error: goal: the start already meets")
+    assert "nothing to plan" in proc.stderr and not (tmp_path / "o").exists()
 
 
 @pytest.mark.filterwarnings("error")
 def test_jaw_goal_at_its_start_is_refused_before_planning(tmp_path):
     task = load_task(bundled_variant(tmp_path, "parallel_jaw_task", "goal", 0.0))
-    from qsplan.planner.plan.chain_plan import plan_chain_task
+    from qsplan.planner.plan.scripted import plan_task
 
-    with pytest.raises(QsplanError, match="goal.x: a described hand's plan slides the workpiece"):
-        plan_chain_task(task)
+    with pytest.raises(QsplanError, match="goal: the start already meets the goal"):
+        plan_task(task)

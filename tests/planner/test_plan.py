@@ -167,7 +167,7 @@ def test_degenerate_closure_is_named_without_meaningless_edge_corners():
     from qsplan.planner.plan.scripted import PlanFailure, plan_task
 
     task = load_task(task_paths()["pentagon_task"])
-    task = make_task(replace(task.hand, finger_length=0.16), 0.0, [0.02])  # the demo hand's fingers: they cross
+    task = make_task(replace(task.hand.paper, finger_length=0.16), 0.0, [0.02])  # the demo hand's fingers: they cross
     with pytest.raises(PlanFailure) as info:
         # from x = 0.025 (the fingers cross above the pentagon below 0.0175) to 0.035, the same contacts throughout
         plan_task(make_task(task.hand, 0.025, [0.035], mu_range=(0.0, 0.6), torque_resolution=0.01))

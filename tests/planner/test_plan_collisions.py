@@ -30,7 +30,7 @@ def crossing_pentagon_file(tmp_path):
 
 
 def _grasp(task, x):
-    return task.pose(x), finger_angles(task.hand, task.pose(x))[0]
+    return task.pose(x), finger_angles(task.hand.paper, task.pose(x))[0]
 
 
 def test_crossing_fingers_are_found_and_named():

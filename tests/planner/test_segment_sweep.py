@@ -46,7 +46,7 @@ def test_sweep_finds_the_first_invalid_sample_of_the_reference(seed):
     xs = np.linspace(x0, x1, 25)
     ref = [check_contact_state(task, x, effort, direction, touching, comps) for x in xs]
     k_ref = next((k for k, c in enumerate(ref) if not c.ok), None)
-    k, S, band, speed = sweep_contact_segment(task, "case", xs, effort, direction, touching, comps)
+    k, S, band, speed, _ = sweep_contact_segment(task, "case", xs, effort, direction, touching, comps)
     assert k == k_ref, (k, k_ref, ref[k_ref].reason if k_ref is not None else None)
     if k is None:
         lo = np.array([c.lower for c in ref])

@@ -4,7 +4,6 @@
 import numpy as np
 import pytest
 
-from qsplan.hands.chain_hand import ChainHand
 from qsplan.hands.description import bundled_hands
 from qsplan.hands.two_finger import TwoFingerHand
 from qsplan.mechanics.errors import QsplanError
@@ -23,7 +22,7 @@ def _task(tmp_path, hand_lines, rest=REST, name="t.toml"):
 
 def test_bundled_and_relative_hand_files(tmp_path):
     two = load_task(_task(tmp_path, 'file = "two_link_hand"\n' + WORKPIECE))
-    assert isinstance(two.hand, ChainHand) and two.hand.description.source == "bundled:two_link_hand"
+    assert two.hand.paper is None and two.hand.description.source == "bundled:two_link_hand"
     np.testing.assert_array_equal(two.joint_limits, two.hand.description.joint_limits)
     np.testing.assert_array_equal(two.joint_speeds, [0.5] * 4)
     (tmp_path / "hands").mkdir()
@@ -31,7 +30,7 @@ def test_bundled_and_relative_hand_files(tmp_path):
     mine = load_task(_task(tmp_path, 'file = "hands/mine.toml"\n' + WORKPIECE))  # relative to the task file
     assert mine.hand.description.source == str(tmp_path / "hands" / "mine.toml")
     paper = load_task(_task(tmp_path, 'file = "paper_hand"\n' + WORKPIECE))
-    assert isinstance(paper.hand, TwoFingerHand) and paper.hand.finger_length == 0.16
+    assert paper.hand.accelerated and isinstance(paper.hand.paper, TwoFingerHand) and paper.hand.finger_length == 0.16
     assert paper.joint_speed == 0.5 and paper.joint_limits.tolist() == [[0.05, 3.09], [0.05, 3.09]]
 
 

@@ -1,9 +1,10 @@
-"""Where a replay's fingers grasp the workpiece again between segments (:mod:`qsplan.planner.replay.replay`).
+"""Closing the fingers again on a workpiece that moved: a plan's grasp at another pose (the replay's regrasps).
 
 After a re-simulated segment the workpiece may stand a little away from where the plan put it; the plan's
 regrasp closes the fingers on it there, with the grasp the plan uses: the paper's fingers by their closed
-forms (:func:`grasp_angles`), a described chain hand's by closing each finger's last joint from the plan's
-free joints (:func:`chain_grasp`).  Units SI (m, rad).
+forms (:func:`grasp_angles`), any described hand by closing each finger's last joint from the plan's free
+joints (:func:`chain_grasp`); :func:`reclose` picks by the hand (the paper's closed forms where they answer).
+Units SI (m, rad).
 """
 
 from __future__ import annotations
@@ -12,7 +13,7 @@ import numpy as np
 
 from qsplan.mechanics.errors import QsplanError
 
-__all__ = ["GRASP_MATCH_TOL", "chain_grasp", "grasp_angles"]
+__all__ = ["GRASP_MATCH_TOL", "chain_grasp", "grasp_angles", "reclose"]
 
 #: Joint angles (rad) within which an exported row's fingers are taken to realise a grasp's closed form:
 #: the export writes angles to 1e-12 or better (repr of floats), tangency round-off is ~1e-15.
@@ -59,3 +60,12 @@ def chain_grasp(hand, pose, q_planned, planned_pose) -> np.ndarray:
     if here is None:
         raise QsplanError(f"q: the fingers close onto nothing at x = {pose[0]:.6g} m from the planned free joints")
     return here[0]
+
+
+def reclose(hand, pose, q_planned, planned_pose) -> np.ndarray:
+    """The plan's grasp (its joints ``q_planned`` at ``planned_pose``) closed on the workpiece at ``pose``, shape (n_j,)
+    (:class:`qsplan.hands.described.DescribedHand`: its paper record's closed forms where accelerated, else its chain
+    record's closing)."""
+    if hand.accelerated:
+        return grasp_angles(hand.paper, pose, q_planned, planned_pose)
+    return chain_grasp(hand.chain, pose, q_planned, planned_pose)

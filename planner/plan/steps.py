@@ -1,0 +1,128 @@
+"""The planned sequence as typed values: the steps the route search chose and the search's figures (issue 22).
+
+An automatic plan (:func:`qsplan.planner.plan.autoplan.plan_automatic`) records what its search chose, one
+frozen step per phase, and a :class:`SearchSummary`.  ``plan.json`` writes them under ``metadata.sequence``
+(:meth:`as_dict`), described by the export schema; the keys are the same for every hand.  Each step's
+``as_dict`` gives the unit-suffixed keys (``x_from_m``, ``narrowest_band``'s unit in ``effort_unit``) and, beside
+them, the keys earlier plans wrote (``x_from``, ``x``, ``from``, ``to``): extended, never renamed.
+
+Units: SI (m, s; the narrowest band in the effort joint's unit, N m or N).  Room for the next formations'
+transitions: a new step type with a ``kind`` and ``as_dict``.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+__all__ = ["RegraspStep", "SearchSummary", "SlideStep", "search_summary", "step_dicts"]
+
+
+def _finite(v) -> float | None:
+    return float(v) if v is not None and math.isfinite(v) else None
+
+
+@dataclass(frozen=True, slots=True)
+class SlideStep:
+    """An in-contact slide of the route.
+
+    Attributes
+    ----------
+    grasp : str
+        The grasp's label (what each finger touches; a hand with free joints: their values).
+    x_from, x_to : float
+        Workpiece ``x`` at its ends (m).
+    effort_joint : str
+        The effort-controlled joint.
+    narrowest_band : float
+        Its narrowest guaranteed band along the slide, in the joint's effort unit (inf: unbounded).
+    effort_unit : str
+        ``"N m"`` (revolute) or ``"N"`` (prismatic).
+    """
+
+    grasp: str
+    x_from: float
+    x_to: float
+    effort_joint: str
+    narrowest_band: float
+    effort_unit: str = "N m"
+    kind = "slide"
+
+    def as_dict(self) -> dict:
+        band = _finite(self.narrowest_band)
+        return {"kind": self.kind, "grasp": self.grasp, "x_from_m": self.x_from, "x_to_m": self.x_to,
+                "effort_joint": self.effort_joint, "narrowest_band": band, "effort_unit": self.effort_unit,
+                "x_from": self.x_from, "x_to": self.x_to}  # fmt: skip
+
+
+@dataclass(frozen=True, slots=True)
+class RegraspStep:
+    """A regrasp of the route: the workpiece rests on the palm at ``x`` (m) while the fingers move.
+
+    Attributes
+    ----------
+    x : float
+    grasp_from, grasp_to : str
+        The labels of the grasps released and taken.
+    """
+
+    x: float
+    grasp_from: str
+    grasp_to: str
+    kind = "regrasp"
+
+    def as_dict(self) -> dict:
+        return {"kind": self.kind, "x_from_m": self.x, "x_to_m": self.x, "grasp_from": self.grasp_from,
+                "grasp_to": self.grasp_to, "x": self.x, "from": self.grasp_from, "to": self.grasp_to}  # fmt: skip
+
+
+@dataclass(frozen=True, slots=True)
+class SearchSummary:
+    """What the route search did (:mod:`qsplan.planner.search`).
+
+    Attributes
+    ----------
+    planner : str
+        The search that found the route (``"widest"``: the exact widest route; ``"RRTstar"``, ``"BITstar"``).
+    rounds : int
+        Searches run (a route the realisation refused is searched again without the refused cell).
+    grasps, grid_points : int
+        The band tables' rows and positions; ``grid_step_m`` their spacing (m).
+    table_states, band_states : int
+        Configurations in the tables; guaranteed bands computed.
+    table_seconds, search_seconds : float
+    search_evaluations : int
+    route_width : float
+        The route's narrowest band (N m; inf: unbounded).
+    grid_step_m : float
+    """
+
+    planner: str
+    rounds: int
+    grasps: int
+    grid_points: int
+    grid_step_m: float
+    table_states: int
+    band_states: int
+    table_seconds: float
+    search_seconds: float
+    search_evaluations: int
+    route_width: float
+    kind = "search"
+
+    def as_dict(self) -> dict:
+        return {"kind": self.kind, "planner": self.planner, "rounds": self.rounds, "grasps": self.grasps,
+                "grid_points": self.grid_points, "grid_step_m": self.grid_step_m, "table_states": self.table_states,
+                "band_states": self.band_states, "table_seconds": self.table_seconds,
+                "search_seconds": self.search_seconds, "search_evaluations": self.search_evaluations,
+                "route_width": _finite(self.route_width)}  # fmt: skip
+
+
+def search_summary(sequence) -> SearchSummary | None:
+    """The :class:`SearchSummary` of a plan's ``sequence`` (None for a scripted plan)."""
+    return next((s for s in sequence if isinstance(s, SearchSummary)), None)
+
+
+def step_dicts(sequence) -> list:
+    """``metadata.sequence``: each step's and the summary's :meth:`as_dict`, in order."""
+    return [s.as_dict() for s in sequence]
