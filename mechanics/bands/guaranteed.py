@@ -41,6 +41,7 @@ from math import comb
 import numpy as np
 
 from qsplan.mechanics.bands.disturbance import check_wrench_box, loaded_reason, wrench_vertex_rows
+from qsplan.mechanics.bands.roots import critical_polynomial, roots_batch
 from qsplan.mechanics.bands.effort import (
     Band,
     band_kinematics,
@@ -329,43 +330,47 @@ def _shared_band(mode: ContactMode, joint: int, nodes, s0s, s1, det, scales, lo:
     t = shared_coordinates(mode)
     mu_of = lambda x: 0.5 * (lo + hi) + 0.5 * (hi - lo) * x  # noqa: E731 - for messages
     pdet = _poly_fit_exact(t, det, deg)
-    P = np.polynomial.Polynomial
-    roots_det = [r.real for r in P(pdet).roots() if abs(r.imag) < ROOT_IMAG_TOL and -1.0 <= r.real <= 1.0]
+    roots_det = [r.real for r in roots_batch([pdet])[0] if abs(r.imag) < ROOT_IMAG_TOL and -1.0 <= r.real <= 1.0]
     if roots_det or np.any(det == 0):
         return Band(mode.letters, joint, np.nan, np.nan, False,
                     f"equilibrium_singular: det Q_AI vanishes at mu = {mu_of(roots_det[0]) if roots_det else nodes[det == 0][0]:.6g}",
                     "shared-roots")  # fmt: skip
+    # every polynomial first, their roots in one batch per size (the same roots as one polyroots call each), then
+    # the rows in order: the first failing row is reported, as a row-by-row pass would
+    R, V = s1.shape[1], len(s0s)
+    n1s = [_poly_fit_exact(t, s1[:, r] * det, deg) for r in range(R)]
+    look = [(r, v) for r in range(R) for v in range(V) if keep is None or keep[v, r]]
+    n0s = {(r, v): _poly_fit_exact(t, s0s[v][:, r] * det, deg) for r, v in look}
+    crits = [critical_polynomial(n0s[rv], n1s[rv[0]]) for rv in look]
+    found = roots_batch(n1s + crits)
+    zeros1 = [[c.real for c in np.atleast_1d(z) if abs(c.imag) < ROOT_IMAG_TOL and -1.0 <= c.real <= 1.0]
+              for z in found[:R]]  # fmt: skip
+    crit_of = dict(zip(look, found[R:]))
+    val = np.polynomial.polynomial.polyval
     lower, upper = -np.inf, np.inf
     fscales = [float(np.max(scale)) for scale in scales]
-    for r in range(s1.shape[1]):
-        n1 = P(_poly_fit_exact(t, s1[:, r] * det, deg))
-        d = P(pdet)
-        zeros1 = [c.real for c in np.atleast_1d(n1.roots()) if abs(c.imag) < ROOT_IMAG_TOL and -1.0 <= c.real <= 1.0]
+    for r, v in look:
+        n1, n0, fscale = n1s[r], n0s[(r, v)], fscales[v]
         flat = tol.force * max(1e-300, float(np.max(np.abs(s1[:, r]))))
-        for v, (s0, fscale) in enumerate(zip(s0s, fscales)):
-            if keep is not None and not keep[v, r]:
+        cand = [-1.0, 1.0]
+        cand += [c.real for c in np.atleast_1d(crit_of[(r, v)]) if abs(c.imag) < CRITICAL_IMAG_TOL and -1.0 < c.real < 1.0]
+        for z in zeros1[r]:
+            # at a root of the slope the row holds for every effort iff s0 >= 0 there
+            if val(z, n0) / val(z, pdet) < -tol.force * fscale:
+                return Band(mode.letters, joint, np.nan, np.nan, False,
+                            f"coulomb: row {r} fails for every effort at mu = {mu_of(z):.6g}", "shared-roots")  # fmt: skip
+        for c in cand:
+            sl = val(c, n1) / val(c, pdet)
+            if abs(sl) <= flat:
+                if val(c, n0) / val(c, pdet) < -tol.force * fscale:
+                    return Band(mode.letters, joint, np.nan, np.nan, False, f"coulomb: row {r} fails at mu = {mu_of(c):.6g}",
+                                "shared-roots")  # fmt: skip
                 continue
-            n0 = P(_poly_fit_exact(t, s0[:, r] * det, deg))
-            cand = [-1.0, 1.0]
-            crit = (n0.deriv() * n1 - n0 * n1.deriv()).roots()
-            cand += [c.real for c in np.atleast_1d(crit) if abs(c.imag) < CRITICAL_IMAG_TOL and -1.0 < c.real < 1.0]
-            for z in zeros1:
-                # at a root of the slope the row holds for every effort iff s0 >= 0 there
-                if n0(z) / d(z) < -tol.force * fscale:
-                    return Band(mode.letters, joint, np.nan, np.nan, False,
-                                f"coulomb: row {r} fails for every effort at mu = {mu_of(z):.6g}", "shared-roots")  # fmt: skip
-            for c in cand:
-                sl = n1(c) / d(c)
-                if abs(sl) <= flat:
-                    if n0(c) / d(c) < -tol.force * fscale:
-                        return Band(mode.letters, joint, np.nan, np.nan, False, f"coulomb: row {r} fails at mu = {mu_of(c):.6g}",
-                                    "shared-roots")  # fmt: skip
-                    continue
-                e = -n0(c) / n1(c)
-                if sl > 0:
-                    lower = max(lower, e)
-                else:
-                    upper = min(upper, e)
+            e = -val(c, n0) / val(c, n1)
+            if sl > 0:
+                lower = max(lower, e)
+            else:
+                upper = min(upper, e)
     if lower > upper:
         return Band(mode.letters, joint, np.nan, np.nan, False, "coulomb: no effort works for every mu in the range", "shared-roots")
     return Band(mode.letters, joint, float(lower), float(upper), True, None, "shared-roots")
