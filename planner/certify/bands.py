@@ -53,7 +53,7 @@ def recomputed_bands(task, cols, scenes: dict) -> dict:
     out = {}
     for mode, rows in groups.items():
         bands = robust_bands([scenes[k] for k in rows], mode, task.mu_range, shared=task.shared_mu,
-                             force_margin=task.force_margin)  # fmt: skip
+                             force_margin=task.force_margin, disturbance=task.disturbance)  # fmt: skip
         out.update(zip(rows, bands))
     return out
 

@@ -40,7 +40,7 @@ from qsplan.planner.certify.bands import BAND_RTOL, band_checks, free_row_cells,
 from qsplan.planner.certify.files import META_TOL, agreement_checks, metadata_checks, schema_checks
 from qsplan.planner.certify.inputs import (plan_columns_required, plan_file, plan_sources, read_plan,
                                            read_plan_file, task_from_metadata)  # fmt: skip
-from qsplan.planner.certify.modes import mode_checks, row_scene, slip_reversals, slip_velocities
+from qsplan.planner.certify.modes import disturbance_checks, mode_checks, row_scene, slip_reversals, slip_velocities
 from qsplan.planner.certify.route import (ENDPOINT_TOL, FREE_PATH_STEP, endpoint_checks, free_path_checks,
                                           rest_checks, structure_checks)  # fmt: skip
 from qsplan.planner.certify.rows import (
@@ -322,6 +322,8 @@ def certify_plan(plan, task, *, n_random: int = 8, seed: int = 0, force_margin: 
                     scenes[k] = scene
                     more, excluded = mode_checks(task, cols, k, mus, force_margin, _xdot_rows(cols, k), batched, scene)
                     found += more
+                    if task.disturbance is not None:
+                        found += disturbance_checks(task, cols, k, mus, force_margin, batched, scene)
                     slips = slip_velocities(task, cols, k, scene)
                     if slips is not None and slip is not None and slip[:2] == (k - 1, phase[k]):
                         found += slip_reversals(mode, scene.contact_names, slip[2], slips)

@@ -118,7 +118,7 @@ def _stated(claim, truth, path: str) -> str | None:
 def metadata_checks(meta, task, cols) -> list:
     """Every fact ``plan.json``'s metadata states, against the task and the rows."""
     from qsplan.hands.interface import hand_metadata
-    from qsplan.planner.export.plan_files import plan_metadata_limits
+    from qsplan.planner.export.plan_files import disturbance_metadata, plan_metadata_limits
     from qsplan.planner.task.record import task_record, task_tables
 
     if not isinstance(meta, dict):
@@ -152,6 +152,10 @@ def metadata_checks(meta, task, cols) -> list:
                     if key == "hand" and isinstance(meta[key], dict) else meta[key]
                 where = _stated(claimed, _plain(truth), f"metadata.{key}")
                 claim(where is None, f"{where} is not the task's")
+        if "disturbance" in meta or task.disturbance is not None:
+            where = _stated(meta.get("disturbance"), _plain(disturbance_metadata(task)), "metadata.disturbance")
+            claim(where is None and (meta.get("disturbance") is None) == (task.disturbance is None),
+                  f"{where or 'metadata.disturbance'} is not the task's")
         out += _phase_claims(meta["phases"], cols)
         contact = np.flatnonzero(cols["mode"] != "free")
         if contact.size:

@@ -17,7 +17,7 @@ import numpy as np
 
 from qsplan.mechanics import DEFAULT_TOLERANCES, Tolerances, solve_many, solve_many_reference
 
-__all__ = ["MOTION_RTOL", "EXACT_TOLERANCES", "SLIP_SIGN_TOL", "mode_checks", "row_scene", "slip_velocities",
+__all__ = ["MOTION_RTOL", "EXACT_TOLERANCES", "SLIP_SIGN_TOL", "disturbance_checks", "mode_checks", "row_scene", "slip_velocities",
            "slip_reversals"]
 
 #: Relative difference tolerated between the workpiece speed the solver computes from
@@ -190,3 +190,20 @@ def mode_checks(task, cols, k, mus, force_margin=0.0, xdot_rows=np.nan, batched=
     kinds = {"planned": "mode", "mode": "mode"}
     set_aside = tuple(sorted(letters[j] for j in np.flatnonzero(excluded)))
     return [(kinds.get(kind, kind), msg) for kind, msg in found.items()], set_aside
+
+
+def disturbance_checks(task, cols, k, mus, force_margin, batched, scene) -> list:
+    """Check 4 under the task's disturbance (``task.disturbance``, a box of wrenches on the workpiece): the row's
+    commands keep the planned mode the only feasible one at every friction vector **and** every vertex of the wrench
+    box (each added to the scene's ``g_obj``, eq. 2).  For the planned mode the vertices decide (for fixed friction its
+    rows are affine in the wrench); for the competitors this samples what the exact preclusion proved.  Returns
+    ``[(kind, message)]``, the first vertex showing each kind."""
+    from dataclasses import replace
+
+    found = {}
+    for w in task.disturbance.vertices():
+        loaded = replace(scene, g_obj=scene.g_obj + w)
+        more, _ = mode_checks(task, cols, k, mus, force_margin, np.nan, batched, loaded)
+        for kind, msg in more:
+            found.setdefault(kind, f"{msg}, under the disturbance wrench [{w[0]:.4g} N, {w[1]:.4g} N, {w[2]:.4g} N m]")
+    return list(found.items())

@@ -55,7 +55,7 @@ from qsplan.planner.export.schedule import FORMAT, VERSION
 from qsplan.planner.task.record import task_record, task_tables
 
 __all__ = ["PLAN_COLUMNS", "PLAN_FORMAT", "column_meanings", "export_plan", "plan_columns", "plan_joints",
-           "plan_metadata", "plan_metadata_limits", "plain_json", "read_plan_csv", "task_tables"]
+           "disturbance_metadata", "plan_metadata", "plan_metadata_limits", "plain_json", "read_plan_csv", "task_tables"]
 
 PLAN_FORMAT = FORMAT + ".plan"
 
@@ -216,6 +216,7 @@ def plan_metadata(plan) -> dict:
                              meaning="inside every band, for every friction in the range, every loaded contact's "
                                      "normal force and every rolling contact's friction-cone slacks are at least "
                                      "these (eq. 28 made strict)"),
+        "disturbance": disturbance_metadata(task),
         "command": {"rule": "per in-contact segment one margin m kept from both band edges at every row: lower + m "
                             "where the band is wider than 2 m, the midpoint where it is narrower; m = min(half the "
                             "segment's narrowest band, max_margin_resolutions x torque_resolution_N_m); each phase "
@@ -245,6 +246,16 @@ def _joint_units(hand) -> dict:
     from qsplan.hands.interface import JOINT_UNITS, joint_kinds, joint_names
 
     return {n: JOINT_UNITS[k] for n, k in zip(joint_names(hand), joint_kinds(hand))}
+
+
+def disturbance_metadata(task) -> dict | None:
+    """``metadata.disturbance``: the task's box of external wrenches (N, N, N m) and its meaning; None: none."""
+    if task.disturbance is None:
+        return None
+    return dict(task.disturbance.to_dict(),
+                meaning="every band holds its mode, and precludes every competitor, for every external wrench on the "
+                        "workpiece in this box (about the world origin, added to its weight) as well as every friction "
+                        "in the range")  # fmt: skip
 
 
 def plan_metadata_limits(task) -> dict:

@@ -270,7 +270,8 @@ def _edge_corners(task, x, effort, direction, grasp=None, path=None):
     scene = contact_samples(task, [x], effort, speed, grasp=grasp, free=free, free_rates=rates).scenes[0]
     n = scene.n_contacts
     rows = np.array([[lo] * n, [hi] * n]) if task.shared_mu else np.array(list(product((lo, hi), repeat=n)))
-    low, up, ok = effort_bands(scene, ContactMode(task.formation.mode), rows, force_margin=task.force_margin)
+    low, up, ok = effort_bands(scene, ContactMode(task.formation.mode), rows, force_margin=task.force_margin,
+                               disturbance=task.disturbance)
     if not np.any(ok):
         return None, None
     i = int(np.nanargmax(np.where(ok, low, -np.inf)))

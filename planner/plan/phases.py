@@ -187,7 +187,8 @@ def sweep_contact_segment(task, name, x, effort, direction, touching, comps, gra
     if k is not None:
         why = "a sliding contact's direction reverses here (it would roll in between: a mode change, eq. 16)"
         return k, None, None, None, why
-    band = guaranteed_sweep(S, task.mu_range, task.shared_mu, mode.letters, comps, force_margin=task.force_margin).band
+    band = guaranteed_sweep(S, task.mu_range, task.shared_mu, mode.letters, comps, force_margin=task.force_margin,
+                            disturbance=task.disturbance).band
     bad = ~np.asarray(band.feasible) | (band.upper - band.lower < task.torque_resolution)
     if bad.any():
         return int(np.argmax(bad)), None, None, None, None

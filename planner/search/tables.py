@@ -336,4 +336,4 @@ def _effort_bands(task, parts, e: int):
     joint_velocity = np.where(effort[None, :], np.nan, velocity)
     batch = batch_from_arrays(LazyScenes(velocity.shape[0], scene), *stacked, joint_velocity)
     return robust_band_arrays(batch, task.formation.mode, task.mu_range, shared=task.shared_mu,
-                              force_margin=task.force_margin)  # fmt: skip
+                              force_margin=task.force_margin, disturbance=task.disturbance)  # fmt: skip

@@ -157,7 +157,8 @@ def check_contact_state(task: Task, x: float, effort_joint: str, direction: floa
     mode = task.formation.mode
     if not band_kinematics(S.scenes[0], ContactMode(mode)).ok:
         return StateCheck(float(x), False, f"the {mode_name(mode)} kinematics fail (eqs. 24-25)")
-    g = guaranteed_sweep(S, task.mu_range, task.shared_mu, mode, competitors, force_margin=task.force_margin)
+    g = guaranteed_sweep(S, task.mu_range, task.shared_mu, mode, competitors, force_margin=task.force_margin,
+                         disturbance=task.disturbance)
     b, d = g.band, g.desired
     cut = tuple(c for c, (lo, hi) in g.competitors.items() if np.isfinite(lo[0]))
     lo, hi = float(b.lower[0]), float(b.upper[0])

@@ -18,6 +18,7 @@ from qsplan.mechanics.errors import QsplanError
 from qsplan.mechanics.model.fields import in_range, short_repr
 
 __all__ = ["PLAN_FORCE_MARGIN", "TASK_RANGES", "WORKPIECE_KEYS", "HandChoice", "check_hand", "hand_from_task_table",
+           "task_disturbance",
            "in_task_range", "plan_force_margin", "short_repr", "task_number", "field_name"]
 
 #: Plausible physical range ``(lo, hi)`` of every number of a task, with its unit; outside it a value is
@@ -43,6 +44,10 @@ __all__ = ["PLAN_FORCE_MARGIN", "TASK_RANGES", "WORKPIECE_KEYS", "HandChoice", "
 #:   hand-scale finger presses with tens of newtons (a human fingertip about 50 N), so a margin beyond
 #:   100 N (the weight of 10 kg) asks for contact forces no such finger exerts (1e6 N was planned, with
 #:   a command of 713,407 N m).
+#: * ``disturbance`` (N, N, N m): ``[controller] disturbance``'s corners, from -100 to 100: a box of external
+#:   wrenches on the workpiece (inertia at the time scaling's accelerations, bumps, a cable's pull) the bands
+#:   withstand; the same 100 N as the force margin (10 kg's weight, beyond a hand-scale finger), and 100 N m at
+#:   the workpiece (100 N at a metre, far beyond a palm-sized part).
 TASK_RANGES = {
     "size": (1e-3, 1.0, "m"),
     "position": (-1.0, 1.0, "m"),
@@ -56,6 +61,7 @@ TASK_RANGES = {
     "workpiece_speed": (1e-4, 0.5, "m/s"),
     "min_normal_force": (0.0, 100.0, "N"),
     "min_coulomb_slack": (0.0, 100.0, "N"),
+    "disturbance": (-100.0, 100.0, "N, N, N m"),
 }
 
 
@@ -218,3 +224,38 @@ def plan_force_margin(min_normal_force=None, min_coulomb_slack=None, field: str 
             raise QsplanError(f"{field}.{name}: expected a nonnegative finite force (N); got {short_repr(v)}")
         values.append(in_task_range(x, f"{field}.{name}", name))
     return ForceMargin(*values)
+
+
+def task_disturbance(table, field: str = "controller.disturbance"):
+    """A task's ``[controller] disturbance`` table ``{lo = [fx, fy, m], hi = [fx, fy, m]}`` (N, N, N m; about the world
+    origin, added to the workpiece's weight) as a :class:`qsplan.mechanics.bands.disturbance.WrenchBox`, None for
+    none (absent, or zeros).  Each corner inside :data:`TASK_RANGES` ``["disturbance"]``.
+
+    Raises
+    ------
+    QsplanError
+        Naming ``controller.disturbance.<key>`` and the component.
+    """
+    from qsplan.mechanics.bands.disturbance import WrenchBox, check_wrench_box
+
+    if table is None or isinstance(table, WrenchBox):
+        return check_wrench_box(table)
+    if not isinstance(table, dict):
+        raise QsplanError(f"{field}: expected a table {{lo = [fx, fy, m], hi = [fx, fy, m]}} (N, N, N m); "
+                          f"got {short_repr(table)}")  # fmt: skip
+    extra = sorted(set(table) - {"lo", "hi"}, key=str)
+    if extra:
+        raise QsplanError(f"{field}.{field_name(extra[0])}: unknown field; expected lo and hi")
+    corners = []
+    for key in ("lo", "hi"):
+        if key not in table:
+            raise QsplanError(f"{field}.{key}: missing (3 numbers: force x, force y in N, moment in N m)")
+        v = table[key]
+        if not isinstance(v, (list, tuple)) or len(v) != 3:
+            raise QsplanError(f"{field}.{key}: expected 3 numbers (N, N, N m); got {short_repr(v)}")
+        corners.append([in_task_range(task_number(x, f"{field}.{key}[{i}]", "N or N m"), f"{field}.{key}[{i}]",
+                                      "disturbance") for i, x in enumerate(v)])  # fmt: skip
+    try:
+        return check_wrench_box(WrenchBox(*corners))
+    except QsplanError as exc:
+        raise QsplanError(f"controller.{exc}") from None

@@ -71,4 +71,6 @@ def task_record(task) -> dict:
                           "min_normal_force": float(task.force_margin.normal),
                           "min_coulomb_slack": float(task.force_margin.slack)},
            "limits": limits}  # fmt: skip
+    if task.disturbance is not None:
+        doc["controller"]["disturbance"] = {"lo": list(task.disturbance.lo), "hi": list(task.disturbance.hi)}
     return doc

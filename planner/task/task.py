@@ -30,6 +30,8 @@ TOML form (all SI: m, kg, rad, s, N m)::
     torque_resolution = 0.02     # N m: the narrowest band the controller can hold
     min_normal_force = 0.05      # N, optional: every contact's normal force at least this, for all friction
     min_coulomb_slack = 0.05     # N, optional: rolling contacts' cone slacks at least this (qsplan.planner.task.fields.PLAN_FORCE_MARGIN)
+    disturbance = { lo = [-0.1, -0.1, -0.005], hi = [0.1, 0.1, 0.005] }  # optional (N, N, N m): every band
+                                 # holds for every external wrench on the workpiece in this box (none by default)
     [limits]                     # optional: narrows the hand's own limits, never widens them
     left = [0.05, 3.09]          # a joint's range by its name (rad; m for a prismatic joint)
     right = [0.05, 3.09]
@@ -55,7 +57,8 @@ from qsplan.mechanics.bands.effort import ForceMargin, check_force_margin
 from qsplan.mechanics.errors import QsplanError
 from qsplan.mechanics.model.friction import check_mu_range
 from qsplan.planner.task.fields import (PLAN_FORCE_MARGIN, TASK_RANGES, check_hand, field_name, hand_from_task_table,
-                                        in_task_range, plan_force_margin, short_repr, task_number)  # fmt: skip
+                                        in_task_range, plan_force_margin, short_repr, task_disturbance,
+                                        task_number)  # fmt: skip
 from qsplan.hands.formations import DEFAULT_FORMATION, FORMATIONS, Formation
 from qsplan.planner.task.goal import Goal, make_goal, make_start_features
 from qsplan.planner.task.limits import LIMIT_KEYS, resolve_limits
@@ -75,7 +78,7 @@ MIN_SEGMENT_LENGTH = 1e-4
 _TABLE_KEYS = {
     "motion": {"start_x", "waypoints"},
     "friction": {"range", "shared"},
-    "controller": {"torque_resolution", "min_normal_force", "min_coulomb_slack"},
+    "controller": {"torque_resolution", "min_normal_force", "min_coulomb_slack", "disturbance"},
 }
 
 _DATA = Path(__file__).parent.parent / "data"  # planner/data, installed as qsplan.planner package data
@@ -123,6 +126,9 @@ class Task:
     formation : qsplan.hands.formations.Formation
         How the hand holds the workpiece: its contacts, their order, the desired mode (today's one entry of
         :data:`qsplan.hands.formations.FORMATIONS`, the bottom edge on the palm and a point of each finger, 4S).
+    disturbance : qsplan.mechanics.bands.disturbance.WrenchBox or None
+        A box of external wrenches on the workpiece (N, N, N m) every guaranteed band and preclusion withstands
+        (:mod:`qsplan.mechanics.bands.disturbance`); None: none.
     """
 
     name: str
@@ -141,6 +147,7 @@ class Task:
     speeds: np.ndarray | None = None
     start_joints: np.ndarray | None = None
     formation: Formation = FORMATIONS[DEFAULT_FORMATION]
+    disturbance: object = None
 
     @property
     def joint_speeds(self) -> np.ndarray:
@@ -169,7 +176,7 @@ def _pair(value, field, unit) -> tuple:
 def make_task(hand, start_x, waypoints=None, mu_range=(0.0, 0.2), torque_resolution=0.02, shared_mu=False,
               joint_limits=None, joint_speed=None, workpiece_speed=0.01,
               name="task", force_margin=None, goal=None, start=None, base_dir=None, joint_speeds=None,
-              formation=None) -> Task:  # fmt: skip
+              formation=None, disturbance=None) -> Task:  # fmt: skip
     """Validate and build a :class:`Task` (parameters as its attributes; ``hand`` a TwoFingerHand or a dict of
     :func:`qsplan.hands.two_finger.make_two_finger_hand` arguments).  Either ``waypoints`` (a scripted
     sequence) or ``goal`` (the ``[goal]`` table as a dict, or a :class:`Goal`: the planner finds the sequence);
@@ -260,7 +267,7 @@ def make_task(hand, start_x, waypoints=None, mu_range=(0.0, 0.2), torque_resolut
         formation = registered(formation)
     return Task(name, hand, start_x, wp, (lo, hi), bool(shared_mu), checked["torque_resolution"], limits,
                 float(np.min(speeds)), checked["workpiece_speed"], force_margin, goal, start_features, speeds,
-                start_joints, formation)  # fmt: skip
+                start_joints, formation, task_disturbance(disturbance))  # fmt: skip
 
 
 def _start_joints(hand, table) -> np.ndarray | None:
@@ -317,16 +324,9 @@ def load_task(path) -> Task:
 
 
 def task_from_record(doc, base_dir=None, default_name: str = "task") -> Task:
-    """The task of a task file's tables (a parsed TOML document, or :func:`qsplan.planner.task.record.task_record`'s
-    record): every field checked as :func:`load_task` checks a file's.
-
-    Parameters
-    ----------
-    doc : dict
-    base_dir : str or Path, optional
-        Folder against which a relative ``[hand] file`` is resolved.
-    default_name : str
-        The task's name when ``doc`` gives none.
+    """The task of a task file's tables ``doc`` (a parsed TOML document, or :func:`qsplan.planner.task.record.task_record`'s
+    record), every field checked as :func:`load_task` checks a file's; ``base_dir`` resolves a relative ``[hand] file``,
+    ``default_name`` names a task that gives no name.
 
     Raises
     ------
@@ -375,6 +375,8 @@ def task_from_record(doc, base_dir=None, default_name: str = "task") -> Task:
     if "formation" in doc:
         kw["formation"] = doc["formation"]
     kw["force_margin"] = plan_force_margin(controller.get("min_normal_force"), controller.get("min_coulomb_slack"))
+    if "disturbance" in controller:
+        kw["disturbance"] = controller["disturbance"]
     return make_task(_table(doc, "hand"), motion["start_x"], motion.get("waypoints"),
                      torque_resolution=controller["torque_resolution"], name=doc.get("name", default_name), **kw)  # fmt: skip
 

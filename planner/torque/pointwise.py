@@ -124,6 +124,8 @@ class GuaranteedSweep:
         One coefficient shared by all contacts (else independent per contact).
     force_margin : ForceMargin or None
         Minimum normal force and Coulomb slack (N) the desired mode keeps (None: eq. 28 as is).
+    disturbance : WrenchBox or (lo, hi) or None
+        The box of external wrenches on the workpiece the band withstands (None: none).
     """
 
     band: BandSweep
@@ -133,6 +135,7 @@ class GuaranteedSweep:
     mu_range: tuple
     shared: bool
     force_margin: object = None
+    disturbance: object = None
 
 
 
@@ -201,7 +204,7 @@ def point_band_sweep(samples, mu, mode=None, label=None) -> BandSweep:
 
 
 def guaranteed_sweep(samples, mu_range=DEFAULT_MU_RANGE, shared=False, mode=None, competitors=None, *,
-                     force_margin=None) -> GuaranteedSweep:  # fmt: skip
+                     force_margin=None, disturbance=None) -> GuaranteedSweep:  # fmt: skip
     """The band guaranteeing ``mode`` and precluding every competitor for all friction in the set (Fig. 13).
 
     Parameters
@@ -218,6 +221,8 @@ def guaranteed_sweep(samples, mu_range=DEFAULT_MU_RANGE, shared=False, mode=None
         (:func:`qsplan.mechanics.bands.robust.admissible_competitors`; in chunks: :func:`qsplan.planner.torque.sweep.competing_modes`).
     force_margin : ForceMargin or (float, float), optional
         Minimum normal force and Coulomb slack (N) kept for all friction in the set (:func:`qsplan.mechanics.robust_band`).
+    disturbance : WrenchBox or (lo, hi), optional
+        A box of external wrenches on the workpiece (N, N, N m) the band withstands too (:func:`qsplan.mechanics.robust_band`).
 
     Returns
     -------
@@ -229,7 +234,8 @@ def guaranteed_sweep(samples, mu_range=DEFAULT_MU_RANGE, shared=False, mode=None
     mode = _mode(samples, mode)
     comps = admissible_competitors(samples.scenes, mode) if competitors is None else tuple(competitors)
     # robust_band at every sample, batched over the samples (bit-identical: tests/mechanics/test_bands_batched.py)
-    robust = robust_bands(samples.scenes, mode, (lo, hi), shared=shared, competitors=comps, force_margin=force_margin)
+    robust = robust_bands(samples.scenes, mode, (lo, hi), shared=shared, competitors=comps, force_margin=force_margin,
+                          disturbance=disturbance)
     desired = [r.desired for r in robust]
     method = desired[0].method
     where = f"mu in [{lo:g}, {hi:g}]" + (" (shared)" if shared else " (each contact)")
@@ -242,7 +248,7 @@ def guaranteed_sweep(samples, mu_range=DEFAULT_MU_RANGE, shared=False, mode=None
                      frozen_array([r.feasible for r in robust]), frozen_array([r.exact for r in robust]), method,
                      tuple(r.reason for r in robust))  # fmt: skip
     split = frozen_array(np.array([r.split for r in robust], dtype=bool))
-    return GuaranteedSweep(band, dsweep, hulls, split, (lo, hi), bool(shared), force_margin)
+    return GuaranteedSweep(band, dsweep, hulls, split, (lo, hi), bool(shared), force_margin, disturbance)
 
 
 def sampled_guaranteed_sweep(samples, mu_values, mode=None, competitors=None, *, force_margin=None) -> BandSweep:
