@@ -1,13 +1,12 @@
-"""``qsplan demo``: the main job, end to end: plan the bundled regrasp like the paper's Fig. 9.
+"""``qsplan demo``: the main job, end to end: plan the first 4S segment of the paper's Fig. 9.
 
 ::
 
     qsplan demo [--out DIR] [--seed S] [--planner NAME] [--force] [--quiet] [--no-plots]
 
-Plans :func:`qsplan.planner.task.task.demo_task_path` (three 4S segments of the default hand:
-slide left until the left finger nearly meets the longest edge, right, left to
-the middle, regrasping between them) exactly as ``qsplan plan`` does, and writes
-the torque trajectory and the plots into DIR (default ``out/demo``).
+Plans :func:`qsplan.planner.task.task.demo_task_path` exactly as ``qsplan plan`` does (:data:`DEMO_PLAN`
+says what it plans; a test holds the plan to it), and writes the torque trajectory, its certificate, the
+re-simulation and the plots into DIR (default ``out/demo``).
 """
 
 from __future__ import annotations
@@ -15,11 +14,16 @@ from __future__ import annotations
 from qsplan.planner.cli.options import add_plan_options
 from qsplan.planner.cli.plan import FLAGS, run_task
 
-__all__ = ["FLAGS", "add_parser", "run"]
+__all__ = ["DEMO_PLAN", "FLAGS", "add_parser", "run"]
+
+#: What the demo plans, in words (its ``--help``, the README): ``tests/planner/test_cmd_plan.py`` checks the plan
+#: against it (one in-contact segment, no regrasp).
+DEMO_PLAN = ("the first 4S segment of Fig. 9: one slide of the paper hand's workpiece 4 cm to the left, no regrasp, "
+             "with the widest guaranteed band for every friction in [0, 0.2]")
 
 
 def add_parser(subparsers):
-    p = subparsers.add_parser("demo", help="plan the bundled two-finger regrasp (like Fig. 9) end to end")
+    p = subparsers.add_parser("demo", help=f"plan the bundled task end to end: {DEMO_PLAN}")
     add_plan_options(p, "out/demo")
     return p
 

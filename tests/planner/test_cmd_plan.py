@@ -87,3 +87,22 @@ def test_ctrl_c_during_planning_exits_130_and_leaves_nothing(tmp_path):
     assert proc.returncode == 130, err[-500:]
     assert err.splitlines()[-1] == "qsplan: interrupted" and "Traceback" not in err
     assert not out.exists() or not any(out.iterdir())
+
+
+def test_the_demo_plans_what_its_description_says():
+    """``qsplan demo --help`` and the README say what the demo plans (DEMO_PLAN); the plan is held to it."""
+    from pathlib import Path
+
+    from qsplan.planner.cli.demo import DEMO_PLAN
+    from qsplan.planner.plan.results import ContactSegmentPlan, RegraspPlan
+    from qsplan.planner.plan.scripted import plan_task
+    from qsplan.planner.task.task import demo_task_path, load_task
+
+    plan = plan_task(load_task(demo_task_path()))
+    slides = [p for p in plan.phases if isinstance(p, ContactSegmentPlan)]
+    assert "one slide" in DEMO_PLAN and "no regrasp" in DEMO_PLAN and "4 cm to the left" in DEMO_PLAN
+    assert len(slides) == 1 and not any(isinstance(p, RegraspPlan) for p in plan.phases)
+    assert slides[0].x[-1] - slides[0].x[0] == pytest.approx(-0.04, abs=1e-12)
+    assert slides[0].mode == "SSSS"
+    readme = (Path(__file__).resolve().parents[2] / "README.md").read_text()
+    assert "one slide 4 cm to the left, no regrasp" in readme and "bundled regrasp" not in readme
