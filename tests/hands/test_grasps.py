@@ -253,6 +253,7 @@ def test_unknown_placement_index_names_the_field():
 # -- scenes ---------------------------------------------------------------------------------------------------------
 
 
+@pytest.mark.slow
 def test_tip_scenes_analytic_equal_generic():
     used = 0
     rng = np.random.default_rng(5)

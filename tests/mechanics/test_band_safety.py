@@ -265,6 +265,18 @@ def test_empty_and_unbounded_are_distinct_answers():
         assert ct.empty and ct.exact and np.isnan(ct.lower) and ct.reason is None
 
 
+#: Scenes of the quick survey run by default (the full one, :data:`N_SCENES`, is marked slow): the first scenes of the
+#: same seeded sequence, enough for unbounded, empty and feasible bands of both friction models (~10 s).
+N_QUICK = 20
+
+
+def test_quick_survey_every_reported_band_is_safe_and_exact_bands_are_confirmed():
+    out = survey(N_QUICK)
+    assert out["unsafe"] == []
+    assert out["unconfirmed"] == []
+    assert out["unbounded"] >= 1 and out["empty"] >= 1 and out["feasible"] >= 10
+
+
 @pytest.mark.slow
 def test_every_reported_band_is_safe_and_exact_bands_are_confirmed():
     out = survey()

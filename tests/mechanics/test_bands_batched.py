@@ -108,6 +108,7 @@ def test_robust_bands_of_the_segment_are_the_per_state_ones(segment, shared, mar
         assert any(np.isposinf(r.upper) for r in ref)
 
 
+@pytest.mark.slow
 def test_robust_bands_of_random_scenes_batched_by_shape_are_the_per_state_ones(random_scenes):
     """Per group of one shape: the planted mode of its first scene, and the modes whose guaranteed band is
     unbounded at some scene (the hard cases for preclusion); competitors found per state (default) or given."""

@@ -97,6 +97,7 @@ def test_robust_band_arrays_of_the_segment(segment, shared, margin):
     assert_arrays_are_bands(type(arrays)(*(getattr(arrays, f)[::4] for f in arrays.__slots__)), bands[::4], refs)
 
 
+@pytest.mark.slow
 def test_robust_band_arrays_of_random_scenes(random_groups):
     """The planted mode and the modes unbounded somewhere (the hard cases for preclusion), competitors per state
     or given; the cases cover unbounded, empty, inexact and split bands and per-state searches."""

@@ -221,6 +221,27 @@ def test_demo_hand_band_edges_are_where_the_solver_changes_its_mind():
     assert not all(verdict(scene, band.lower - d, mu, w, mode)[0] for mu, w in vertices)
 
 
+#: Random cases of the quick check run by default (the full 20 are marked slow): one exact finite band and one
+#: empty band of the same seeded cases (each of the others takes 5-14 s on a loaded 2-core machine).
+QUICK_CASES = (1, 5)
+
+
+def test_quick_random_scene_bands_are_safe_at_every_vertex_and_exact_when_said():
+    n_bands = 0
+    for k in QUICK_CASES:
+        scene, mode, shared, box = random_case(k)
+        if mode is None:
+            continue
+        band = robust_band(scene, mode, MU_RAND, shared=shared, disturbance=box)
+        n_bands += 1
+        rng = np.random.default_rng([SEED, k, 1])
+        if band.feasible:
+            assert unsafe_efforts(scene, band, shared, box, MU_RAND, rng) == [], k
+        if band.exact and band.feasible:
+            assert edges_confirmed(scene, band, shared, box, MU_RAND, rng), k
+    assert n_bands == len(QUICK_CASES)
+
+
 @pytest.mark.slow
 def test_random_scene_bands_are_safe_at_every_vertex_and_exact_when_said():
     n_bands = n_exact = n_unbounded = n_empty = 0

@@ -49,6 +49,7 @@ def _smallest_slack(scene, mode, c_n, c_t):
     return min(out)
 
 
+@pytest.mark.slow
 def test_lp_agrees_with_reference_on_planted_scenes():
     compared = boundary = feasible = 0
     for scene in _planted(1995):

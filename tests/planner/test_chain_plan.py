@@ -173,6 +173,7 @@ def test_any_chain_a_two_link_finger_beside_a_leaning_jaw():
     _check_rows(plan)
 
 
+@pytest.mark.slow
 def test_the_two_link_hands_exported_commands_drive_the_simulator_through_the_plan(two_link_plan, tmp_path):
     """The exported file alone (plan.csv), driven through the finite-motion simulator (every mode checked at every
     instant, eqs. 13-28): the workpiece follows the planned x and all four contacts slide, at the friction interval's

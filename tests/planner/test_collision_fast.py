@@ -108,6 +108,7 @@ def test_default_hand_and_bundled_tasks_agree_with_shapely():
         assert np.any(decisions == COLLIDES) and np.any(np.all(decisions == CLEAR, axis=1))
 
 
+@pytest.mark.slow
 def test_shapes_and_random_hands_agree_with_shapely():
     rng = np.random.default_rng(1995)
     for hand in hands(rng, 8)[3:]:
