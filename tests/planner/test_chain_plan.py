@@ -1,4 +1,4 @@
-"""Plans of described hands (qsplan.planner.plan.chain_plan): slides planned on the contact manifold by OMPL.
+"""Plans of hands with free joints (the one pipeline, qsplan.planner.plan.autoplan): grasp rows, band tables, slides.
 
 Each plan is checked independently of the planner: shapely measures every body pair and each finger's
 contact at every row, the joint and speed limits are checked by finite differences of the rows, and
