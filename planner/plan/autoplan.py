@@ -37,6 +37,7 @@ from qsplan.planner.plan.results import ContactSegmentPlan, Plan, PlanFailure
 from qsplan.planner.plan.steps import RegraspStep, SearchSummary, SlideStep
 from qsplan.planner.search.ompl_search import search_route
 from qsplan.planner.search.tables import band_tables, table_grid
+from qsplan.planner.task.goal import feature_text
 
 __all__ = ["FREE_GRID", "FREE_SEARCH_MARGIN", "MAX_GOAL_GRASPS", "MAX_ROUNDS", "grasp_rows", "goal_nodes",
            "plan_automatic", "route_phases", "start_nodes"]
@@ -64,19 +65,11 @@ FREE_SEARCH_MARGIN = 0.01
 SAME_FREE = 1e-9
 
 
-def _feature_text(feature):
-    """A task's feature as a grasp's ``matches`` reads it: None (any), ``"vertex"`` (the start's ``"inner"``: the
-    inner edge on whichever vertex), ``"edge:K"``, ``"vertex:K"``."""
-    if feature is None:
-        return None
-    return "vertex" if feature[0] == "inner" else f"{feature[0]}:{feature[1]}"
-
-
 def _start_grasps(tables, task, i):
     """Indices of the valid rows that meet the task's start at grid index ``i``: its features (a hand without free
     joints) or its ``[start]`` free joints (a hand with them, where given)."""
     free = bool(task.hand.free_joints)  # a hand with free joints starts from them ([start] by name), not features
-    feats = [None, None] if free else [_feature_text(f) for f in task.start_features]
+    feats = [None, None] if free else [feature_text(f) for f in task.start_features]
     out = []
     for g in range(len(tables.grasps)):
         if not (tables.graph.valid[g, i] and _meets(tables, task, g, i, feats)):
@@ -98,7 +91,7 @@ def _meets(tables, task, g, i, feats) -> bool:
 
 
 def _goal_grasps(tables, task, i):
-    feats = [_feature_text(task.goal.left), _feature_text(task.goal.right)]
+    feats = [feature_text(task.goal.left), feature_text(task.goal.right)]
     return [g for g in range(len(tables.grasps)) if _meets(tables, task, g, i, feats)]
 
 
@@ -149,7 +142,7 @@ def grasp_rows(task, x0: float, x1: float) -> tuple:
     grid = np.stack(np.meshgrid(*axes, indexing="ij"), axis=-1).reshape(-1, len(free))
     starts = task.start_joints[free][None] if task.start_joints is not None else grid
     start = _valid_at(task, hand.grasp_candidates(formation, starts, [x0]), x0)
-    goal_feats = (None, None) if task.goal is None else (_feature_text(task.goal.left), _feature_text(task.goal.right))
+    goal_feats = (None, None) if task.goal is None else (feature_text(task.goal.left), feature_text(task.goal.right))
     at_goal = _valid_at(task, hand.grasp_candidates(formation, grid, [x1]), x1)
     goals = _spread([g for g in at_goal if g.matches(*goal_feats)])
     keys = {s.keys for s in start}  # grasps at the goal the start's contacts slide to (then a regrasp if need be)

@@ -21,11 +21,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from qsplan.planner.task.goal import feature_text
 from qsplan.planner.plan.failure import ConfigurationReport, failure_report
 from qsplan.planner.states.contact import mode_name
 from qsplan.planner.search.widest import SearchGraph, slide_widths, widest_route
 
-__all__ = ["NoRouteReport", "no_route_report", "unreachable_goal_report"]
+__all__ = ["NoRouteReport", "blocking_overlap", "no_route_report", "unreachable_goal_report"]
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -73,18 +74,117 @@ def _joint_words(task, name: str) -> str:
     return f"{name} finger" if any(f == (k,) for f in task.hand.finger_joints) else f"joint {name}"
 
 
+def _asked(task, which) -> str | None:
+    """What the task asks of its start or goal (``which``), in words, or None where it asks nothing but a position."""
+    if which == "goal":
+        feats = [f for f in (task.goal.left, task.goal.right) if f is not None]
+        return task.goal.describe() if feats else None
+    if task.hand.free_joints:
+        if task.start_joints is None:
+            return None
+        names = task.hand.joint_names
+        return "the [start] free joints " + ", ".join(f"{names[j]} = {task.start_joints[j]:.4g}"
+                                                      for j in task.hand.free_joints)  # fmt: skip
+    return f"start features {list(task.start_features)}"
+
+
+def _matching(task, tables, which) -> list:
+    """The rows whose grasp is the start's or the goal's (``which``), valid or not: a hand with free joints' ``[start]``
+    rows (closed from those values), else the rows whose placements match the features asked (the vertex a placement
+    touches not compared: an invalid configuration may touch none)."""
+    rows = range(len(tables.grasps))
+    hand = task.hand
+    if which == "start" and hand.free_joints:
+        if task.start_joints is None:
+            return list(rows)
+        start = np.asarray(task.start_joints, float)[list(hand.free_joints)]
+        return [g for g in rows if np.array_equal(np.asarray(tables.grasps[g].grasp.free, float), start)]
+    feats = task.start_features if which == "start" else (task.goal.left, task.goal.right)
+    texts = [feature_text(f) for f in feats]
+    return [g for g in rows if tables.grasps[g].grasp.matches(*texts)]
+
+
+def _open(task, tables, g, i):
+    """Row ``g`` at grid index ``i`` with the fingers that close onto nothing fully open: ``(q, collision)``, the
+    collision of a body with the workpiece, None where none overlaps it (a closing joint's NaN set to the end of its
+    range its opening sense points to: :meth:`qsplan.hands.protocol.Hand.opening`; a link folded onto another there is
+    the open pose's, not the grasp's obstacle)."""
+    hand, lim = task.hand, task.joint_limits
+    q = np.array(tables.q[g, i], dtype=float)
+    if np.any(~np.isfinite(q[list(hand.free_joints)])):
+        return None, None
+    mid = np.where(np.isfinite(q), q, 0.5 * (lim[:, 0] + lim[:, 1]))
+    sense = hand.opening(tables.grasps[g].grasp, float(tables.x[i]), mid)
+    q = np.where(np.isfinite(q), q, np.where(sense > 0, lim[:, 1], lim[:, 0]))
+    hits = [c for c in hand.collisions(task.pose(tables.x[i]), q) if "workpiece" in c.bodies]
+    return q, (hits[0] if hits else None)
+
+
+def blocking_overlap(task, tables, i, rows):
+    """The first overlap among the tables' ``rows`` at grid index ``i``: a closed configuration whose bodies overlap,
+    else one whose fingers, fully open where they close onto nothing, already overlap the workpiece.
+
+    Returns
+    -------
+    (int, ndarray (n_j,), qsplan.hands.collision.Collision, bool) or None
+        The row, its joints (rad or m), the overlap, and whether the fingers were opened.
+    """
+    from qsplan.planner.search.tables import OVERLAP
+
+    for g in rows:
+        if tables.why[g, i] == OVERLAP:
+            hit = task.hand.collisions(task.pose(tables.x[i]), tables.q[g, i], first=True)
+            if hit:
+                return g, tables.q[g, i], hit[0], False
+    for g in rows:
+        if not tables.graph.valid[g, i] and np.any(~np.isfinite(tables.q[g, i])):
+            q, hit = _open(task, tables, g, i)
+            if hit is not None:
+                return g, q, hit, True
+    return None
+
+
+def _reasons(task, tables, i, rows, most: int = 4) -> list:
+    """The distinct reasons the rows ``rows`` are invalid at grid index ``i``, each with how many share it and one
+    example, in order of first appearance."""
+    seen = {}
+    for g in rows:
+        if not tables.graph.valid[g, i]:
+            seen.setdefault(tables.reason(task, g, i), []).append(g)
+    n = len(rows)
+    return [f"{tables.grasps[gs[0]].label}: {why}" if n == 1 else
+            f"{why} ({len(gs)} of {n} grasps, e.g. {tables.grasps[gs[0]].label})"
+            for why, gs in list(seen.items())[:most]]  # fmt: skip
+
+
 def unreachable_goal_report(task, tables, i, which, grasps_at) -> ConfigurationReport:
-    """The start or goal (``which``) at grid index ``i`` has no valid grasp with the asked features."""
+    """The start or goal (``which``) at grid index ``i`` has no valid grasp with the asked features: the reasons the
+    candidates are invalid there, the grasps valid there instead, and the bodies that overlap (a closed grasp's, or
+    a finger's fully open where it closes onto nothing), with their configuration."""
+    x = float(tables.x[i])
+    asked = _asked(task, which)
     cands = grasps_at(tables, task, i)
-    lines = [f"{tables.grasps[g].label}: {tables.reason(task, g, i)}" for g in cands[:6] if not tables.graph.valid[g, i]]
-    lines += [f"{tables.grasps[g].label} is valid there with {_touching(task, tables, g, i)}"
-              for g in range(len(tables.grasps)) if tables.graph.valid[g, i]][:4]  # fmt: skip
-    if not lines:  # nothing meets it, nothing is valid: why each candidate is not
-        lines = [f"{tables.grasps[g].label}: {tables.reason(task, g, i)}" for g in range(len(tables.grasps))][:4]
-    feats = task.goal.describe() if which == "goal" else f"start features {list(task.start_features)}"
-    reason = (f"the {which} is unreachable on this palm: no grasp meeting it ({feats}) is a valid configuration"
-              + (f" ({'; '.join(lines)})" if lines else " (no candidate grasp of this hand has those features anywhere)"))  # fmt: skip
-    return ConfigurationReport(f"the {which}", f"the {which}", float(tables.x[i]), None, reason)
+    everyone = list(range(len(tables.grasps)))
+    lines = _reasons(task, tables, i, cands[:6] if asked else everyone)
+    if asked:
+        lines += [f"{tables.grasps[g].label} is valid there with {_touching(task, tables, g, i)}"
+                  for g in everyone if tables.graph.valid[g, i]][:4]  # fmt: skip
+    if not lines:  # nothing meets it, nothing is valid: why each grasp is not
+        lines = _reasons(task, tables, i, everyone)
+    if asked:
+        reason = f"the {which} is unreachable on this palm: no grasp meeting it ({asked}) is a valid configuration"
+    else:
+        reason = (f"the {which} is unreachable on this palm: none of the {len(everyone)} grasps the planner considered "
+                  f"(the {which} names no features: any would do) is a valid configuration at x = {x:.4g} m")  # fmt: skip
+    reason += f" ({'; '.join(lines)})" if lines else " (no candidate grasp of this hand has those features anywhere)"
+    found = blocking_overlap(task, tables, i, (cands or _matching(task, tables, which)) if asked else everyone)
+    if found is None:
+        return ConfigurationReport(f"the {which}", f"the {which}", x, None, reason)
+    g, q, hit, opened = found
+    where = "with the fingers that close onto nothing fully open, " if opened else ""
+    reason += f"; {where}grasp {tables.grasps[g].label}: {hit.message}"
+    return ConfigurationReport(f"the {which}", f"the {which}", x, tuple(float(v) for v in q), reason, hit.bodies,
+                               hit.area, hit.depth)  # fmt: skip
 
 
 def _blocking(task, tables, g, i0, i1) -> str:

@@ -1,11 +1,16 @@
 """The plan card: one A4 page an operator reads at a glance before running a plan (``plan_card.png``).
 
-From top to bottom: the task and a one-line verdict (certified row by row, re-simulated at N friction
-vectors); hand snapshots lettered A, B, ...; then on one shared time axis the contact-mode timeline
-(the letters mark the snapshots' instants, each segment names its torque-controlled finger), each
-torque-controlled joint's command inside its guaranteed band with the narrowest point of every band
-marked and labelled with its width, and each joint's velocity command.  Text is at least 7.5 pt on the
-printed page.  Only the plan's public fields are read (see :mod:`qsplan.planner.plotting.plan_panels`).
+From top to bottom: the task, its facts and a table with a line per phase (numbered as ``plan.csv``
+numbers them): what the hand does, the commanded joint, the command's range and which way it acts, the
+slack (the command's margin to the nearer band edge) and the narrowest band, in the joint's unit; the
+one-line verdict (certified row by row, re-simulated at N friction vectors); hand snapshots lettered A,
+B, ..., the plan's start and end always among them, each titled with what the hand does there (sliding,
+holding, open, closing: :func:`qsplan.planner.plotting.hands.row_state`); then on one shared time axis a
+thin mode bar (the letters mark the snapshots' instants), each torque-controlled joint's command inside
+its guaranteed band with the slack and the narrowest point marked, edges beyond the plot marked as in
+Fig. 13 (filled: unbounded, hollow: finite), and each joint's velocity command.  The legend lists what is
+drawn, nothing else.  Text is at least 7.5 pt on the printed page.  Only the plan's public fields are
+read (see :mod:`qsplan.planner.plotting.plan_panels`).
 """
 
 from __future__ import annotations
@@ -14,33 +19,42 @@ import textwrap
 
 import numpy as np
 
+from qsplan.planner.plotting.hands import plan_snapshots
 from qsplan.planner.plotting.plan_panels import (
+    SLACK,
     draw_band,
+    effort_sense,
     effort_words,
     is_contact,
     joint_math,
     joint_title,
     mark_narrowest,
+    mark_slack,
+    phase_label,
     plot_mode_timeline,
-    snapshot_keys,
+    slack,
     timeline_handles,
     torque_limits,
 )
 from qsplan.planner.plotting.style import A4_PORTRAIT, FONT, NARROWEST, joint_colour, torque_text
 
-__all__ = ["CARD_DPI", "LEGEND_LABEL_CHARS", "MAX_SNAPSHOTS", "card_snapshots", "plan_card", "verdict"]
+__all__ = ["CARD_DPI", "LEGEND_LABEL_CHARS", "MAX_SNAPSHOTS", "card_snapshots", "phase_rows", "plan_card", "verdict"]
 
 #: Resolution (dots per inch) the card is written at: 150 keeps 7.5 pt text sharp on an A4 print.
 CARD_DPI = 150
 
-#: Snapshots on the card, at most (the instants are thinned evenly beyond it).
+#: Snapshots on the card, at most (the instants are thinned evenly beyond it; the start and the end stay).
 MAX_SNAPSHOTS = 10
 
 #: Longest legend label (characters) that three legend columns hold on the A4 page at the legend's 8 pt; longer
 #: labels (a described hand's joint names in the timeline's entries) take two columns.
 LEGEND_LABEL_CHARS = 44
 
+#: Width (points) the header's table may take: the A4 page's 595 pt less its margins.
+_TABLE_WIDTH = 570.0
+
 _OK, _BAD = "#1a7f37", "#b42318"
+_COLUMNS = ("phase", "t (s)", "what the hand does", "commanded", "command, its direction", "slack", "narrowest band")
 
 
 def verdict(certificate=None, replays=()) -> tuple:
@@ -76,74 +90,237 @@ def verdict(certificate=None, replays=()) -> tuple:
 
 
 def card_snapshots(plan, limit: int = MAX_SNAPSHOTS) -> list:
-    """The card's snapshots: each in-contact segment's start and end (and instants between when there is
-    room), each regrasp with open fingers.
+    """The card's snapshots (:func:`qsplan.planner.plotting.hands.plan_snapshots`): the plan's start and end, each
+    phase's ends, a regrasp's rows off the workpiece, and instants along each in-contact segment while there is room.
 
     Returns
     -------
-    list of (t, pose, q, effort_joint or None, open), at most ``limit``, in time order.
+    list of qsplan.planner.plotting.hands.Snapshot
+        At most ``limit`` (at least the start and the end), in time order.
     """
     n_seg = max(1, sum(is_contact(p) for p in plan.phases))
-    per_phase = int(np.clip((limit - (len(plan.phases) - n_seg)) // n_seg, 2, 4))
-    shots = snapshot_keys(plan, per_phase=per_phase)
-    if len(shots) > limit:
-        shots = [shots[k] for k in np.unique(np.round(np.linspace(0, len(shots) - 1, limit)).astype(int))]
-    return shots
+    others = sum(p.t.size for p in plan.phases if not is_contact(p))
+    per_segment = int(np.clip((limit - others) // n_seg, 2, 4))
+    return plan_snapshots(plan, per_segment=per_segment, limit=max(2, limit))
+
+
+def _range(values, unit) -> str:
+    lo, hi = float(np.min(values)), float(np.max(values))
+    if f"{lo:.3g}" == f"{hi:.3g}":
+        return torque_text(lo, unit)
+    return f"{torque_text(lo, unit) if np.isinf(lo) else f'{lo:.3g}'} to {torque_text(hi, unit)}"
+
+
+def phase_rows(plan) -> list:
+    """The header table's rows, one per phase (numbered as ``plan.csv``): the cells of the card's columns in words
+    (phase, times, what the hand does, commanded joint, command range and direction, slack, narrowest band); a cell
+    may hold two lines."""
+    hand = plan.task.hand
+    rows = []
+    for i, ph in enumerate(plan.phases):
+        times = f"{float(ph.t[0]):.3g} to {float(ph.t[-1]):.3g}"
+        if not is_contact(ph):
+            from qsplan.planner.plotting.hands import fingers_touching
+
+            pose = plan.task.pose(float(np.ravel(ph.x)[0]))
+            off = {s for k in range(ph.t.size) for s, on in fingers_touching(hand, pose, ph.q[k]).items() if not on}
+            who = "both fingers" if len(off) == 2 else f"the {next(iter(off))} finger" if off else "the fingers"
+            rows.append((str(i), times, f"regrasp: {who}\nopen and close again", "velocity only", "-", "-", "-"))
+            continue
+        word, unit = effort_words(hand, ph.effort_joint)
+        dx = float(ph.x[-1] - ph.x[0])
+        mode, _ = phase_label(ph, hand)
+        signs = set(np.sign(ph.command[ph.command != 0]).tolist())
+        sense = "zero" if not signs else "changes sign" if len(signs) > 1 else effort_sense(hand, ph.effort_joint, *signs)
+        value, edge, _ = slack(ph)
+        room = f"{torque_text(value, unit)}\nto the {edge} edge" if np.isfinite(value) else "unbounded:\nno edge"
+        k = int(np.argmin(ph.width))
+        w = float(ph.width[k])
+        side = "lower" if np.isinf(ph.lower).all() else "upper"
+        narrow = f"{torque_text(w, unit)} at {float(ph.t[k]):.3g} s" if np.isfinite(w) else f"none: {side}\nedge unbounded"
+        rows.append((str(i), times, f"slides {'left' if dx < 0 else 'right'} {abs(dx) * 1000:.3g} mm\nin {mode}",
+                     f"{joint_title(ph.effort_joint)} {word}", f"{_range(ph.command, unit)}\n{sense}",
+                     room, narrow))  # fmt: skip
+    return rows
 
 
 def _letters(n):
     return [chr(ord("A") + k) if k < 26 else f"A{k - 25}" for k in range(n)]
 
 
-def _shade_other_control(ax, plan, joint, torque: bool):
-    """Hatch where ``joint`` is under the other kind of control, and say so where there is room."""
+def _shade_other_control(ax, plan, joint, torque: bool) -> bool:
+    """Hatch where ``joint`` is under the other kind of control, and say so where there is room; whether any."""
     t0, t1 = float(plan.phases[0].t[0]), float(plan.duration)
+    drawn = False
     for ph in plan.phases:
         mine = is_contact(ph) and ph.effort_joint == joint
         if mine == torque:
             continue
         a, b = float(ph.t[0]), float(ph.t[-1])
         ax.axvspan(a, b, fc="none", ec="0.8", hatch="////", lw=0, zorder=0)
+        drawn = True
         if (b - a) > 0.18 * (t1 - t0):
             ax.text(0.5 * (a + b), 0.5, "velocity-controlled" if torque else "torque-controlled (band above)",
                     transform=ax.get_xaxis_transform(), ha="center", va="center", fontsize=FONT["note"],
                     color="0.45", bbox={"fc": "white", "ec": "none", "pad": 1.0})  # fmt: skip
-
-
-def _offset(sub, points):
-    """The subfigure's coordinates shifted down by ``points`` (negative: down)."""
-    from matplotlib.transforms import offset_copy
-
-    return offset_copy(sub.transSubfigure, fig=sub.get_figure(root=True), y=points, units="points")
+    return drawn
 
 
 def _facts(plan) -> str:
     task = plan.task
     lo, hi = task.mu_range
     model = "one shared friction coefficient" if task.shared_mu else "each contact's friction coefficient"
-    name, t, w = plan.narrowest()
-    unit = next((effort_words(task.hand, s.effort_joint)[1] for s in plan.segments if s.name == name), "N m")
     n_seg = len(plan.segments)
-    where = f" at t = {t:.3g} s ({str(name).split(':')[0]})" if name else ""
-    return (f"Bands guaranteed for {model} in [{lo:g}, {hi:g}]; controller torque resolution "
-            f"{task.torque_resolution:g} N m. {n_seg} in-contact segment{'s' if n_seg != 1 else ''}, "
-            f"{len(plan.phases) - n_seg} regrasp{'s' if len(plan.phases) - n_seg != 1 else ''}, "
-            f"{plan.duration:.3g} s of motion; narrowest band {torque_text(w, unit) if np.isfinite(w) else 'unbounded'}{where}.")  # fmt: skip
+    n_reg = len(plan.phases) - n_seg
+    units = {effort_words(task.hand, p.effort_joint) for p in plan.segments}
+    word, unit = units.pop() if len(units) == 1 else ("effort", "N m or N")
+    text = (f"Bands guaranteed for {model} in [{lo:g}, {hi:g}]; controller {word} resolution {task.torque_resolution:g} "
+            f"{unit}. {n_seg} in-contact segment{'s' if n_seg != 1 else ''}, "
+            f"{n_reg} regrasp{'s' if n_reg != 1 else ''}, {plan.duration:.3g} s of motion.")
+    if plan.segments:
+        i, seg = min(((i, p) for i, p in enumerate(plan.phases) if is_contact(p)), key=lambda ip: slack(ip[1])[0])
+        unit = effort_words(task.hand, seg.effort_joint)[1]
+        value, edge, _ = slack(seg)
+        text += (f" Smallest slack {torque_text(value, unit)} (phase {i}, to its {edge} edge)" if np.isfinite(value)
+                 else " Every band is unbounded on both sides (no slack limit)")  # fmt: skip
+        name, t, w = plan.narrowest()
+        if np.isfinite(w):
+            j, narrow = next((i, p) for i, p in enumerate(plan.phases) if is_contact(p) and p.name == name)
+            width = torque_text(w, effort_words(task.hand, narrow.effort_joint)[1])
+            text += f"; narrowest band {width} at t = {t:.3g} s (phase {j})."
+        else:
+            text += "; no band is bounded on both sides, so only the slack limits the command."
+    return text
 
 
-def _snapshot_row(sub, plan, shots, letters):
+def _text_width(text, size, bold=False) -> float:
+    """Width (points) of ``text`` drawn at ``size`` points in the default font."""
+    from matplotlib.font_manager import FontProperties
+    from matplotlib.textpath import TextPath
+
+    return float(TextPath((0, 0), text, size=size, prop=FontProperties(weight="bold" if bold else "normal"))
+                 .get_extents().width)  # fmt: skip
+
+
+def _header(head, lines, xs) -> None:
+    """The header's ``lines`` (:func:`_header_lines`) top down, in points, so that no two lines meet."""
+    y = -4.0
+    for i, (text, size, colour, bold) in enumerate(lines):
+        cells = text if isinstance(text, tuple) else (text,)  # a table row: cells at the measured columns
+        for x, cell in zip(xs if isinstance(text, tuple) else (0.0,), cells):
+            head.text(0.01, 1.0, cell, fontsize=size, color=colour, va="top", weight="bold" if bold else "normal",
+                      linespacing=1.15, transform=_offset(head, y, x))  # fmt: skip
+        y -= _height(text, size) + (4 if i == 0 else 0)
+
+
+def _height(text, size) -> float:
+    """Height (points) a header line of ``size`` points takes (a table row: its tallest cell)."""
+    cells = text if isinstance(text, tuple) else (text,)
+    return 1.3 * size + 1.15 * size * max(c.count("\n") for c in cells)
+
+
+def _header_lines(plan, verdict_line, ok) -> tuple:
+    """``(lines, column x positions)``: each line ``(text or cells, size, colour, bold)``."""
+    rows = phase_rows(plan)
+    size, gap = FONT["note"], 9.0
+    widths = [max(_text_width(line, size, bold=r is _COLUMNS) for r in rows + [_COLUMNS] for line in r[c].split("\n"))
+              for c in range(len(_COLUMNS))]  # fmt: skip
+    xs = list(np.cumsum([0.0] + [w + gap for w in widths[:-1]]))
+    lines = [(f"Plan card: {plan.task.name}", FONT["suptitle"] + 1, "k", True)]
+    lines += [(s, FONT["label"], "k", False) for s in textwrap.wrap(_facts(plan), 112, break_on_hyphens=False)]
+    if xs[-1] + widths[-1] <= _TABLE_WIDTH:
+        lines += [(_COLUMNS, size, "k", True)] + [(r, size, "k", False) for r in rows]
+    else:  # too wide for columns: one sentence per phase
+        for r in rows:
+            cells = [c.replace("\n", " ") for c in r]
+            text = f"phase {cells[0]} ({cells[1]} s): {cells[2]}; "
+            text += "; ".join(f"{h} {v}" for h, v in zip(_COLUMNS[3:], cells[3:]))
+            lines += [(s, size, "k", False) for s in textwrap.wrap(text, 130)]
+    lines += [(s, FONT["label"], _OK if ok else _BAD, True) for s in textwrap.wrap(verdict_line, 100)]
+    return lines, xs
+
+
+def _offset(sub, points, x_points=0.0):
+    """The subfigure's coordinates shifted down by ``points`` (negative: down) and right by ``x_points``."""
+    from matplotlib.transforms import offset_copy
+
+    return offset_copy(sub.transSubfigure, fig=sub.get_figure(root=True), x=x_points, y=points, units="points")
+
+
+def _snapshot_row(sub, plan, shots, letters) -> set:
+    """The snapshots, each titled with its letter, time, role and what the hand does; what was drawn."""
     from qsplan.planner.plotting.hands import hand_limits, plot_hand
 
-    lim = hand_limits(plan.task.hand, [(pose, q) for _, pose, q, _, _ in shots])
+    lim = hand_limits(plan.task.hand, [(s.pose, s.q) for s in shots])
     rows = 1 if len(shots) <= 5 else 2
     cols = -(-len(shots) // rows)
     axes = sub.subplots(rows, cols, squeeze=False).ravel()
-    for i, (ax, (t, pose, q, effort, opened), letter) in enumerate(zip(axes, shots, letters)):
-        plot_hand(plan.task.hand, pose, q, ax=ax, contacts=not opened, effort_joint=effort, limits=lim,
-                  scale_bar=i == 0)  # fmt: skip
-        ax.set_title(f"{letter}: t = {t:.3g} s" + (", open" if opened else ""), fontsize=FONT["note"], pad=2)
+    drawn = set()
+    for i, (ax, s, letter) in enumerate(zip(axes, shots, letters)):
+        plot_hand(plan.task.hand, s.pose, s.q, ax=ax, contacts=s.touching, effort_joint=s.effort_joint, limits=lim,
+                  scale_bar=i == 0, effort_sign=s.effort if s.effort_joint else None)  # fmt: skip
+        drawn |= ({"contacts"} if s.touching else set()) | ({"effort"} if s.effort_joint else set())
+        role = {"start": ", start", "end": ", end"}.get(s.role, "")
+        state = s.state if len(s.off) != 1 or s.state not in ("open", "closing") else f"{s.off[0]} finger {s.state}"
+        ax.set_title(f"{letter}: t = {s.t:.3g} s{role}\nphase {s.phase}: {state}", fontsize=FONT["note"], pad=2)
     for ax in axes[len(shots):]:
         ax.set_visible(False)
+    return drawn
+
+
+def _torque_panel(ax, plan, joint, res) -> set:
+    """One joint's commands inside their bands, slack and narrowest marked; what was drawn."""
+    hand = plan.task.hand
+    segs = [p for p in plan.phases if is_contact(p) and p.effort_joint == joint]
+    ylim = torque_limits(segs, res)
+    word, unit = effort_words(hand, joint)
+    drawn = set()
+    for seg in segs:
+        drawn |= draw_band(ax, seg.t, seg.lower, seg.upper, seg.command, joint_colour(hand, joint), ylim, label=False)
+        k = int(np.argmin(seg.width))
+        if mark_narrowest(ax, seg, ylim, label=False, unit=unit):
+            drawn.add("narrowest")
+        if mark_slack(ax, seg, ylim, unit=unit, avoid=float(seg.t[k])):
+            drawn.add("slack")
+    if _shade_other_control(ax, plan, joint, torque=True):
+        drawn.add("hatch")
+    ax.set_ylim(*ylim)
+    ax.axhline(0.0, color="0.6", lw=0.5)
+    symbol = "\\tau" if word == "torque" else "f"
+    plus = "counter-clockwise" if word == "torque" else "along +q"
+    ax.set_ylabel(f"${symbol}_{{{joint_math(joint)}}}$ ({unit})\n+: {plus}", fontsize=FONT["label"])
+    ax.set_title(f"{joint_title(joint)}: {word} command inside its guaranteed band", fontsize=FONT["label"], loc="left")
+    return drawn
+
+
+def _legend_handles(plan, drawn, torque_joints) -> list:
+    """Legend entries of what was drawn (``drawn``: keys of the snapshots', bands' and marks' drawings)."""
+    from matplotlib.lines import Line2D
+    from matplotlib.patches import Patch
+
+    from qsplan.planner.plotting.hands import snapshot_legend_handles
+
+    hand = plan.task.hand
+    colour = joint_colour(hand, torque_joints[0]) if torque_joints else "0.3"
+    word = effort_words(hand, torque_joints[0])[0] if torque_joints else "torque"
+    marks = {"upper_inf": ("^", True, "upper edge unbounded"),
+             "upper_off": ("^", False, "upper edge above the plot (finite)"),
+             "lower_inf": ("v", True, "lower edge unbounded"),
+             "lower_off": ("v", False, "lower edge below the plot (finite)")}
+    handles = snapshot_legend_handles(effort="effort" in drawn, hand=hand, contacts="contacts" in drawn,
+                                      effort_arrow="effort" in drawn) + timeline_handles(plan)  # fmt: skip
+    entries = [("band", Patch(fc=colour, alpha=0.16, label=f"guaranteed {word} band")),
+               ("upper", Line2D([], [], color=colour, lw=1.3, label="band's upper edge")),
+               ("lower", Line2D([], [], color=colour, lw=1.3, ls="--", label="band's lower edge"))]
+    entries += [(key, Line2D([], [], color=colour, ls="none", marker=m, ms=5, mfc=colour if filled else "white",
+                             mew=1.1, label=label)) for key, (m, filled, label) in marks.items()]  # fmt: skip
+    entries += [("command", Line2D([], [], color="k", lw=1.6, label=f"{word} command")),
+                ("slack", Line2D([], [], color=SLACK, lw=1.2, marker="_", ms=7,
+                                 label="slack: command to the nearer edge")),
+                ("narrowest", Line2D([], [], color=NARROWEST, ls="none", marker="$\\updownarrow$", ms=9,
+                                     label="narrowest band, with its width")),
+                ("hatch", Patch(fc="none", ec="0.8", hatch="////", label="joint under the other kind of control"))]  # fmt: skip
+    return handles + [h for key, h in entries if key in drawn]
 
 
 def plan_card(plan, certificate=None, replays=(), snapshots: int = MAX_SNAPSHOTS):
@@ -157,15 +334,13 @@ def plan_card(plan, certificate=None, replays=(), snapshots: int = MAX_SNAPSHOTS
     replays : sequence of qsplan.planner.replay.replay.Replay
         The exported plan re-simulated.
     snapshots : int
-        Hand snapshots, at most.
+        Hand snapshots, at most (at least 2: the start and the end).
 
     Returns
     -------
     matplotlib.figure.Figure
     """
     from matplotlib.figure import Figure
-    from matplotlib.lines import Line2D
-    from matplotlib.patches import Patch
 
     from qsplan.hands.interface import joint_names, joint_units
 
@@ -176,45 +351,29 @@ def plan_card(plan, certificate=None, replays=(), snapshots: int = MAX_SNAPSHOTS
     torque_joints = [j for j in names if any(is_contact(p) and p.effort_joint == j for p in plan.phases)]
     velocity_joints = [j for k, j in enumerate(names) if any(np.isfinite(p.qd[:, k]).any() for p in plan.phases)]
     fig = Figure(figsize=A4_PORTRAIT, layout="constrained")
-    head, body = fig.subfigures(2, 1, height_ratios=[0.095, 0.905])
-    line, ok = verdict(certificate, replays)
-    lines = [(f"Plan card: {plan.task.name}", FONT["suptitle"] + 1, "k")]
-    lines += [(s, FONT["label"], "k") for s in textwrap.wrap(_facts(plan), 112)]
-    lines += [(s, FONT["label"], _OK if ok else _BAD) for s in textwrap.wrap(line, 100)]
-    y = -4.0
-    for i, (text, size, colour) in enumerate(lines):  # top down, in points, so that no two lines meet
-        head.text(0.01, 1.0, text, fontsize=size, color=colour, va="top", weight="bold" if i == 0 or colour != "k"
-                  else "normal", transform=_offset(head, y))  # fmt: skip
-        y -= 1.3 * size + (4 if i == 0 else 0)
-    heights = [3.3 if len(shots) > 5 else 1.7, 1.0] + [2.3] * len(torque_joints) + [1.05] * len(velocity_joints)
+    lines, xs = _header_lines(plan, *verdict(certificate, replays))
+    head_in = (8.0 + sum(_height(text, size) for text, size, _, _ in lines) + 4.0) / 72.0
+    head, body = fig.subfigures(2, 1, height_ratios=[head_in, A4_PORTRAIT[1] - head_in])
+    _header(head, lines, xs)
+    heights = [3.3 if len(shots) > 5 else 1.7, 0.5] + [2.3] * len(torque_joints) + [1.05] * len(velocity_joints)
     grid = body.add_gridspec(len(heights), 1, height_ratios=heights)
-    _snapshot_row(body.add_subfigure(grid[0]), plan, shots, letters)
+    drawn = _snapshot_row(body.add_subfigure(grid[0]), plan, shots, letters)
     timeline = body.add_subplot(grid[1])
-    plot_mode_timeline(plan, timeline, marks=list(zip([s[0] for s in shots], letters)), legend=False, xlabel=False)
+    plot_mode_timeline(plan, timeline, marks=list(zip([s.t for s in shots], letters)), legend=False, xlabel=False,
+                       compact=True)  # fmt: skip
     axes = [timeline]
     res = plan.task.torque_resolution
     for i, joint in enumerate(torque_joints):
         ax = body.add_subplot(grid[2 + i], sharex=timeline)
-        segs = [p for p in plan.phases if is_contact(p) and p.effort_joint == joint]
-        ylim = torque_limits(segs, res)
-        word, unit = effort_words(hand, joint)
-        for seg in segs:
-            draw_band(ax, seg.t, seg.lower, seg.upper, seg.command, joint_colour(hand, joint), ylim, label=False)
-            mark_narrowest(ax, seg, ylim, label=False, unit=unit)
-        _shade_other_control(ax, plan, joint, torque=True)
-        ax.set_ylim(*ylim)
-        ax.axhline(0.0, color="0.6", lw=0.5)
-        symbol = "\\tau" if word == "torque" else "f"
-        ax.set_ylabel(f"${symbol}_{{{joint_math(joint)}}}$ ({unit})", fontsize=FONT["label"])
-        ax.set_title(f"{joint_title(joint)}: {word} command inside its guaranteed band", fontsize=FONT["label"],
-                     loc="left")  # fmt: skip
+        drawn |= _torque_panel(ax, plan, joint, res)
         axes.append(ax)
     for joint in velocity_joints:
         ax = body.add_subplot(grid[len(axes) + 1], sharex=timeline)
         for ph in plan.phases:  # a free motion's rows hold the velocity until the next row: steps
             ax.plot(ph.t, ph.qd[:, names.index(joint)], color=joint_colour(hand, joint), lw=1.3,
                     drawstyle="default" if is_contact(ph) else "steps-post")  # fmt: skip
-        _shade_other_control(ax, plan, joint, torque=False)
+        if _shade_other_control(ax, plan, joint, torque=False):
+            drawn.add("hatch")
         ax.axhline(0.0, color="0.6", lw=0.5)
         short = joint in ("left", "right")  # a described hand's long joint names stay in the title: short panels
         ax.set_ylabel(f"$\\dot q_{{{joint}}}$ ({units[joint]})" if short else f"$\\dot q$ ({units[joint]})",
@@ -229,20 +388,9 @@ def plan_card(plan, certificate=None, replays=(), snapshots: int = MAX_SNAPSHOTS
         if ax is not axes[-1]:
             ax.tick_params(labelbottom=False)
     timeline.set_xlim(float(plan.phases[0].t[0]), float(plan.duration))
-    axes[-1].set_xlabel("t (s) from the plan's start (dotted lines: phase switches)", fontsize=FONT["label"])
-    from qsplan.planner.plotting.hands import snapshot_legend_handles
-
-    colour = joint_colour(hand, torque_joints[0]) if torque_joints else "0.3"
-    word = effort_words(hand, torque_joints[0])[0] if torque_joints else "torque"
-    handles = snapshot_legend_handles(hand=hand) + timeline_handles(plan) + [
-        Patch(fc=colour, alpha=0.16, label=f"guaranteed {word} band"),
-        Line2D([], [], color=colour, lw=1.3, label="band's upper edge"),
-        Line2D([], [], color=colour, lw=1.3, ls="--", label="band's lower edge"),
-        Line2D([], [], color=colour, ls="none", marker="^", ms=5, label="edge off the plot or unbounded"),
-        Line2D([], [], color="k", lw=1.6, label=f"{word} command"),
-        Line2D([], [], color=NARROWEST, ls="none", marker="$\\updownarrow$", ms=9, label="narrowest band, with its width"),
-        Patch(fc="none", ec="0.8", hatch="////", label="joint under the other kind of control"),
-    ]
+    axes[-1].set_xlabel("t (s) from the plan's start" + (" (dotted lines: phase switches)" if switches else ""),
+                        fontsize=FONT["label"])  # fmt: skip
+    handles = _legend_handles(plan, drawn, torque_joints)
     ncol = 3 if max(len(h.get_label()) for h in handles) <= LEGEND_LABEL_CHARS else 2
     body.legend(handles=handles, loc="outside lower center", ncol=ncol, fontsize=FONT["legend"], frameon=False)
     return fig

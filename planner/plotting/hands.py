@@ -1,4 +1,5 @@
-"""Plots for operators: a two-finger hand at one configuration and strips of snapshots (Fig. 9).
+"""Plots for operators: a two-finger hand at one configuration, strips of snapshots (Fig. 9), and which
+configurations of a plan to draw.
 
 Compute lives in :mod:`qsplan.hands`; this module only draws.  ``plot_*`` functions take
 ``ax=None`` (a new figure is made) and return the axes; ``*_figure`` functions return a
@@ -7,20 +8,79 @@ Compute lives in :mod:`qsplan.hands`; this module only draws.  ``plot_*`` functi
 Every body :func:`qsplan.hands.interface.hand_body_polygons` returns is drawn (palm, workpiece and
 every link: the paper's two fingers, or every link of a described hand's chains, each in its
 finger's colour); the torque-controlled joint's link is drawn with a thick outline and marked
-``tau``; contacts are dots with their inward normals; a scale bar on the palm gives the size.
-:func:`snapshot_legend_handles` explains the marks.
+``tau``, with an arrow the way its commanded effort pushes it (:func:`effort_direction`); contacts are dots with
+their inward normals; a scale bar on the palm gives the size.  :func:`snapshot_legend_handles` explains the marks.
+:func:`plan_snapshots` picks a plan's configurations to draw and says of each what the hand does there
+(:func:`row_state`: sliding, holding, open, closing), from the rows and the bodies' polygons alone
+(:func:`fingers_touching`).
 """
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 
+from qsplan.mechanics.model.geometry import CONTACT_TOL
+
+from qsplan.planner.plotting.plan_panels import is_contact
 from qsplan.planner.plotting.style import FONT, axes_or_new, body_style, joint_colour
 
-__all__ = ["hand_limits", "hand_strip_figure", "plot_hand", "snapshot_legend_handles"]
+__all__ = ["STATES", "TOUCH_TOL", "Snapshot", "effort_direction", "fingers_touching", "hand_limits", "hand_strip_figure",
+           "plan_snapshots", "plot_hand", "row_state", "snapshot_legend_handles"]
 
 #: Relative length of the drawn contact normals (of the finger length, :func:`qsplan.hands.interface.finger_reach`).
 _NORMAL = 0.12
+
+#: Relative length of the arrow of the commanded effort on its link (of the finger length).
+_EFFORT_ARROW = 0.22
+
+#: Distance (m) within which a finger touches the workpiece: the contact search's own tolerance
+#: (:data:`qsplan.mechanics.model.geometry.CONTACT_TOL`), so a drawing calls touching what the planner does.
+TOUCH_TOL = CONTACT_TOL
+
+#: Joint step (rad or m) of the finite difference that finds which way an effort pushes its link: far above
+#: rounding (1e-16 relative), far below any visible motion (10 micrometres at the tip of a 10 cm link).
+_EFFORT_STEP = 1e-4
+
+#: What the hand does at a row of a plan, in the operator's words (:func:`row_state`).
+STATES = ("sliding", "holding", "open", "closing")
+
+
+def fingers_touching(hand, pose, q) -> dict:
+    """``{"left": bool, "right": bool}``: whether any link of each finger is within :data:`TOUCH_TOL` of the workpiece.
+
+    Parameters
+    ----------
+    pose : array-like, shape (3,)
+        Workpiece ``(x, y, theta)`` (m, m, rad).
+    q : array-like, shape (n_j,)
+        Joint positions (rad or m).
+    """
+    from shapely.geometry import Polygon
+
+    from qsplan.hands.interface import finger_of_joint, hand_body_polygons
+
+    polys = hand_body_polygons(hand, pose, q)
+    work = Polygon(polys["workpiece"])
+    out = {"left": False, "right": False}
+    for joint, side in finger_of_joint(hand).items():
+        out[side] |= bool(Polygon(polys[joint]).distance(work) <= TOUCH_TOL)
+    return out
+
+
+def effort_direction(hand, pose, q, joint, sign) -> tuple:
+    """``(point, direction)``: the centre of ``joint``'s link (m, shape (2,)) and the unit vector (shape (2,)) it moves
+    along when the joint's effort has the sign of ``sign`` (a torque turns it, a force pushes it along its axis)."""
+    from qsplan.hands.interface import hand_body_polygons, joint_names
+
+    q = np.asarray(q, dtype=float)
+    step = np.zeros_like(q)
+    step[joint_names(hand).index(joint)] = _EFFORT_STEP * np.sign(sign)
+    a = hand_body_polygons(hand, pose, q)[joint]
+    b = hand_body_polygons(hand, pose, q + step)[joint]
+    d = (b - a).mean(axis=0)
+    return a.mean(axis=0), d / max(float(np.hypot(*d)), 1e-300)
 
 
 def hand_limits(hand, configurations, pad: float = 0.08) -> tuple:
@@ -56,7 +116,7 @@ def _scale_bar(ax, hand, limits):
 
 
 def plot_hand(hand, pose, q=None, ax=None, alpha=1.0, contacts=True, label_joints=False, effort_joint=None,
-              limits=None, scale_bar=True):  # fmt: skip
+              limits=None, scale_bar=True, effort_sign=None):  # fmt: skip
     """The palm, the fingers and the workpiece at one configuration (Fig. 9).
 
     Parameters
@@ -72,6 +132,9 @@ def plot_hand(hand, pose, q=None, ax=None, alpha=1.0, contacts=True, label_joint
         Name each joint under its axis.
     effort_joint : str, optional
         The torque-controlled joint: its link drawn with a thick outline and a ``tau`` mark.
+    effort_sign : float, optional
+        The sign of its commanded effort: an arrow from its link's centre the way the effort pushes the link
+        (:func:`effort_direction`).
     limits : ((float, float), (float, float)), optional
         Axes limits (m); default :func:`hand_limits` of this configuration.
     scale_bar : bool
@@ -99,6 +162,10 @@ def plot_hand(hand, pose, q=None, ax=None, alpha=1.0, contacts=True, label_joint
         colour = joint_colour(hand, effort_joint)
         ax.annotate("$\\tau$", tip, ha="center", va="center", fontsize=FONT["label"], color=colour, weight="bold",
                     zorder=6, bbox={"boxstyle": "circle,pad=0.15", "fc": "white", "ec": colour, "lw": 1.0})  # fmt: skip
+        if effort_sign is not None and np.sign(effort_sign) != 0:
+            p, d = effort_direction(hand, pose, q, effort_joint, effort_sign)
+            ax.annotate("", xy=p + _EFFORT_ARROW * finger_reach(hand) * d, xytext=p, zorder=6,
+                        arrowprops={"arrowstyle": "-|>", "color": colour, "lw": 1.6, "shrinkA": 7, "shrinkB": 0})  # fmt: skip
     if contacts:
         scale = _NORMAL * finger_reach(hand)
         for c in contacts_at(hand, pose, q):
@@ -122,9 +189,9 @@ def plot_hand(hand, pose, q=None, ax=None, alpha=1.0, contacts=True, label_joint
     return ax
 
 
-def snapshot_legend_handles(effort: bool = True, hand=None) -> list:
-    """Legend entries explaining the snapshots: the fingers, contacts, normals, the torque-controlled finger (a
-    described ``hand``'s: the torque-controlled joint's link)."""
+def snapshot_legend_handles(effort: bool = True, hand=None, contacts: bool = True, effort_arrow: bool = False) -> list:
+    """Legend entries explaining the snapshots: the fingers, and what is drawn of ``contacts`` (dots, normals), the
+    torque-controlled finger (a described ``hand``'s: the torque-controlled joint's link) and its ``effort_arrow``."""
     from matplotlib.lines import Line2D
 
     from matplotlib.patches import Patch
@@ -132,11 +199,15 @@ def snapshot_legend_handles(effort: bool = True, hand=None) -> list:
     chain = hand is not None and any(len(f) > 1 for f in hand.finger_joints)  # fingers of several links
     out = [Patch(fc=body_style(n)[0], ec=body_style(n)[1], label=f"{n} finger" + ("'s links" if chain else ""))
            for n in ("left", "right")]  # fmt: skip
-    out += [Line2D([], [], ls="none", marker="o", ms=4, color="k", label="contact"),
-           Line2D([], [], color="k", lw=0.8, marker=">", ms=4, markevery=[1], label="contact normal (into the workpiece)")]  # fmt: skip
+    if contacts:
+        out += [Line2D([], [], ls="none", marker="o", ms=4, color="k", label="contact"),
+                Line2D([], [], color="k", lw=0.8, marker=">", ms=4, markevery=[1], label="contact normal (into the workpiece)")]  # fmt: skip
     if effort:
         what = "torque-controlled joint's link" if chain else "torque-controlled finger"
         out.append(Line2D([], [], ls="none", marker="$\\tau$", ms=8, color="0.2", label=f"{what} (thick outline)"))
+    if effort_arrow:
+        out.append(Line2D([], [], color="0.2", lw=1.6, marker=">", ms=5, markevery=[1],
+                          label="the way its commanded effort pushes it"))  # fmt: skip
     return out
 
 
@@ -174,3 +245,131 @@ def hand_strip_figure(samples, n=5, title=None):
     fig.suptitle(title or f"{seg.name}\nmode {seg.mode}: the {seg.effort_joint} finger torque-controlled, "
                  "the other velocity-controlled", fontsize=FONT["title"])  # fmt: skip
     return fig
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class Snapshot:
+    """One configuration of a plan drawn for the operator (the plan card's and the snapshots figure's panels).
+
+    Attributes
+    ----------
+    t : float
+        Time from the plan's start (s).
+    phase, row : int
+        The phase (numbered as ``plan.csv``'s ``phase`` column) and its row.
+    pose : ndarray, shape (3,)
+        Workpiece ``(x, y, theta)`` (m, m, rad).
+    q : ndarray, shape (n_j,)
+        Joint positions (rad or m).
+    effort_joint : str or None
+        The torque-controlled joint (None in a regrasp).
+    effort : float
+        Its command at the row (N m or N; NaN in a regrasp).
+    state : str
+        What the hand does there, one of :data:`STATES` (:func:`row_state`).
+    off : tuple of str
+        The fingers off the workpiece (``"left"``, ``"right"``).
+    role : str
+        ``"start"`` (the plan's first row), ``"end"`` (its last) or ``""``.
+    """
+
+    t: float
+    phase: int
+    row: int
+    pose: np.ndarray
+    q: np.ndarray
+    effort_joint: str | None
+    effort: float
+    state: str
+    off: tuple
+    role: str
+
+    @property
+    def touching(self) -> bool:
+        """Every finger on the workpiece (its contacts can be drawn)."""
+        return not self.off
+
+
+def _pose(plan, phase, k):
+    x = np.ravel(phase.x)
+    return plan.task.pose(float(x[min(k, x.size - 1)]))
+
+
+def _off(plan, phase, k) -> tuple:
+    touching = fingers_touching(plan.task.hand, _pose(plan, phase, k), phase.q[k])
+    return tuple(side for side, on in touching.items() if not on)
+
+
+def row_state(plan, i, k) -> tuple:
+    """``(state, off)``: what the hand does at row ``k`` of phase ``i`` (from the rows), and its fingers off the
+    workpiece.
+
+    ``"open"``: a finger is off the workpiece (:func:`qsplan.planner.plotting.hands.fingers_touching`);
+    ``"closing"``: off, after a row already off and before a row where every finger touches again (the fingers'
+    approach to the next grasp); ``"sliding"``: every finger touches and the workpiece moves along the phase;
+    ``"holding"``: every finger touches and the workpiece stays (a regrasp's release and re-closed grasp).
+    """
+    ph = plan.phases[i]
+    off = _off(plan, ph, k)
+    if off:
+        n = ph.t.size
+        approach = 0 < k < n - 1 and not _off(plan, ph, k + 1) and bool(_off(plan, ph, k - 1))
+        return ("closing" if approach else "open"), off
+    moving = np.size(ph.x) > 1 and float(np.ptp(ph.x)) > 0.0
+    return ("sliding" if moving else "holding"), off
+
+
+def _candidates(plan, per_segment) -> dict:
+    """``{(phase, row): priority}``: 0 the plan's first and last rows; 1 each phase's ends and a regrasp's first and
+    last rows off the workpiece; 2 the rest (a segment's inner samples, a regrasp's other rows)."""
+    out = {}
+    for i, ph in enumerate(plan.phases):
+        n = ph.t.size
+        if is_contact(ph):
+            rows = np.unique(np.round(np.linspace(0, n - 1, max(2, per_segment))).astype(int))
+            out |= {(i, int(k)): 1 if k in (0, n - 1) else 2 for k in rows}
+        else:
+            off = [k for k in range(n) if _off(plan, ph, k)]
+            out |= {(i, k): 1 if k in (0, n - 1) or (off and k in (off[0], off[-1])) else 2 for k in range(n)}
+    last = len(plan.phases) - 1
+    out |= {(0, 0): 0, (last, plan.phases[last].t.size - 1): 0}
+    return out
+
+
+def plan_snapshots(plan, per_segment: int = 3, limit: int | None = None) -> list:
+    """The configurations to draw, in time order: the plan's start and end always, each phase's ends, ``per_segment``
+    rows along each in-contact segment and a regrasp's rows off the workpiece, at most ``limit``.
+
+    Where two phases meet (same time, same configuration) the later phase's row is kept.  Beyond ``limit`` the rows
+    of least priority go first, thinned evenly (the start and the end stay).
+
+    Returns
+    -------
+    list of Snapshot
+    """
+    cand = _candidates(plan, per_segment)
+    by_t = {}
+    for (i, k), prio in sorted(cand.items()):  # at a switch the later phase's row wins, with the best priority
+        t = float(plan.phases[i].t[k])
+        old = by_t.get(t)
+        by_t[t] = (i, k, min(prio, old[2]) if old else prio)
+    keys = [by_t[t] for t in sorted(by_t)]
+    if limit is not None and len(keys) > limit:
+        kept = []
+        for prio in (0, 1, 2):
+            group = [key for key in keys if key[2] == prio]
+            room = max(0, int(limit) - len(kept))
+            if len(group) > room:
+                picks = np.unique(np.round(np.linspace(0, len(group) - 1, room)).astype(int)) if room else []
+                group = [group[j] for j in picks]
+            kept += group
+        keys = sorted(kept, key=lambda key: float(plan.phases[key[0]].t[key[1]]))
+    out, last = [], (len(plan.phases) - 1, plan.phases[-1].t.size - 1)
+    for i, k, _ in keys:
+        ph = plan.phases[i]
+        state, off = row_state(plan, i, k)
+        effort = float(ph.command[k]) if is_contact(ph) else float("nan")
+        role = "start" if (i, k) == (0, 0) else "end" if (i, k) == last else ""
+        out.append(Snapshot(float(ph.t[k]), i, k, _pose(plan, ph, k), np.asarray(ph.q[k], float),
+                            ph.effort_joint if is_contact(ph) else None, effort, state, off, role))  # fmt: skip
+    return out

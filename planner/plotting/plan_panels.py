@@ -1,10 +1,13 @@
-"""The pieces plan figures are drawn from: phases in words, band panels, the mode timeline, snapshot choice.
+"""The pieces plan figures are drawn from: phases in words, band panels, slack marks, the mode timeline.
 
-Shared by :mod:`qsplan.planner.plotting.plan` (one figure per view) and
-:mod:`qsplan.planner.plotting.card` (the plan card).  Only the plan's public fields are read
+Shared by :mod:`qsplan.planner.plotting.plan` (one figure per view), :mod:`qsplan.planner.plotting.card` (the plan
+card) and :mod:`qsplan.planner.plotting.animation`.  Only the plan's public fields are read
 (``Plan.phases``, :class:`~qsplan.planner.plan.results.ContactSegmentPlan`; any other phase is
-drawn as a free motion of the fingers), so plans with more phases or fields draw too.
-matplotlib is imported inside the functions.
+drawn as a free motion of the fingers), so plans with more phases or fields draw too (the snapshots' choice is
+:func:`qsplan.planner.plotting.hands.plan_snapshots`).  Phases are numbered as
+``plan.csv`` numbers them (``phase`` 0 first).  Band edges are marked as in Fig. 13
+(:func:`qsplan.planner.plotting.band_panels.plot_band_sweep`): beyond the plot, filled triangles where an edge is
+unbounded, hollow ones where it is finite.  matplotlib is imported inside the functions.
 """
 
 from __future__ import annotations
@@ -27,8 +30,16 @@ from qsplan.planner.plotting.style import (
     torque_text,
 )
 
-__all__ = ["draw_band", "effort_words", "is_contact", "joint_math", "joint_title", "mark_narrowest", "phase_colour",
-           "phase_label", "plot_mode_timeline", "snapshot_keys", "timeline_handles", "torque_limits"]
+__all__ = ["SLACK", "draw_band", "edge_marker", "effort_sense", "effort_words", "is_contact", "joint_math",
+           "joint_title", "mark_narrowest", "mark_slack", "phase_colour", "phase_label", "plot_mode_timeline", "slack",
+           "timeline_handles", "torque_limits"]
+
+#: Colour of the slack marks (the command's margin to the nearer band edge).
+SLACK = "#1a7f37"
+
+#: Effort (N m or N) within which two rows' slacks count as equal when choosing where to mark it: rounding of
+#: ``command - edge``, far below any controller's resolution.
+_SLACK_TIE = 1e-9
 
 
 def is_contact(phase) -> bool:
@@ -40,13 +51,24 @@ def is_contact(phase) -> bool:
 
 def effort_words(hand, joint) -> tuple:
     """``(word, unit)`` of a joint's effort: ``("torque", "N m")`` for a revolute joint (the paper's fingers, and
-    without a hand), ``("force", "N")`` for a prismatic one."""
+    without a hand), ``("force", "N")`` for a prismatic one (units: :data:`qsplan.hands.interface.JOINT_UNITS`)."""
+    from qsplan.hands.interface import JOINT_UNITS
+
+    kind = "revolute"
     if hand is not None:
         from qsplan.hands.interface import joint_kinds, joint_names
 
-        if dict(zip(joint_names(hand), joint_kinds(hand))).get(joint) == "prismatic":
-            return "force", "N"
-    return "torque", "N m"
+        kind = dict(zip(joint_names(hand), joint_kinds(hand))).get(joint, "revolute")
+    return ("force" if kind == "prismatic" else "torque"), JOINT_UNITS[kind]["tau"]
+
+
+def effort_sense(hand, joint, sign) -> str:
+    """Which way an effort of ``sign`` acts, in words: a torque ``"counter-clockwise"`` (positive) or
+    ``"clockwise"``, a force ``"along +q"`` (positive: the way its joint position grows) or ``"along -q"``."""
+    word, _ = effort_words(hand, joint)
+    if word == "torque":
+        return "counter-clockwise" if sign > 0 else "clockwise"
+    return "along +q" if sign > 0 else "along -q"
 
 
 def joint_math(name) -> str:
@@ -106,49 +128,101 @@ def torque_limits(segments, resolution=0.0) -> tuple:
     return bottom - pad, top + pad
 
 
-def draw_band(ax, t, lower, upper, command, colour, ylim, *, label=True) -> None:
+def edge_marker(ax, t, y, side, infinite, colour, label=None, ms=5.0):
+    """Triangles at ``y`` marking an edge beyond the plot at times ``t``: up (``side`` "upper") or down, filled where
+    the edge is unbounded, hollow where it is finite (Fig. 13's convention)."""
+    return ax.plot(t, np.full(np.size(t), y), ls="none", marker="^" if side == "upper" else "v", ms=ms, color=colour,
+                   mfc=colour if infinite else "white", mew=1.1, clip_on=False, label=label)  # fmt: skip
+
+
+def draw_band(ax, t, lower, upper, command, colour, ylim, *, label=True, word="torque") -> set:
     """A guaranteed band between ``ylim``: fill, upper edge solid, lower edge dashed, the command bold.
 
-    An upper edge above the plot (or unbounded) is cut at its top and marked with up-triangles; a lower
-    edge below it (or unbounded below), at its bottom with down-triangles.
+    An edge beyond the plot is cut at the plot's side and marked there (:func:`edge_marker`): filled triangles
+    where it is unbounded, hollow ones where it is finite.
+
+    Returns
+    -------
+    set of str
+        What was drawn, for a legend of drawn marks only: ``"band"``, ``"command"``, ``"upper"``, ``"lower"`` (edges
+        in view), ``"upper_inf"``, ``"upper_off"``, ``"lower_inf"``, ``"lower_off"`` (marks beyond the plot).
     """
     y0, y1 = ylim
     up, lo = np.asarray(upper, float), np.asarray(lower, float)
     beyond, below = ~(up <= y1), ~(lo >= y0)
     ax.fill_between(t, np.clip(np.where(np.isfinite(lo), lo, y0), y0, y1), np.clip(np.where(np.isfinite(up), up, y1), y0, y1),
                     color=colour, alpha=0.16, lw=0, label="guaranteed band" if label else None)  # fmt: skip
-    ax.plot(t, np.where(beyond, np.nan, up), color=colour, lw=1.3, **UPPER, label="upper edge" if label else None)
-    ax.plot(t, np.where(below, np.nan, lo), color=colour, lw=1.3, **LOWER, label="lower edge" if label else None)
-    for mask, y, marker, what in ((beyond, y1, "^", "upper edge above the plot or unbounded"),
-                                  (below, y0, "v", "lower edge below the plot or unbounded")):  # fmt: skip
-        if mask.any():
-            idx = np.flatnonzero(mask)
-            idx = idx[:: max(1, idx.size // 6)]
-            ax.plot(t[idx], np.full(idx.size, y), ls="none", marker=marker, ms=5, color=colour, clip_on=False,
-                    label=what if label else None)  # fmt: skip
-    ax.plot(t, command, color=COMMAND, lw=1.6, label="torque command" if label else None)
+    drawn = {"band", "command"}
+    for side, edge, cut, style, y in (("upper", up, beyond, UPPER, y1), ("lower", lo, below, LOWER, y0)):
+        if not cut.all():
+            drawn.add(side)
+        ax.plot(t, np.where(cut, np.nan, edge), color=colour, lw=1.3, **style,
+                label=f"{side} edge" if label and not cut.all() else None)  # fmt: skip
+        every = np.flatnonzero(cut)
+        every = every[:: max(1, every.size // 6)]  # one spacing for both kinds of mark
+        for infinite in (True, False):
+            idx = every[np.isinf(edge[every]) == infinite]
+            if idx.size:
+                what = "unbounded" if infinite else ("above" if side == "upper" else "below") + " the plot (finite)"
+                edge_marker(ax, t[idx], y, side, infinite, colour, label=f"{side} edge {what}" if label else None)
+                drawn.add(f"{side}_{'inf' if infinite else 'off'}")
+    ax.plot(t, command, color=COMMAND, lw=1.6, label=f"{word} command" if label else None)
+    return drawn
 
 
-def mark_narrowest(ax, seg, ylim, label=True, unit: str = "N m") -> None:
-    """The narrowest point of a segment's band: a red double arrow, labelled with its width (off the edges)."""
+def mark_narrowest(ax, seg, ylim, label=True, unit: str = "N m") -> bool:
+    """The narrowest point of a segment's band: a red double arrow, labelled with its width (off the edges).
+
+    Drawn only when both edges there are finite and inside ``ylim``, so that an arrow is never cut; returns whether
+    it was drawn (the width is said in words either way: the plan card's table, the bands' titles).
+    """
     k = int(np.argmin(seg.width))
     t, lo, up = float(seg.t[k]), float(seg.lower[k]), float(seg.upper[k])
-    top = min(up, ylim[1]) if np.isfinite(up) else ylim[1]
-    bottom = max(lo, ylim[0]) if np.isfinite(lo) else ylim[0]  # an edge unbounded below ends at the plot's floor
-    ax.annotate("", xy=(t, top), xytext=(t, bottom), arrowprops={"arrowstyle": "<->", "color": NARROWEST, "lw": 1.4},
-                annotation_clip=False)  # fmt: skip
-    cut = "" if np.isfinite(up) and up <= ylim[1] else " (edge above)"
-    cut += "" if np.isfinite(lo) and lo >= ylim[0] else " (edge below)"
+    if not (np.isfinite(lo) and np.isfinite(up) and ylim[0] <= lo and up <= ylim[1]):
+        return False
+    ax.annotate("", xy=(t, up), xytext=(t, lo), arrowprops={"arrowstyle": "<->", "color": NARROWEST, "lw": 1.4,
+                                                           "shrinkA": 0, "shrinkB": 0})  # fmt: skip
     right = t < 0.5 * (seg.t[0] + seg.t[-1])
     c = float(seg.command[k])  # the label sits beside the arrow, halfway from the command to the farther end
-    y = 0.5 * (c + top) if top - c > c - bottom else 0.5 * (bottom + c)
-    va, dy = "center", 0
-    width = torque_text(up - lo, unit) if np.isfinite(up - lo) else "unbounded"
-    ax.annotate(f"narrowest {width}{cut}", (t, y), xytext=(3 if right else -3, dy),
-                textcoords="offset points", ha="left" if right else "right", va=va, fontsize=FONT["note"],
+    y = 0.5 * (c + up) if up - c > c - lo else 0.5 * (lo + c)
+    ax.annotate(f"narrowest {torque_text(up - lo, unit)}", (t, y), xytext=(3 if right else -3, 0),
+                textcoords="offset points", ha="left" if right else "right", va="center", fontsize=FONT["note"],
                 color=NARROWEST, bbox={"boxstyle": "round,pad=0.15", "fc": "white", "ec": "none", "alpha": 0.85})  # fmt: skip
     if label:
         ax.plot([], [], color=NARROWEST, marker="$\\updownarrow$", ls="none", ms=9, label="narrowest band (width)")
+    return True
+
+
+def slack(seg) -> tuple:
+    """``(slack, edge, k)``: the command's smallest margin to the nearer band edge along ``seg`` (N m or N), which
+    edge that is (``"lower"`` or ``"upper"``) and the first row where it is reached."""
+    below, above = seg.command - seg.lower, seg.upper - seg.command
+    near = np.minimum(below, above)
+    k = int(np.argmin(near))
+    return float(near[k]), "lower" if below[k] <= above[k] else "upper", k
+
+
+def mark_slack(ax, seg, ylim, unit: str = "N m", avoid=None) -> bool:
+    """The slack of ``seg`` (:func:`slack`) on the plot: a green bracket from the command to the nearer edge, with its
+    value, at a row where it is reached (inside the segment, away from time ``avoid`` s); whether it was drawn."""
+    value, edge, _ = slack(seg)
+    near = np.minimum(seg.command - seg.lower, seg.upper - seg.command)
+    rows = np.flatnonzero(near <= value + _SLACK_TIE)
+    edge_room = 0.1 * (seg.t[-1] - seg.t[0])  # the bracket and its label inside the segment
+    inner = rows[(seg.t[rows] - seg.t[0] >= edge_room) & (seg.t[-1] - seg.t[rows] >= edge_room)]
+    rows = inner if inner.size else rows
+    k = int(rows[np.argmax(np.abs(seg.t[rows] - avoid))] if avoid is not None else rows[rows.size // 2])
+    t, c = float(seg.t[k]), float(seg.command[k])
+    e = float(seg.lower[k] if edge == "lower" else seg.upper[k])
+    if not (np.isfinite(e) and ylim[0] <= min(c, e) and max(c, e) <= ylim[1]):
+        return False
+    ax.annotate("", xy=(t, e), xytext=(t, c), arrowprops={"arrowstyle": "|-|,widthA=0.25,widthB=0.25", "color": SLACK,
+                                                         "lw": 1.2, "shrinkA": 0, "shrinkB": 0})  # fmt: skip
+    right = t < 0.5 * (seg.t[0] + seg.t[-1])
+    ax.annotate(f"slack {torque_text(value, unit)}", (t, 0.5 * (c + e)), xytext=(4 if right else -4, 0),
+                textcoords="offset points", ha="left" if right else "right", va="center", fontsize=FONT["note"],
+                color=SLACK, bbox={"boxstyle": "round,pad=0.15", "fc": "white", "ec": "none", "alpha": 0.85})  # fmt: skip
+    return True
 
 
 def timeline_handles(plan) -> list:
@@ -164,10 +238,12 @@ def timeline_handles(plan) -> list:
     return list(out.values())
 
 
-def plot_mode_timeline(plan, ax=None, marks=None, legend=True, xlabel=True):
-    """Which mode each phase keeps and which finger is torque-controlled, against time.
+def plot_mode_timeline(plan, ax=None, marks=None, legend=True, xlabel=True, compact=False):
+    """Which mode each phase keeps and which finger is torque-controlled, against time; phases numbered as in
+    ``plan.csv``.
 
-    Labels of boxes too narrow for them are written above their box; the legend names the colours.
+    Labels of boxes too narrow for them are shortened (``compact``) or written above their box; the legend names the
+    colours.
 
     Parameters
     ----------
@@ -177,6 +253,9 @@ def plot_mode_timeline(plan, ax=None, marks=None, legend=True, xlabel=True):
         Times (s) to mark with a letter (the plan card's snapshots).
     legend, xlabel : bool
         Draw the colour legend (below) and the time label (the plan card draws its own).
+    compact : bool
+        One line per box (the plan card's thin bar): ``"phase 0: 4S (SSSS), right finger torque"``, else
+        ``"phase 0"``, else ``"0"``.
 
     Returns
     -------
@@ -187,19 +266,24 @@ def plot_mode_timeline(plan, ax=None, marks=None, legend=True, xlabel=True):
     width_in = ax.get_figure(root=True).get_figwidth() * 0.85
     above, last_x = [], -np.inf
     hand = plan.task.hand
-    for ph in plan.phases:
+    for i, ph in enumerate(plan.phases):
         a, b = float(ph.t[0]), float(ph.t[-1])
         colour = phase_colour(ph, hand)
         ax.barh(0, b - a, left=a, height=0.8, color=colour, alpha=0.75, edgecolor="k", lw=0.5)
         mode, control = phase_label(ph, hand)
-        text = f"{mode}\n{control}"
-        need = max(len(s) for s in text.split("\n")) * FONT["note"] * 0.52 / 72
-        if need < 0.92 * (b - a) / max(t1 - t0, 1e-12) * width_in:
-            ax.text(0.5 * (a + b), 0, text, ha="center", va="center", fontsize=FONT["note"])
+        room = 0.92 * (b - a) / max(t1 - t0, 1e-12) * width_in
+        if compact:
+            short = mode if not is_contact(ph) else f"{mode}, {control}"
+            texts = [f"phase {i}: {short}", f"phase {i}", str(i)]
         else:
-            above.append((0.5 * (a + b), mode))
+            texts = [f"phase {i}: {mode}\n{control}"]
+        fits = [u for u in texts if max(len(v) for v in u.split("\n")) * FONT["note"] * 0.52 / 72 < room]
+        if fits:
+            ax.text(0.5 * (a + b), 0, fits[0], ha="center", va="center", fontsize=FONT["note"])
+        else:
+            above.append((0.5 * (a + b), str(i) if compact else f"{i}: {mode}"))
     for x, text in above:  # short labels above their boxes, staggered when close
-        level = 1 if (x - last_x) / max(t1 - t0, 1e-12) * width_in < 0.8 else 0
+        level = 1 if (x - last_x) / max(t1 - t0, 1e-12) * width_in < 0.8 and not compact else 0
         last_x = x
         ax.annotate(text, (x, 0.4), xytext=(x, 0.6 + 0.4 * level), ha="center", va="bottom", fontsize=FONT["note"],
                     arrowprops={"arrowstyle": "-", "color": "0.3", "lw": 0.6})  # fmt: skip
@@ -214,36 +298,16 @@ def plot_mode_timeline(plan, ax=None, marks=None, legend=True, xlabel=True):
         ax.plot(ts, [-0.55] * len(ts), ls="none", marker="^", color="k", ms=4, clip_on=False)
         ax.annotate(" ".join(letter for _, letter in group), (float(np.mean(ts)), -0.55), xytext=(0, -3),
                     textcoords="offset points", ha="center", va="top", fontsize=FONT["note"], weight="bold")  # fmt: skip
-    ax.set_ylim(-0.9 if marks else -0.5, 1.3 if above else 0.5)
+    ax.set_ylim(-0.9 if marks else -0.5, (1.0 if compact else 1.3) if above else 0.5)
     ax.set_xlim(t0, t1)
     ax.set_yticks([])
     for side in ("left", "right", "top"):
         ax.spines[side].set_visible(False)
     if xlabel:
         ax.set_xlabel("t (s) from the plan's start", fontsize=FONT["label"])
-    ax.set_title("contact mode of each phase and the torque-controlled finger", fontsize=FONT["label"], loc="left")
+    ax.set_title("phases as numbered in plan.csv: contact mode and the torque-controlled joint", fontsize=FONT["label"],
+                 loc="left")  # fmt: skip
     if legend:
         handles = timeline_handles(plan)
         legend_below(ax, handles=handles, ncol=min(3, len(handles)))
     return ax
-
-
-def snapshot_keys(plan, per_phase=3) -> list:
-    """The configurations to draw: ``per_phase`` along each in-contact segment, the open fingers of each regrasp.
-
-    Returns
-    -------
-    list of (t, pose, q, effort_joint or None, open)
-        Time (s), workpiece pose (3,), joint positions (n_j,), the torque-controlled joint, whether the fingers are
-        open.
-    """
-    out = []
-    for ph in plan.phases:
-        if is_contact(ph):
-            for k in np.unique(np.round(np.linspace(0, ph.t.size - 1, per_phase)).astype(int)):
-                out.append((float(ph.t[k]), plan.task.pose(ph.x[k]), ph.q[k], ph.effort_joint, False))
-        else:
-            k = int(np.argmax(np.abs(ph.q - ph.q[0]).sum(axis=1)))
-            x = float(np.ravel(ph.x)[min(k, np.size(ph.x) - 1)])
-            out.append((float(ph.t[k]), plan.task.pose(x), ph.q[k], None, True))
-    return out

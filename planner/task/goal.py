@@ -27,7 +27,7 @@ import numpy as np
 
 from qsplan.mechanics.errors import QsplanError
 
-__all__ = ["Goal", "FEATURE_KINDS", "parse_feature", "make_goal", "make_start_features", "palm_x_range",
+__all__ = ["Goal", "FEATURE_KINDS", "feature_text", "parse_feature", "make_goal", "make_start_features", "palm_x_range",
            "task_positions"]
 
 #: The feature kinds of a goal: the fingertip on an edge, the inner long edge on a vertex.
@@ -143,3 +143,12 @@ def task_positions(task) -> list:
     if task.goal is not None:
         out.append(("the goal", "goal.x", float(task.goal.x)))
     return out
+
+
+def feature_text(feature):
+    """A task's finger feature (``("inner", None)``, ``("edge", K)``, ``("vertex", K)`` or None) as a grasp's ``matches``
+    reads it (:func:`qsplan.hands.grasps.grasp_meets`): None (any), ``"vertex"`` (the start's ``"inner"``: the inner
+    edge on whichever vertex), ``"edge:K"``, ``"vertex:K"``."""
+    if feature is None:
+        return None
+    return "vertex" if feature[0] == "inner" else f"{feature[0]}:{feature[1]}"
