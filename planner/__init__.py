@@ -25,12 +25,14 @@ Public API (loaded on first use, so ``import qsplan.planner`` stays light):
   :func:`search_route`, :data:`SEQUENCE_PLANNERS`
 * no plan: :class:`PlanFailure` (a :class:`NoAnswerError`) with its :class:`FailureReport`
 * export: :func:`export_plan`, :func:`read_plan_csv`, :func:`export_schedule`, :func:`check_outputs`
-* replay and verification: :func:`replay_plan`, :func:`friction_samples`, :class:`Replay`
+* replay and verification: :func:`replay_plan`, :func:`friction_samples`, :class:`Replay`; in MuJoCo
+  (``pip install 'qsplan[sim]'``): :func:`replay_mujoco`, :func:`scene_xml`
+* controller-rate samples of a plan (a Plan, a plan directory or file): :func:`sample_plan`, :class:`PlanSamples`
 * independent certification of an exported plan: :func:`certify_plan`, :class:`Certificate`
 * torque bands along a segment and commands: :func:`segment_bands`, :func:`guaranteed_sweep`,
   :func:`point_band_sweep`, :func:`sampled_guaranteed_sweep`, :func:`choose_command`, :func:`sweep_segment`;
   for one scene, the guaranteed band with every competitor precluded: :func:`robust_band`
-* plots: :func:`plan_figures`, :func:`segment_band_figures`, :func:`plot_hand`, :func:`plot_mu_map`,
+* plots: :func:`plan_figures`, :func:`plan_animation`, :func:`segment_band_figures`, :func:`plot_hand`, :func:`plot_mu_map`,
   :func:`rod_motion_figure`, :func:`push_motion_figure`, :func:`save_figure`, ...
 * errors: :class:`QsplanError` (bad input, a ``ValueError``), :class:`NoAnswerError` (no answer exists)
 """
@@ -93,6 +95,10 @@ _LAZY = {
     "plan_outputs": "qsplan.planner.pipeline.run",
     # replay and verification
     "replay_plan": "qsplan.planner.replay.replay",
+    "replay_mujoco": "qsplan.planner.replay.mujoco_replay",
+    "scene_xml": "qsplan.planner.replay.mujoco_scene",
+    "sample_plan": "qsplan.planner.export.sample",
+    "PlanSamples": "qsplan.planner.export.sample",
     "friction_samples": "qsplan.planner.replay.replay",
     "Replay": "qsplan.planner.replay.replay",
     "SegmentReplay": "qsplan.planner.replay.replay",
@@ -130,6 +136,7 @@ _LAZY = {
     "solve_result_to_dict": "qsplan.planner.reports.solve_report",
     # plots (matplotlib is imported inside the functions)
     "plan_figures": "qsplan.planner.plotting.plan",
+    "plan_animation": "qsplan.planner.plotting.animation",
     "plan_card": "qsplan.planner.plotting.card",
     "plot_plan_bands": "qsplan.planner.plotting.plan",
     "plot_mode_timeline": "qsplan.planner.plotting.plan",

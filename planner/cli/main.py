@@ -11,6 +11,9 @@ Subcommands, one module each in :mod:`qsplan.planner.cli` (``add_parser(subparse
     qsplan paper [--out DIR]                        reproduce the paper's examples into DIR
     qsplan muspace | band | simulate | sweep | plan | demo | verify   (see each module)
     qsplan hands [REF] [--out DIR [--force]]        list the bundled hand files, or check and show one
+    qsplan check TASK [--out DIR [--force]] [--json]  feasibility preview: valid and banded x ranges per grasp
+    qsplan sample PLAN_DIR --rate HZ [--out FILE]   the plan at a controller's rate
+    qsplan replay PLAN_DIR [--engine mujoco] ...    the exported commands executed in MuJoCo
     qsplan --version                                the version (qsplan.__version__)
 
 Bad input prints one line on stderr naming the field and the problem and
@@ -30,8 +33,8 @@ from __future__ import annotations
 import argparse
 import sys
 
-from qsplan.planner.cli import (band, count, demo, hands, modes, muspace, paper, partition, plan, simulate, sweep,
-                                verify)  # fmt: skip
+from qsplan.planner.cli import (band, check, count, demo, hands, modes, muspace, paper, partition, plan, replay,
+                                sample, simulate, sweep, verify)  # fmt: skip
 from qsplan.planner.cli.options import (
     EXIT_INTERRUPTED,
     EXIT_USAGE,
@@ -49,7 +52,7 @@ __all__ = ["COMMANDS", "EXIT_USAGE", "main", "build_parser", "add_parallel_optio
 #: The subcommands, in the order of ``qsplan --help``.
 COMMANDS = {"modes": modes, "count": count, "partition": partition, "paper": paper, "muspace": muspace,
             "band": band, "simulate": simulate, "sweep": sweep, "plan": plan, "demo": demo, "verify": verify,
-            "hands": hands}  # fmt: skip
+            "hands": hands, "sample": sample, "check": check, "replay": replay}  # fmt: skip
 
 
 class _VersionShown(Exception):

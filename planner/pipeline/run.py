@@ -10,8 +10,9 @@ inside DIR (:func:`qsplan.planner.export.files.staging_dir`) ``plan.csv`` and ``
 (:func:`qsplan.planner.export.plan_files.export_plan`), ``certificate.json``: the exported file
 certified row by row from the task alone (:func:`qsplan.planner.certify.certify.certify_plan`),
 ``replay.json``: the exported file re-simulated (:func:`qsplan.planner.replay.replay.replay_plan`)
-at ``verify`` friction vectors of the interval, and the operator plots with the plan card
-(:func:`qsplan.planner.plotting.plan.plan_figures`).  Only then are the files published into DIR,
+at ``verify`` friction vectors of the interval, ``scene.xml`` (the task's scene for MuJoCo), and the operator
+plots with the plan card (:func:`qsplan.planner.plotting.plan.plan_figures`) and the animation
+(``plan_animation.gif`` and ``.html``; a failure: ``failure.png``).  Only then are the files published into DIR,
 by renames, the plan files last (:func:`qsplan.planner.export.manifest.publish_outputs`): a plan
 file never appears in DIR before it is certified, and a run interrupted at any point (Ctrl-C
 while certifying included) leaves no plan of its own there.  Outputs are recorded in
@@ -37,10 +38,14 @@ from qsplan.planner.export.manifest import MANIFEST, own_outputs, publish_output
 from qsplan.planner.plan.results import Plan, PlanFailure
 from qsplan.planner.plan.scripted import DEFAULT_OPTIONS, plan_task
 
-__all__ = ["PLAN_FILES", "PLAN_PLOTS", "CertificationReport", "PlanRun", "plan_outputs", "run_plan"]
+__all__ = ["ANIMATION_FILES", "FAILURE_FILES", "PLAN_FILES", "PLAN_PLOTS", "CertificationReport", "PlanRun", "plan_outputs", "run_plan"]
 
-#: Files :func:`run_plan` writes into its directory (``replay.json`` only when ``verify`` > 0).
-PLAN_FILES = ("plan.csv", "plan.json", "certificate.json", "replay.json")
+#: Files :func:`run_plan` writes into its directory (``replay.json`` only when ``verify`` > 0; ``scene.xml``: the
+#: task's scene for MuJoCo).
+PLAN_FILES = ("plan.csv", "plan.json", "certificate.json", "replay.json", "scene.xml")
+
+#: What a run that finds no plan writes (``failure.png``, the failed configuration drawn, only with the plots).
+FAILURE_FILES = ("failure.json", "failure.png")
 
 #: The plan itself: published last, so that where it is, its certificate and every other output of its run are.
 PLAN_DATA = ("plan.csv", "plan.json")
@@ -65,6 +70,10 @@ class CertificationReport:
 
     def as_dict(self) -> dict:
         return {"kind": "certification", "message": self.message, "certificate": self.certificate.to_dict()}
+
+#: The animation it writes with the plots (:func:`qsplan.planner.plotting.animation.plan_animation`): a GIF and a
+#: self-contained HTML page with a slider.
+ANIMATION_FILES = ("plan_animation.gif", "plan_animation.html")
 
 #: Plots it writes (``<name>.png``) unless ``plots=False``; ``plan_card`` is the one page for the operator.
 PLAN_PLOTS = ("plan_bands", "mode_timeline", "hand_snapshots", "plan_card")
@@ -102,7 +111,8 @@ class PlanRun:
 def plan_outputs(out_dir, plots: bool = True) -> list:
     """The paths :func:`run_plan` may write into ``out_dir`` (checked before planning)."""
     out = Path(out_dir)
-    return [out / f for f in PLAN_FILES] + ([out / f"{n}.png" for n in PLAN_PLOTS] if plots else [])
+    return [out / f for f in PLAN_FILES] + ([out / f"{n}.png" for n in PLAN_PLOTS] + [out / f for f in ANIMATION_FILES]
+                                            if plots else [])  # fmt: skip
 
 
 def run_plan(task, out_dir, *, seed: int = 1, planner: str = "RRTConnect", time_limit: float | None = None,
@@ -174,7 +184,13 @@ def run_plan(task, out_dir, *, seed: int = 1, planner: str = "RRTConnect", time_
             plan = plan_task(task, options, progress, sequence_planner=sequence_planner)
         except PlanFailure as exc:
             atomic_write(stage / "failure.json", json.dumps(exc.report.as_dict(), indent=1))
-            raise PlanFailure(exc.report, report_path=publish(["failure.json"])[0]) from None
+            names = ["failure.json"]
+            if plots:  # the failed configuration drawn: the blocking bodies, where the band closes
+                from qsplan.planner.plotting.failure import failure_figure
+
+                failure_figure(task, exc.report, stage / "failure.png")
+                names.append("failure.png")
+            raise PlanFailure(exc.report, report_path=publish(names)[0]) from None
         from qsplan.planner.export.plan_files import export_plan
 
         staged = [p.name for p in export_plan(plan, stage, force=True)]
@@ -188,10 +204,21 @@ def run_plan(task, out_dir, *, seed: int = 1, planner: str = "RRTConnect", time_
         if replays:
             atomic_write(stage / "replay.json", json.dumps([r.as_dict() for r in replays], indent=1))
             staged.append("replay.json")
+        staged.append(_scene(plan, stage))
         if plots:  # after the re-simulation: the plan card states its verdict
             staged += _draw(plan, certificate, replays, stage, progress)
         files = publish(staged)
     return PlanRun(plan, out, tuple(str(p) for p in files), tuple(replays), certificate)
+
+
+def _scene(plan, stage) -> str:
+    """``scene.xml``: the task's scene for MuJoCo (:func:`qsplan.planner.replay.mujoco_scene.scene_xml`), its keyframe
+    the plan's first row; needs no MuJoCo to write (``qsplan replay DIR --engine mujoco`` runs it)."""
+    from qsplan.planner.export.plan_files import plan_columns
+    from qsplan.planner.replay.mujoco_scene import start_of, write_scene
+
+    write_scene(plan.task, stage / "scene.xml", start=start_of(plan_columns(plan)[0]), force=True)
+    return "scene.xml"
 
 
 def _check_outputs(out, plots, force, inputs) -> list:
@@ -200,15 +227,16 @@ def _check_outputs(out, plots, force, inputs) -> list:
     Never an input, force or not (nor a file this run would remove); never through a link; an existing output is
     replaced only with ``force`` or when an earlier run wrote it and nobody changed it since (the manifest).
     """
-    names = [p.name for p in plan_outputs(out, True)] + ["failure.json"]
+    names = [p.name for p in plan_outputs(out, True)] + list(FAILURE_FILES)
     check_output_path(out / MANIFEST, inputs)  # the record of what qsplan wrote: never through a link
     for p in (out / n for n in names):  # a file this run may remove (an earlier run's plot, with --no-plots)
         if p.is_file() and not p.is_symlink():
             check_output_path(p, inputs)
     own = own_outputs(out)  # written by an earlier run and unchanged since: replaced without force
     check_outputs([p for p in plan_outputs(out, plots) if p.name not in own], force, inputs)
-    if "failure.json" not in own:
-        check_outputs([out / "failure.json"], force, inputs)  # an earlier run's report is an output too
+    for name in FAILURE_FILES:
+        if name not in own:
+            check_outputs([out / name], force, inputs)  # an earlier run's report is an output too
     # no output of an earlier run stays beside this run's (a failure, --no-plots)
     return names if force else [n for n in names if n in own]
 
@@ -225,7 +253,11 @@ def _draw(plan, certificate, replays, stage, progress) -> list:
         card = name == "plan_card"  # an A4 page: kept at its size
         save_figure(fig, stage / f"{name}.png", option="out_dir", dpi=CARD_DPI if card else 110, tight=not card)
         names.append(f"{name}.png")
-    return names
+    from qsplan.planner.plotting.animation import plan_animation
+
+    progress("drawing the animation")
+    plan_animation(plan, stage / ANIMATION_FILES[0], stage / ANIMATION_FILES[1])
+    return names + list(ANIMATION_FILES)
 
 
 def _certify(plan, out, stage, progress):

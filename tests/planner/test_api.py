@@ -157,7 +157,7 @@ def test_run_plan_plans_exports_and_replays(tmp_path):
     task_file.write_text(SMALL_TASK)
     run = planner.run_plan(planner.load_task(task_file), tmp_path / "out", verify=1, plots=False)
     assert isinstance(run, planner.PlanRun) and run.followed and len(run.replays) == 1
-    assert [Path(f).name for f in run.files] == ["plan.csv", "plan.json", "certificate.json", "replay.json"]
+    assert [Path(f).name for f in run.files] == ["plan.csv", "plan.json", "certificate.json", "replay.json", "scene.xml"]
     assert run.certificate.ok
     cols = planner.read_plan_csv(tmp_path / "out" / "plan.csv")
     assert set(cols["mode"]) == {"SSSS"} and len(run.plan.segments) == 1

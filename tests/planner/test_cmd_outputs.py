@@ -43,14 +43,14 @@ def test_demo_runs_twice_into_one_directory(tmp_path, capsys):
     code, first, err = run(args, capsys)
     assert code == 0 and err == ""
     written = sorted(p.name for p in out.iterdir())
-    assert written == [MANIFEST, "certificate.json", "plan.csv", "plan.json"]
+    assert written == [MANIFEST, "certificate.json", "plan.csv", "plan.json", "scene.xml"]
     before = (out / "plan.csv").read_bytes()
     (out / "notes.txt").write_text("the operator's notes")
     code, second, err = run(args, capsys)  # its own outputs, unchanged: replaced without --force
-    assert code == 0 and err == "" and second.count("wrote ") == 3
+    assert code == 0 and err == "" and second.count("wrote ") == 4
     assert (out / "plan.csv").read_bytes() == before and (out / "notes.txt").read_text() == "the operator's notes"
     manifest = json.loads((out / MANIFEST).read_text())
-    assert set(manifest["files"]) == {"plan.csv", "plan.json", "certificate.json"}
+    assert set(manifest["files"]) == {"plan.csv", "plan.json", "certificate.json", "scene.xml"}
     (out / "plan.json").write_text("{}")  # a file qsplan did not write (edited): refused, in one line, untouched
     code, _, err = run(args, capsys)
     assert code == 2 and err.count("\n") == 1 and "plan.json" in err and "--force" in err
