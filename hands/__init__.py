@@ -15,7 +15,11 @@
 * :mod:`qsplan.hands.described` - :class:`DescribedHand`, the one hand: any description, batched generic path
   (:mod:`~qsplan.hands.described_states`, :mod:`~qsplan.hands.described_scenes`,
   :mod:`~qsplan.hands.described_candidates`, :mod:`~qsplan.hands.closing_batch`, :mod:`~qsplan.hands.chain_arrays`),
-  the paper's closed forms as an accelerator (:mod:`~qsplan.hands.paper_accelerator`).
+  the paper's closed forms as an accelerator (:mod:`~qsplan.hands.paper_accelerator`); built at the door by
+  :mod:`~qsplan.hands.described_build` (``as_hand``: every hand a task names becomes one).
+* :mod:`qsplan.hands.motion` - a grasp's slide motion (joint rates, eq. 6 with equality at the closing joints) and
+  closed configurations, for any hand; :mod:`qsplan.hands.reclose` - the fingers closed again between segments.
+* :mod:`qsplan.hands.collision` - overlaps between every pair of bodies, batched.
 
 Submodules are imported on first use so that ``import qsplan.hands`` stays light.
 """

@@ -48,7 +48,7 @@ def _row_q(task, segment: str, x: float):
 
 def _band_report(report):
     """The segment report (``FailureReport``) a report carries, or None."""
-    if report.as_dict()["kind"] == "band closes":
+    if report.as_dict().get("kind") == "band closes":
         return report
     return getattr(report, "band", None)
 
@@ -59,9 +59,10 @@ def failed_configuration(task, report) -> tuple:
     beyond its limit, the palm an edge passes)."""
     d = report.as_dict()
     band = _band_report(report)
-    if d["kind"] == "invalid configuration":
+    kind = d.get("kind")  # a report of another kind (a refused certificate): the start is drawn
+    if kind == "invalid configuration":
         x, q = float(report.x), None if report.q is None else np.asarray(report.q, float)
-    elif d["kind"] == "beyond the palm":
+    elif kind == "beyond the palm":
         return float(report.x), None, (), ()
     elif band is not None:
         x = float(band.narrowest.x if band.narrowest is not None else band.x_start)
@@ -138,7 +139,7 @@ def failure_figure(task, report, path=None):
     fig = Figure(figsize=(8.0, 6.6), layout="constrained")
     ax, strip = fig.subplots(2, 1, height_ratios=[3.6, 0.6])
     plot_configuration(task, x, q, ax=ax, collisions=hits, highlight=over)
-    if report.as_dict()["kind"] == "beyond the palm":  # the stretch of the resting edge beyond the palm's end
+    if report.as_dict().get("kind") == "beyond the palm":  # the stretch of the resting edge beyond the palm's end
         end, edge = report.palm_end, report.edge
         far = edge[0] if report.side == "left" else edge[1]
         ax.plot([end, far], [0.0, 0.0], color=COLLISION, lw=4, solid_capstyle="butt", zorder=8)
@@ -148,7 +149,7 @@ def failure_figure(task, report, path=None):
     what = ("fingers drawn open at mid-range: no grasp closes here" if q is None else
             "q = (" + ", ".join(f"{v:.4g} {u}" for v, u in zip(q, units)) + ")")  # fmt: skip
     red = "; red: overlapping bodies, joints beyond their limits" if hits or over else ""
-    if report.as_dict()["kind"] == "beyond the palm":
+    if report.as_dict().get("kind") == "beyond the palm":
         red = "; red: the resting edge beyond the palm's end"
     ax.set_title(f"workpiece x = {x:.4g} m, {what}{red}", fontsize=FONT["note"])
     _x_strip(strip, task, report, x)

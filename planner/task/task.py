@@ -382,7 +382,7 @@ def task_from_record(doc, base_dir=None, default_name: str = "task") -> Task:
 
 
 def demo_task_path() -> Path:
-    """The bundled task of ``qsplan demo``: a regrasp like the paper's Fig. 9 (three 4S segments)."""
+    """The bundled task of ``qsplan demo``: the first 4S segment of the paper's Fig. 9, planned from a start and a goal."""
     return _DATA / "demo_task.toml"
 
 

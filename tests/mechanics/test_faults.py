@@ -139,6 +139,7 @@ def test_timeout_from_the_environment(monkeypatch):
         parallel.no_progress_timeout()
 
 
+@pytest.mark.slow
 def test_killed_dask_worker_is_restarted_and_results_are_identical():
     """A LocalCluster's nanny restarts a killed worker and the scheduler reruns its chunk: same bits."""
     from distributed import Client, LocalCluster

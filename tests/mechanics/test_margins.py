@@ -140,6 +140,7 @@ def test_box_band_with_margin_is_exact_against_the_solver():
     assert checked >= 10
 
 
+@pytest.mark.slow
 def test_shared_band_with_margin_matches_dense_sampling_and_the_solver():
     checked = 0
     for rng, scene, mode in _scenes(30, 14):

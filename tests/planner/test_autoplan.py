@@ -82,7 +82,8 @@ def test_planner_is_deterministic(tmp_path):
     assert a.plan.sequence[:-1] == b.plan.sequence[:-1]
 
 
-@pytest.mark.parametrize("stem", sorted(s for s, p in task_paths().items() if "[goal]" in p.read_text()))
+@pytest.mark.parametrize("stem", [pytest.param(s, marks=pytest.mark.slow) if s.startswith("two_link") else s  # ~14 s each
+                                  for s in sorted(s for s, p in task_paths().items() if "[goal]" in p.read_text())])
 def test_bundled_goal_tasks(tmp_path, stem):
     """Each bundled automatic task is planned, certified and re-simulated; the infeasible one says why."""
     from qsplan.planner.pipeline.run import run_plan

@@ -106,3 +106,20 @@ def test_the_demo_plans_what_its_description_says():
     assert slides[0].mode == "SSSS"
     readme = (Path(__file__).resolve().parents[2] / "README.md").read_text()
     assert "one slide 4 cm to the left, no regrasp" in readme and "bundled regrasp" not in readme
+
+
+def test_the_readmes_first_task_plans(tmp_path):
+    """The task file of the README's "A first task of your own" loads and plans, as the README says."""
+    from pathlib import Path
+
+    from qsplan.planner.plan.scripted import plan_task
+    from qsplan.planner.task.task import load_task
+
+    readme = (Path(__file__).resolve().parents[2] / "README.md").read_text()
+    section = readme[readme.index("## A first task of your own"):]
+    text = section[section.index("```toml") + len("```toml"):section.index("```", section.index("```toml") + 7)]
+    path = tmp_path / "my_task.toml"
+    path.write_text(text)
+    plan = plan_task(load_task(path))
+    assert plan.phases[-1].x[-1] == pytest.approx(-0.03, abs=1e-12)
+    assert plan.narrowest()[2] >= 0.02

@@ -100,6 +100,7 @@ def assert_agrees(hand, poses, qs, every=1):
     return decisions
 
 
+@pytest.mark.slow
 def test_default_hand_and_bundled_tasks_agree_with_shapely():
     rng = np.random.default_rng(13)
     for hand in hands(rng, 0)[:3]:

@@ -153,7 +153,7 @@ def test_failing_forced_plan_leaves_no_old_plan_beside_failure_json(tmp_path, mo
     with pytest.raises(PlanFailure) as info:
         pipeline.run_plan(task, tmp_path, force=True)
     assert info.value.report_path == tmp_path / "failure.json"
-    assert sorted(p.name for p in tmp_path.iterdir() if not p.name.startswith(".")) == ["failure.json"]
+    assert sorted(p.name for p in tmp_path.iterdir() if not p.name.startswith(".")) == ["failure.json", "failure.png"]
     with pytest.raises(PlanFailure):  # the report qsplan wrote is replaced by the next run (issue 16)
         pipeline.run_plan(task, tmp_path, force=False)
     (tmp_path / "failure.json").write_text("annotated by hand")
