@@ -148,8 +148,10 @@ def metadata_checks(meta, task, cols) -> list:
                            ("task_tables", task_tables(task)), ("formation", task.formation.as_dict()),
                            ("task_record", task_record(task))):
             if key in meta:
-                claimed = {k: v for k, v in meta[key].items() if k != "description_source"} \
-                    if key == "hand" and isinstance(meta[key], dict) else meta[key]
+                # not facts of the plan: where a hand description was read from, what the task is called
+                ignored = {"hand": "description_source", "task_record": "name"}.get(key)
+                claimed = {k: v for k, v in meta[key].items() if k != ignored} \
+                    if ignored and isinstance(meta[key], dict) else meta[key]
                 where = _stated(claimed, _plain(truth), f"metadata.{key}")
                 claim(where is None, f"{where} is not the task's")
         if "disturbance" in meta or task.disturbance is not None:

@@ -85,3 +85,17 @@ def test_a_bad_record_names_its_field(changes, message):
 def test_a_record_is_a_table():
     with pytest.raises(QsplanError, match="task: expected a table"):
         task_from_record(["not", "a", "table"])
+
+
+def test_the_certifier_checks_the_record_but_not_the_tasks_name(tmp_path):
+    from dataclasses import replace
+
+    from qsplan.planner.certify.certify import certify_plan
+    from qsplan.planner.export.plan_files import export_plan
+    from qsplan.planner.plan.scripted import plan_task
+
+    task = load_task(task_paths()["parallel_jaw_task"])
+    export_plan(plan_task(task), tmp_path)
+    assert certify_plan(tmp_path, replace(task, name="another name"), n_random=0).ok
+    refused = certify_plan(tmp_path, replace(task, mu_range=(0.0, 0.25)), n_random=0)
+    assert any(v.kind == "metadata" and "task_record" in v.message for v in refused.violations)
