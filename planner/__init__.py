@@ -27,7 +27,8 @@ Public API (loaded on first use, so ``import qsplan.planner`` stays light):
 * export: :func:`export_plan`, :func:`read_plan_csv`, :func:`export_schedule`, :func:`check_outputs`
 * replay and verification: :func:`replay_plan`, :func:`friction_samples`, :class:`Replay`; in MuJoCo
   (``pip install 'qsplan[sim]'``): :func:`replay_mujoco`, :func:`scene_xml`
-* controller-rate samples of a plan (a Plan, a plan directory or file): :func:`sample_plan`, :class:`PlanSamples`
+* controller-rate samples of a plan: ``plan.sample(times)``, or of a plan directory or file :func:`sample_plan`;
+  :class:`PlanSamples`
 * independent certification of an exported plan: :func:`certify_plan`, :class:`Certificate`
 * torque bands along a segment and commands: :func:`segment_bands`, :func:`guaranteed_sweep`,
   :func:`point_band_sweep`, :func:`sampled_guaranteed_sweep`, :func:`choose_command`, :func:`sweep_segment`;

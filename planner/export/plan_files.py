@@ -52,117 +52,13 @@ import numpy as np
 
 from qsplan.planner.export.files import atomic_write, check_out_dir, check_outputs, csv_cell, json_value
 from qsplan.planner.export.schedule import FORMAT, VERSION
+from qsplan.planner.plan.table import PLAN_COLUMNS, column_family, plan_columns, plan_joints
 from qsplan.planner.task.record import task_record, task_tables
 
 __all__ = ["PLAN_COLUMNS", "PLAN_FORMAT", "column_meanings", "export_plan", "plan_columns", "plan_joints",
            "disturbance_metadata", "plan_metadata", "plan_metadata_limits", "plain_json", "read_plan_csv", "task_tables"]
 
 PLAN_FORMAT = FORMAT + ".plan"
-
-#: Every column family of a plan file: ``(name, unit, meaning)``, ``<joint>`` standing for ``left`` and ``right``.
-PLAN_COLUMNS = (
-    ("t", "s", "time from the plan's start"),
-    ("q_<joint>", "rad", "joint angle"),
-    ("qd_<joint>", "rad/s", "velocity command while the joint is velocity-controlled; nan (null) while torque-controlled"),
-    ("tau_<joint>", "N m", "torque command while the joint is torque-controlled, inside its guaranteed band; nan "
-                           "(null) while velocity-controlled (every regrasp row, and the other finger in contact)"),
-    ("tau_<joint>_min", "N m", "lower edge of the guaranteed band (-inf, JSON null: unbounded below); nan (null) "
-                               "while velocity-controlled"),
-    ("tau_<joint>_max", "N m", "upper edge of the guaranteed band (inf, JSON null: unbounded above); nan (null) "
-                               "while velocity-controlled"),
-    ("mode", None, "contact mode the command guarantees, one letter per contact (palm:0, palm:1, left, right; "
-                   "SSSS = 4S); free on regrasp rows"),
-    ("margin", "N m", "distance from the torque command to the nearer band edge; nan (null) on regrasp rows"),
-    ("x_workpiece", "m", "workpiece pose: x of its centre of mass"),
-    ("y_workpiece", "m", "workpiece pose: y of its centre of mass"),
-    ("theta_workpiece", "rad", "workpiece pose: orientation"),
-    ("phase", None, "index of the phase, an integer (0, 1, 2, ...: segments and regrasps in time order); "
-                    "metadata.phases[phase] names it"),
-    ("effort_joint", None, "the torque-controlled finger (left, right); none on regrasp rows"),
-)  # fmt: skip
-
-#: Characters a joint's name may hold to name columns (the schema's column pattern).
-_NAME_CHARS = frozenset("abcdefghijklmnopqrstuvwxyz0123456789_")
-
-
-def plan_joints(hand) -> tuple:
-    """The joints a plan of ``hand`` has columns for, in the hand's order (:func:`qsplan.hands.interface.joint_names`).
-
-    Raises
-    ------
-    QsplanError
-        A joint whose name cannot name a column (lowercase letters, digits and underscores; not ``none``), or two
-        joints whose columns would share a name.
-    """
-    from qsplan.hands.interface import joint_names
-    from qsplan.mechanics.errors import QsplanError
-
-    names = joint_names(hand)
-    for n in names:
-        if not n or set(n) - _NAME_CHARS or n == "none":
-            raise QsplanError(f"hand.joint_names: {n!r} cannot name a plan column; expected lowercase letters, digits "
-                              "and underscores (and not 'none')")  # fmt: skip
-    columns = [f"{c}_{n}{s}" for n in names for c, s in (("q", ""), ("qd", ""), ("tau", ""), ("tau", "_min"),
-                                                         ("tau", "_max"))]  # fmt: skip
-    if len(set(columns)) != len(columns):
-        raise QsplanError(f"hand.joint_names: {list(names)} give two columns of one name; rename a joint")
-    return names
-
-
-def _match(name: str, joints=None) -> tuple:
-    """``(the PLAN_COLUMNS entry of column name, its joint or None)``; ``joints``: the plan's joint names (default
-    the paper's ``left`` and ``right``)."""
-    for joint in sorted(joints or ("left", "right"), key=len, reverse=True):
-        for head, tail in (("q", ""), ("qd", ""), ("tau", ""), ("tau", "_min"), ("tau", "_max")):
-            if name == f"{head}_{joint}{tail}":
-                return next(c for c in PLAN_COLUMNS if c[0] == f"{head}_<joint>{tail}"), joint
-    return next(c for c in PLAN_COLUMNS if c[0] == name), None
-
-
-def plan_columns(plan) -> tuple:
-    """The plan as ordered columns ``{name: list}`` and units ``{name: str or None}`` (:data:`PLAN_COLUMNS`).
-
-    Reads the plan's public fields only (``phases``; a phase that is not a
-    :class:`~qsplan.planner.plan.results.ContactSegmentPlan` is a free motion of every joint); one group of
-    columns per joint of ``plan.task.hand``, in its order, with its kind's units.
-    """
-    from qsplan.hands.interface import JOINT_UNITS, joint_kinds
-    from qsplan.planner.plan.results import ContactSegmentPlan
-
-    joints = plan_joints(plan.task.hand)
-    kinds = dict(zip(joints, joint_kinds(plan.task.hand)))
-    order = ["t", *(f"q_{n}" for n in joints), *(f"qd_{n}" for n in joints)]
-    for n in joints:
-        order += [f"tau_{n}", f"tau_{n}_min", f"tau_{n}_max"]
-    order += ["mode", "margin", "x_workpiece", "y_workpiece", "theta_workpiece", "phase", "effort_joint"]
-    cols = {k: [] for k in order}
-    y0 = plan.task.hand.rest_height
-    for i, ph in enumerate(plan.phases):
-        n = ph.t.size
-        nan = [math.nan] * n
-        cols["t"] += ph.t.tolist()
-        for j, name in enumerate(joints):
-            cols[f"q_{name}"] += ph.q[:, j].tolist()
-            cols[f"qd_{name}"] += ph.qd[:, j].tolist()
-        contact = isinstance(ph, ContactSegmentPlan)
-        for name in joints:
-            mine = contact and ph.effort_joint == name
-            cols[f"tau_{name}"] += ph.command.tolist() if mine else nan
-            cols[f"tau_{name}_min"] += ph.lower.tolist() if mine else nan
-            cols[f"tau_{name}_max"] += ph.upper.tolist() if mine else nan
-        cols["mode"] += [ph.mode if contact else "free"] * n
-        cols["margin"] += ph.margin.tolist() if contact else nan
-        cols["x_workpiece"] += np.broadcast_to(np.asarray(ph.x, float), (n,)).tolist()
-        cols["y_workpiece"] += [y0] * n
-        cols["theta_workpiece"] += [0.0] * n
-        cols["phase"] += [i] * n
-        cols["effort_joint"] += [ph.effort_joint if contact else "none"] * n
-    units = {}
-    for k in order:
-        (family, unit, _), joint = _match(k, joints)
-        units[k] = unit if joint is None else JOINT_UNITS[kinds[joint]][family.split("_")[0]]
-    return cols, units
-
 
 def column_meanings(names, kinds=None) -> dict:
     """``{column: meaning}`` of a plan file's columns (:data:`PLAN_COLUMNS`; the joints read from the ``q_<joint>``
@@ -171,7 +67,7 @@ def column_meanings(names, kinds=None) -> dict:
     joints = [k[2:] for k in names if k.startswith("q_")]
     out = {}
     for k in names:
-        (_, _, meaning), joint = _match(k, joints)
+        (_, _, meaning), joint = column_family(k, joints)
         if joint is not None and (kinds or {}).get(joint) == "prismatic":
             meaning = meaning.replace("joint angle", "joint position").replace("torque", "force")
         out[k] = meaning

@@ -72,6 +72,7 @@ class ContactSegmentPlan:
     competitors: tuple
     speed: float
     planning: object
+    in_contact = True  # the workpiece held in a contact mode (a class constant, not a field)
 
     @property
     def width(self) -> np.ndarray:
@@ -101,6 +102,7 @@ class RegraspPlan:
     q: np.ndarray
     qd: np.ndarray
     planning: tuple
+    in_contact = False  # the fingers move in free space (a class constant, not a field)
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -152,6 +154,16 @@ class Plan:
     @property
     def checks_per_second(self) -> float:
         return self.validity_checks / self.ompl_seconds if self.ompl_seconds > 0 else float("nan")
+
+    def sample(self, times):
+        """This plan at controller ticks ``times`` (s, strictly increasing, within the plan): per tick each joint's
+        control mode (``velocity``, ``torque``, ``hold``) and command, by the rule of :mod:`qsplan.planner.plan.sampling`
+        (e.g. ``plan.sample(tick_times(plan.duration, 1000))``); a :class:`~qsplan.planner.plan.sampling.PlanSamples`."""
+        from qsplan.planner.plan.sampling import sample_columns
+        from qsplan.planner.plan.table import plan_columns
+
+        cols, units = plan_columns(self)
+        return sample_columns({k: np.asarray(v) for k, v in cols.items()}, units, times)
 
     def narrowest(self):
         """``(segment name, t, width)`` of the narrowest guaranteed band of the plan (s, N m; width inf when

@@ -230,3 +230,20 @@ def test_cli_bad_input_is_one_line(args, match, capsys):
     assert main(["sample", str(REFERENCE / "demo_task.csv"), *args]) == 2
     err = capsys.readouterr().err
     assert match in err and len(err.strip().splitlines()) == 1
+
+
+def test_plan_sample_is_the_files_samples(tmp_path):
+    """``Plan.sample`` (the planned plan) and ``sample_plan`` (its exported files) give the same ticks: one rule."""
+    from qsplan.planner.export.plan_files import export_plan
+    from qsplan.planner.export.sample import sample_plan, tick_times
+    from qsplan.planner.plan.scripted import plan_task
+    from qsplan.planner.task.task import load_task, task_paths
+
+    plan = plan_task(load_task(task_paths()["parallel_jaw_task"]))
+    export_plan(plan, tmp_path)
+    ticks = tick_times(plan.duration, 200)
+    a, b = plan.sample(ticks), sample_plan(tmp_path, ticks)
+    assert a.joints == b.joints and a.kinds == b.kinds == ("prismatic", "prismatic")
+    np.testing.assert_array_equal(a.control, b.control)
+    for name in ("q", "qd", "tau", "q_plan"):
+        np.testing.assert_allclose(getattr(a, name), getattr(b, name), rtol=1e-12, atol=1e-15, equal_nan=True)
