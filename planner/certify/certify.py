@@ -83,6 +83,8 @@ CHECKS = {
             "at least the torque resolution wide",
     "margin": "the margin cell is the command's distance to the nearer band edge, at least half the resolution",
     "torque": "the torque command inside its exported band",
+    "control": "each control_<joint> cell names the row's command: torque for its effort joint, hold for a "
+               "velocity-controlled joint at rest, velocity otherwise",
     "mode": "with the row's commands the planned mode is the only feasible one at the friction set's vertices and "
             "random points; no sliding direction reverses within a segment",
     "undecided": "no mode's feasibility left undecided by near-degeneracy",

@@ -17,6 +17,7 @@ from pathlib import Path
 import numpy as np
 
 from qsplan.mechanics import QsplanError
+from qsplan.planner.plan.table import is_word_column
 
 __all__ = ["MAX_PLAN_BYTES", "MAX_PLAN_ROWS", "plan_columns_required", "plan_file", "plan_sources", "read_plan",
            "read_plan_file", "task_from_metadata"]
@@ -104,7 +105,7 @@ def _read_json(p: Path) -> tuple:
     for name, vals in data.items():
         if not isinstance(vals, list):
             raise QsplanError(f"plan: column {name!r} of {str(p)!r} is not a list of values")
-        if name in ("mode", "effort_joint"):
+        if is_word_column(name):
             cols[name] = np.array([str(v) for v in vals])
             continue
         fill = -math.inf if name.endswith("_min") else (math.inf if name.endswith("_max") else math.nan)
@@ -150,7 +151,7 @@ def _read_csv(p: Path) -> dict:
     out = {}
     for j, name in enumerate(head):
         vals = [r[j] for r in body]
-        if name in ("mode", "effort_joint"):
+        if is_word_column(name):
             out[name] = np.array(vals)
             continue
         try:

@@ -245,6 +245,7 @@ def limit_checks(task, cols, k) -> list:
         qd = cols[f"qd_{side}"][k]
         if np.isfinite(qd) and abs(qd) > speeds[j] * (1 + SPEED_RTOL):
             out.append(("speed", f"{side} joint speed command {qd:.6g} {u}/s beyond the limit {speeds[j]:g} {u}/s"))
+    out += control_checks(cols, k, names)
     if cols["mode"][k] == "free":
         return out
     e = str(cols["effort_joint"][k])
@@ -341,3 +342,21 @@ def friction_points(task, n_random, rng) -> np.ndarray:
         vertices = np.array(np.meshgrid(*[[lo, hi]] * 4, indexing="ij")).reshape(4, -1).T.astype(float)
         draws = rng.uniform(lo, hi, (n_random, 4))
     return np.unique(np.vstack([vertices, draws]), axis=0) if lo == hi else np.vstack([vertices, draws])
+
+
+def control_checks(cols, k, names) -> list:
+    """The row's ``control_<joint>`` cells (plans written before them have none) against its commands: ``torque`` for
+    its effort joint, ``hold`` for a velocity-controlled joint commanded at rest, ``velocity`` otherwise
+    (:func:`qsplan.planner.plan.table.row_control`)."""
+    from qsplan.planner.plan.table import row_control
+
+    out = []
+    effort = str(cols["effort_joint"][k]) if cols["mode"][k] != "free" else None
+    for v in names:
+        key = f"control_{v}"
+        if key not in cols:
+            continue
+        want = row_control(v == effort, float(cols[f"qd_{v}"][k]))
+        if str(cols[key][k]) != want:
+            out.append(("control", f"{key} says {str(cols[key][k])!r}; the row's commands make it {want!r}"))
+    return out

@@ -52,13 +52,14 @@ import numpy as np
 
 from qsplan.planner.export.files import atomic_write, check_out_dir, check_outputs, csv_cell, json_value
 from qsplan.planner.export.schedule import FORMAT, VERSION
-from qsplan.planner.plan.table import PLAN_COLUMNS, column_family, plan_columns, plan_joints
+from qsplan.planner.plan.table import PLAN_COLUMNS, column_family, is_word_column, plan_columns, plan_joints
 from qsplan.planner.task.record import task_record, task_tables
 
 __all__ = ["PLAN_COLUMNS", "PLAN_FORMAT", "column_meanings", "export_plan", "plan_columns", "plan_joints",
            "disturbance_metadata", "plan_metadata", "plan_metadata_limits", "plain_json", "read_plan_csv", "task_tables"]
 
 PLAN_FORMAT = FORMAT + ".plan"
+
 
 def column_meanings(names, kinds=None) -> dict:
     """``{column: meaning}`` of a plan file's columns (:data:`PLAN_COLUMNS`; the joints read from the ``q_<joint>``
@@ -67,8 +68,8 @@ def column_meanings(names, kinds=None) -> dict:
     joints = [k[2:] for k in names if k.startswith("q_")]
     out = {}
     for k in names:
-        (_, _, meaning), joint = column_family(k, joints)
-        if joint is not None and (kinds or {}).get(joint) == "prismatic":
+        (family, _, meaning), joint = column_family(k, joints)
+        if joint is not None and (kinds or {}).get(joint) == "prismatic" and family != "control_<joint>":
             meaning = meaning.replace("joint angle", "joint position").replace("torque", "force")
         out[k] = meaning
     return out
@@ -235,5 +236,5 @@ def read_plan_csv(path) -> dict:
     out = {}
     for j, name in enumerate(head):
         vals = [r[j] for r in body]
-        out[name] = np.array(vals) if name in ("mode", "effort_joint") else np.array(vals, dtype=float)
+        out[name] = np.array(vals) if is_word_column(name) else np.array(vals, dtype=float)
     return out

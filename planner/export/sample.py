@@ -11,6 +11,7 @@ from pathlib import Path
 import numpy as np
 
 from qsplan.mechanics.errors import QsplanError
+from qsplan.planner.plan.table import is_word_column
 from qsplan.planner.plan.sampling import (CONTROL_MODES, MAX_TICKS, TIME_SNAP, PlanSamples, sample_columns,
                                           tick_times)  # fmt: skip
 
@@ -50,8 +51,7 @@ def plan_table(plan) -> tuple:
         doc = _json_doc(side) if p.suffix == ".csv" else json.loads(p.read_text())
         if p.suffix == ".json":
             data = doc["data"]
-            words = ("mode", "effort_joint")
-            cols = {k: np.array(v) if k in words else np.array([np.nan if x is None else x for x in v], float)
+            cols = {k: np.array(v) if is_word_column(k) else np.array([np.nan if x is None else x for x in v], float)
                     for k, v in data.items()}  # fmt: skip
         else:
             cols = read_plan_csv(p)

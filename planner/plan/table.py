@@ -13,7 +13,7 @@ import math
 
 import numpy as np
 
-__all__ = ["PLAN_COLUMNS", "column_family", "plan_columns", "plan_joints"]
+__all__ = ["CONTROLS", "PLAN_COLUMNS", "column_family", "is_word_column", "plan_columns", "plan_joints", "row_control"]
 
 
 #: Every column family of a plan file: ``(name, unit, meaning)``, ``<joint>`` standing for ``left`` and ``right``.
@@ -29,14 +29,31 @@ PLAN_COLUMNS = (
                                "while velocity-controlled"),
     ("mode", None, "contact mode the command guarantees, one letter per contact (palm:0, palm:1, left, right; "
                    "SSSS = 4S); free on regrasp rows"),
-    ("margin", "N m", "distance from the torque command to the nearer band edge; nan (null) on regrasp rows"),
+    ("margin", "N m", "distance from the torque command to the nearer band edge, in the effort joint's unit (N for a "
+                      "prismatic joint); nan (null) on regrasp rows"),
     ("x_workpiece", "m", "workpiece pose: x of its centre of mass"),
     ("y_workpiece", "m", "workpiece pose: y of its centre of mass"),
     ("theta_workpiece", "rad", "workpiece pose: orientation"),
     ("phase", None, "index of the phase, an integer (0, 1, 2, ...: segments and regrasps in time order); "
                     "metadata.phases[phase] names it"),
     ("effort_joint", None, "the torque-controlled finger (left, right); none on regrasp rows"),
+    ("control_<joint>", None, "the joint's control at this row: torque (apply tau_<joint>, a force for a prismatic "
+                              "joint), velocity (track q_<joint> with qd_<joint>) or hold (velocity-controlled at "
+                              "rest: hold q_<joint>)"),
 )  # fmt: skip
+
+#: A joint's control at a row (``control_<joint>``; the same words as :data:`qsplan.planner.plan.sampling.CONTROL_MODES`).
+CONTROLS = ("velocity", "torque", "hold")
+
+
+def is_word_column(name: str) -> bool:
+    """Whether column ``name`` holds words (``mode``, ``effort_joint``, ``control_<joint>``), not numbers."""
+    return name in ("mode", "effort_joint") or name.startswith("control_")
+
+
+def row_control(effort: bool, qd: float) -> str:
+    """``control_<joint>`` of a row: ``torque`` for its effort joint, else ``hold`` at rest (``qd`` 0), ``velocity``."""
+    return "torque" if effort else ("hold" if qd == 0.0 else "velocity")
 
 #: Characters a joint's name may hold to name columns (the schema's column pattern).
 _NAME_CHARS = frozenset("abcdefghijklmnopqrstuvwxyz0123456789_")
@@ -60,7 +77,7 @@ def plan_joints(hand) -> tuple:
             raise QsplanError(f"hand.joint_names: {n!r} cannot name a plan column; expected lowercase letters, digits "
                               "and underscores (and not 'none')")  # fmt: skip
     columns = [f"{c}_{n}{s}" for n in names for c, s in (("q", ""), ("qd", ""), ("tau", ""), ("tau", "_min"),
-                                                         ("tau", "_max"))]  # fmt: skip
+                                                         ("tau", "_max"), ("control", ""))]  # fmt: skip
     if len(set(columns)) != len(columns):
         raise QsplanError(f"hand.joint_names: {list(names)} give two columns of one name; rename a joint")
     return names
@@ -70,7 +87,7 @@ def column_family(name: str, joints=None) -> tuple:
     """``(the PLAN_COLUMNS entry of column name, its joint or None)``; ``joints``: the plan's joint names (default
     the paper's ``left`` and ``right``)."""
     for joint in sorted(joints or ("left", "right"), key=len, reverse=True):
-        for head, tail in (("q", ""), ("qd", ""), ("tau", ""), ("tau", "_min"), ("tau", "_max")):
+        for head, tail in (("q", ""), ("qd", ""), ("tau", ""), ("tau", "_min"), ("tau", "_max"), ("control", "")):
             if name == f"{head}_{joint}{tail}":
                 return next(c for c in PLAN_COLUMNS if c[0] == f"{head}_<joint>{tail}"), joint
     return next(c for c in PLAN_COLUMNS if c[0] == name), None
@@ -90,6 +107,7 @@ def plan_columns(plan) -> tuple:
     for n in joints:
         order += [f"tau_{n}", f"tau_{n}_min", f"tau_{n}_max"]
     order += ["mode", "margin", "x_workpiece", "y_workpiece", "theta_workpiece", "phase", "effort_joint"]
+    order += [f"control_{n}" for n in joints]  # after every earlier column: extended, never reordered
     cols = {k: [] for k in order}
     y0 = plan.task.hand.rest_height
     for i, ph in enumerate(plan.phases):
@@ -112,8 +130,14 @@ def plan_columns(plan) -> tuple:
         cols["theta_workpiece"] += [0.0] * n
         cols["phase"] += [i] * n
         cols["effort_joint"] += [ph.effort_joint if contact else "none"] * n
+        for j, name in enumerate(joints):
+            mine = contact and ph.effort_joint == name
+            cols[f"control_{name}"] += [row_control(mine, float(v)) for v in ph.qd[:, j]]
     units = {}
     for k in order:
         (family, unit, _), joint = column_family(k, joints)
-        units[k] = unit if joint is None else JOINT_UNITS[kinds[joint]][family.split("_")[0]]
+        units[k] = None if unit is None else (unit if joint is None else JOINT_UNITS[kinds[joint]][family.split("_")[0]])
+    efforts = {kinds[e] for e in cols["effort_joint"] if e != "none"}
+    if len(efforts) == 1:  # the margin is a distance in the effort joint's unit
+        units["margin"] = JOINT_UNITS[efforts.pop()]["tau"]
     return cols, units

@@ -21,6 +21,7 @@ from qsplan.mechanics import QsplanError
 from qsplan.mechanics.bands.batched_robust import robust_bands
 from qsplan.planner.certify.certify import certify_plan, read_plan, task_from_metadata
 from qsplan.planner.export.plan_files import export_plan, plan_columns, read_plan_csv
+from qsplan.planner.plan.table import is_word_column
 from qsplan.planner.export.schema import check_schedule_document, check_schedule_files
 from qsplan.planner.plan.results import ContactSegmentPlan, Plan, RegraspPlan
 from qsplan.planner.replay.replay import replay_plan
@@ -140,9 +141,11 @@ def test_export_has_every_joint_with_its_units(two_link, jaws):
     assert doc["metadata"]["limits"]["joints"]["left_jaw"] == {"range": [0.0, 0.1], "unit": "m", "speed": 0.05,
                                                               "speed_unit": "m/s"}  # fmt: skip
     assert doc["metadata"]["phases"][0]["effort_unit"] == "N"
+    assert doc["units"]["margin"] == "N" and units["margin"] == "N m"  # the effort joint's unit
+    assert [k for k in cols if k.startswith("control_")] == [f"control_{n}" for n in names]  # after the old columns
     back = read_plan_csv(out / "plan.csv")
     for k, v in cols.items():
-        if k in ("mode", "effort_joint"):
+        if is_word_column(k):
             assert back[k].tolist() == v
         else:
             np.testing.assert_array_equal(back[k], np.asarray(v, float))

@@ -18,6 +18,7 @@ import pytest
 
 from qsplan.planner import ompl_available, task_paths
 from qsplan.planner.cli import main
+from qsplan.planner.plan.table import is_word_column
 
 pytestmark = pytest.mark.ompl
 
@@ -69,7 +70,7 @@ def _read(plan_dir):
 
 
 def _json_value(column, text):
-    if column in ("mode", "effort_joint"):
+    if is_word_column(column):
         return text
     if column == "phase":
         return int(float(text))
@@ -180,19 +181,30 @@ def misstate_friction(rows, doc):
     doc["metadata"]["friction"]["range"] = [0.0, 0.5]
 
 
+def swap_controls(rows, doc):
+    """The control cells of one in-contact row swapped: the torque joint labelled velocity and a velocity one torque."""
+    k = _contact(rows)
+    cells = [c for c in rows[k] if c.startswith("control_")]
+    values = [rows[k][c] for c in cells]
+    for c, v in zip(cells, values[1:] + values[:1]):
+        rows[k][c] = v
+
+
 BOTH = [drop_first_row, drop_second_half, relabel_slide_as_free, raise_during_regrasp, widen_band, narrow_band,
-        double_margin, bump_phase, swap_times, shift_torque_out, misstate_phase_rows, misstate_friction]  # fmt: skip
+        double_margin, bump_phase, swap_times, shift_torque_out, misstate_phase_rows, misstate_friction,
+        swap_controls]  # fmt: skip
 
 #: The edits each hand's plan gets: every edit on the paper hand's (certified in ~1 s); on the chain hands' (~3 s
 #: each) those whose checks read the hand (its start and goal, its regrasp, its bands), so the suite stays short.
 EDITS = {"paper": BOTH,
          "two_link": [drop_first_row, drop_second_half, relabel_slide_as_free, raise_during_regrasp, widen_band,
                       narrow_band, double_margin],
-         "jaw": [drop_first_row, drop_second_half, relabel_slide_as_free, widen_band, narrow_band]}  # fmt: skip
+         "jaw": [drop_first_row, drop_second_half, relabel_slide_as_free, widen_band, narrow_band, swap_controls]}  # fmt: skip
 CASES = [(hand, edit) for hand, edits in EDITS.items() for edit in edits]
 
 #: The kinds each edit must be named by (at least one of them).
 EXPECTED = {
+    "swap_controls": {"control"},
     "drop_first_row": {"start", "time"},
     "drop_second_half": {"goal"},
     "relabel_slide_as_free": {"rest"},

@@ -2,7 +2,8 @@
 
 - The paper hand's bundled plans and failure report equal the ones the pre-pipeline planner wrote
   (``tests/data/reference_plans``, written by commit 0ca5728 before the three planners became one):
-  numerically to 1e-12 on every machine, byte for byte on the BLAS kernel that wrote them.
+  numerically to 1e-12 on every machine, every cell byte for byte on the BLAS kernel that wrote them (the
+  columns added since, after the old ones, are not in the references).
 - The paper hand planned through the generic described-hand path (closed forms off) gives the same
   phases and the same narrowest band to 1e-9 as the accelerated path, on every bundled paper task.
 - A chain hand runs waypoint tasks, and its failures carry the same report fields as the paper hand's.
@@ -49,8 +50,16 @@ def _rows(path) -> list:
         return list(csv.reader(f))
 
 
+def _reference_cells(rows: list, names: list) -> list:
+    """``rows`` cut to the columns ``names`` (the reference's): later issues extend a plan file with new columns
+    after the old ones, never renaming or moving one (issue 24: ``control_<joint>``)."""
+    index = [rows[0].index(n) for n in names]
+    return [[r[i] for i in index] for r in rows]
+
+
 def _same_cells(got: list, want: list) -> None:
-    assert got[0] == want[0], "columns"
+    assert got[0][: len(want[0])] == want[0], "the reference's columns first, in order"
+    got = _reference_cells(got, want[0])
     assert len(got) == len(want), "row count"
     for i, (a, b) in enumerate(zip(got[1:], want[1:]), start=1):
         for name, x, y in zip(want[0], a, b):
@@ -74,8 +83,8 @@ def test_paper_plans_equal_the_pre_pipeline_planner(name, tmp_path):
     csv_path, _ = export_plan(plan, tmp_path)
     want = REFERENCE / f"{name}.csv"
     _same_cells(_rows(csv_path), _rows(want))
-    if _blas() == REFERENCE_BLAS:
-        assert csv_path.read_bytes() == want.read_bytes()
+    if _blas() == REFERENCE_BLAS:  # every reference cell byte for byte
+        assert _reference_cells(_rows(csv_path), _rows(want)[0]) == _rows(want)
 
 
 def test_paper_failure_report_equals_the_pre_pipeline_planner():

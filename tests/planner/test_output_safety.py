@@ -106,7 +106,7 @@ def test_two_runs_into_one_directory_at_once(tmp_path):
     assert err.splitlines() == [f"qsplan: error: --out: {str(out)!r} is being written by another qsplan run "
                                 f"(pid {winner}); wait for it or choose another directory"]  # fmt: skip
     names = sorted(p.name for p in out.iterdir())
-    assert names == sorted([MANIFEST, "plan.csv", "plan.json", "certificate.json", "replay.json"])
+    assert names == sorted([MANIFEST, "plan.csv", "plan.json", "certificate.json", "replay.json", "scene.xml"])
     assert own_outputs(out) == set(names) - {MANIFEST}  # the winner's files, as it recorded them
     assert json.loads((out / "certificate.json").read_text())["certified"] is True
 
