@@ -1,4 +1,4 @@
-"""Regenerate every figure the README shows (``docs/*.png``) from the scripts and commands that draw them.
+"""Regenerate every figure the README and docs/science.md show (``docs/*.png``) from the scripts that draw them.
 
 ``python examples/readme_figures.py [--with-benchmark]``: each producer runs into a temporary folder and the
 README's file is copied from it into ``docs/``.  ``--with-benchmark`` also reruns ``benchmarks/bench_bands.py``
