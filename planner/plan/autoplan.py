@@ -154,7 +154,7 @@ def grasp_rows(task, x0: float, x1: float) -> tuple:
             if g.keys == s.keys and x1 != x0:
                 slope = zero.copy()
                 slope[free] = (np.asarray(g.free) - np.asarray(s.free)) / (x1 - x0)
-                rows.append(GraspRow(s, FreePath(float(x0), np.asarray(s.free, float), slope, tuple(free))))
+                rows.append(GraspRow(s, FreePath(float(x0), np.asarray(s.free, float), slope, tuple(free), float(x1))))
     return tuple(rows)
 
 

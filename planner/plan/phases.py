@@ -67,12 +67,28 @@ class FreePath:
         joints (their rates follow from the contacts).
     free : tuple of int
         The free joints' indices.
+    x1 : float or None
+        Where the line ends (m): a line between two grasps is a configuration of its row only between ``x0`` and
+        ``x1``, slid from ``x0`` toward ``x1`` (the band tables judge it there only); None: anywhere, either way.
     """
 
     x0: float
     values: np.ndarray
     slope: np.ndarray
     free: tuple
+    x1: float | None = None
+
+    def covers(self, x) -> np.ndarray:
+        """Whether each workpiece ``x`` (n,) lies on the line (between ``x0`` and ``x1``; everywhere without ``x1``)."""
+        x = np.asarray(x, dtype=float)
+        if self.x1 is None:
+            return np.ones(x.shape, dtype=bool)
+        return (x >= min(self.x0, self.x1)) & (x <= max(self.x0, self.x1))
+
+    @property
+    def directions(self) -> tuple:
+        """The slide directions it is used in: ``0`` toward -x, ``1`` toward +x (the band tables' ``d``)."""
+        return (0, 1) if self.x1 is None or self.x1 == self.x0 else ((1,) if self.x1 > self.x0 else (0,))
 
     def at(self, x) -> np.ndarray:
         """The free joints at workpiece ``x`` (n,): shape (n, n_free)."""

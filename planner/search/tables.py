@@ -35,6 +35,10 @@ GRID_STEP = 5e-4
 #: What :attr:`BandTables.why` holds where two bodies overlap (:meth:`BandTables.reason` says which, and by how much).
 OVERLAP = "two bodies overlap"
 
+#: What :attr:`BandTables.why` holds where a line between two grasps does not reach (:class:`qsplan.planner.plan.
+#: phases.FreePath` ``x1``).
+OFF_LINE = "beyond the ends of this line between two grasps"
+
 #: Relative slack of the grid's end counts: ``(end - start) / h`` computes a hair below its integer when the
 #: span is a multiple of the step (floating point), which would drop the last grid point.
 _GRID_ROUNDING = 1e-9
@@ -178,6 +182,11 @@ def _geometry(task, row, x):
     why = [None] * len(x)
     for k in np.flatnonzero(~valid):
         why[k] = states.why(int(k))
+    if row.path is not None:  # a line between two grasps: a configuration of this row only on the line
+        off = valid & ~row.path.covers(x)
+        for k in np.flatnonzero(off):
+            why[k] = OFF_LINE
+        valid &= ~off
     lim = task.joint_limits
     inside = np.all((states.q >= lim[:, 0]) & (states.q <= lim[:, 1]), axis=1)
     for k in np.flatnonzero(valid & ~inside):
@@ -265,7 +274,8 @@ def band_tables(task, grasps, x, progress=None) -> BandTables:
         if keep.size:
             rates = _unit_rates(task, row, states, arrays, idx, keep)
             touched[g, idx[keep], 2:] = _slip_senses(task, arrays, keep, rates)
-            parts.append((g, idx[keep], arrays, keep, rates))
+            dirs = (0, 1) if row.path is None else row.path.directions
+            parts.append((g, idx[keep], arrays, keep, rates, dirs))
     band_states = 0
     for e, name in enumerate(efforts):  # one batch per effort joint: the states of every row and direction
         if parts:
@@ -273,7 +283,9 @@ def band_tables(task, grasps, x, progress=None) -> BandTables:
             band_states += b.lower.size
             at = 0
             for d in range(2):
-                for g, idx, *_ in parts:
+                for g, idx, *_, dirs in parts:
+                    if d not in dirs:
+                        continue
                     part = slice(at, at + idx.size)
                     at += idx.size
                     lower[g, e, d, idx], upper[g, e, d, idx] = b.lower[part], b.upper[part]
@@ -315,7 +327,8 @@ def _take_arrays(arrays, keep):
 
 def _effort_bands(task, parts, e: int):
     """The guaranteed bands of the formation's mode, competitors precluded, of every configuration of ``parts`` with
-    joint ``e`` effort-controlled, moving left (``d = 0``) then right (``d = 1``): one :class:`StateBatch` from the
+    joint ``e`` effort-controlled, moving left (``d = 0``) then right (``d = 1``) where the part is used that way (a
+    line between two grasps: toward its end only): one :class:`StateBatch` from the
     arrays, :func:`qsplan.mechanics.bands.batched_robust.robust_band_arrays` (NaN edges where there is no band)."""
     from qsplan.mechanics.bands.batched import LazyScenes, batch_from_arrays
     from qsplan.mechanics.bands.batched_robust import robust_band_arrays
@@ -323,11 +336,11 @@ def _effort_bands(task, parts, e: int):
     hand = task.hand
     n_j = len(hand.joint_names)
     effort = np.arange(n_j) == e
-    speeds = [(1.0 if d else -1.0) * task.workpiece_speed for d in range(2)]
-    stacked = [np.concatenate([getattr(arrays, f)[keep] for _ in speeds for _, _, arrays, keep, _ in parts])
-               for f in _ARRAYS]  # fmt: skip
-    velocity = np.concatenate([rates * xdot for xdot in speeds for *_, rates in parts])  # (m, n_j)
-    where = [(arrays, int(k)) for _ in speeds for _, _, arrays, keep, _ in parts for k in keep]
+    # every (direction, part) pair the part is used in, left (d = 0) then right: the order band_tables reads back
+    pairs = [((1.0 if d else -1.0) * task.workpiece_speed, part) for d in range(2) for part in parts if d in part[5]]
+    stacked = [np.concatenate([getattr(arrays, f)[keep] for _, (_, _, arrays, keep, _, _) in pairs]) for f in _ARRAYS]
+    velocity = np.concatenate([part[4] * xdot for xdot, part in pairs])  # (m, n_j)
+    where = [(arrays, int(k)) for _, (_, _, arrays, keep, _, _) in pairs for k in keep]
 
     def scene(s):  # the scene of state s, as the hand builds it (a per-state search needs it)
         arrays, k = where[s]
