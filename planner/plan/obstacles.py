@@ -26,7 +26,7 @@ from qsplan.planner.plan.failure import ConfigurationReport, failure_report
 from qsplan.planner.states.contact import mode_name
 from qsplan.planner.search.widest import SearchGraph, slide_widths, widest_route
 
-__all__ = ["NoRouteReport", "blocking_overlap", "no_route_report", "unreachable_goal_report"]
+__all__ = ["open_overlap", "NoRouteReport", "blocking_overlap", "no_route_report", "unreachable_goal_report"]
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -105,18 +105,23 @@ def _matching(task, tables, which) -> list:
 
 
 def _open(task, tables, g, i):
-    """Row ``g`` at grid index ``i`` with the fingers that close onto nothing fully open: ``(q, collision)``, the
+    """Row ``g`` at grid index ``i`` with the fingers that close onto nothing fully open (:func:`open_overlap`)."""
+    return open_overlap(task, tables.grasps[g].grasp, float(tables.x[i]), tables.q[g, i])
+
+
+def open_overlap(task, grasp, x: float, q):
+    """``q`` (n_j,; NaN at the joints that close onto nothing) with those joints fully open: ``(q, collision)``, the
     collision of a body with the workpiece, None where none overlaps it (a closing joint's NaN set to the end of its
     range its opening sense points to: :meth:`qsplan.hands.protocol.Hand.opening`; a link folded onto another there is
-    the open pose's, not the grasp's obstacle)."""
+    the open pose's, not the grasp's obstacle); ``(None, None)`` when a free joint is unknown."""
     hand, lim = task.hand, task.joint_limits
-    q = np.array(tables.q[g, i], dtype=float)
+    q = np.array(q, dtype=float)
     if np.any(~np.isfinite(q[list(hand.free_joints)])):
         return None, None
     mid = np.where(np.isfinite(q), q, 0.5 * (lim[:, 0] + lim[:, 1]))
-    sense = hand.opening(tables.grasps[g].grasp, float(tables.x[i]), mid)
+    sense = hand.opening(grasp, x, mid)
     q = np.where(np.isfinite(q), q, np.where(sense > 0, lim[:, 1], lim[:, 0]))
-    hits = [c for c in hand.collisions(task.pose(tables.x[i]), q) if "workpiece" in c.bodies]
+    hits = [c for c in hand.collisions(task.pose(x), q) if "workpiece" in c.bodies]
     return q, (hits[0] if hits else None)
 
 

@@ -123,6 +123,24 @@ def _grasp_q(task, x, path):
     return task.hand.closed_configuration(task.formation, None, x, None if path is None else path.at([x])[0])
 
 
+def _no_grasp_report(task, seg, where, x, path, exc):
+    """The report of a grasp that does not close at ``x``: with the fingers fully open, the body that already overlaps
+    the workpiece (:func:`qsplan.planner.plan.obstacles.open_overlap`), where one does."""
+    from qsplan.planner.plan.failure import ConfigurationReport
+    from qsplan.planner.plan.obstacles import open_overlap
+
+    hand = task.hand
+    q = np.full(len(hand.joint_names), np.nan)
+    if path is not None:
+        q[list(hand.free_joints)] = path.at([x])[0]
+    q_open, hit = open_overlap(task, None, float(x), q)
+    reason = f"no four-contact grasp: {exc}"
+    if hit is None:
+        return configuration_report(task, seg, where, x, None, reason)
+    return ConfigurationReport(seg, where, float(x), tuple(float(v) for v in q_open),
+                               f"{reason}; with the fingers fully open: {hit.message}", hit.bodies, hit.area, hit.depth)
+
+
 def check_configurations(task: Task) -> None:
     """Check the task's fixed configurations before planning (milliseconds): the grasp at the start and at
     every waypoint (joint limits, no two bodies overlapping) and the opened fingers of every regrasp.
@@ -145,8 +163,7 @@ def check_configurations(task: Task) -> None:
         try:
             q = _grasp_q(task, x, path)
         except QsplanError as exc:
-            report = configuration_report(task, seg, where, x, None, f"no four-contact grasp: {exc}")
-            raise PlanFailure(report) from None
+            raise PlanFailure(_no_grasp_report(task, seg, where, x, path, exc)) from None
         if configuration_problem(task, task.pose(x), q):
             raise PlanFailure(configuration_report(task, seg, where, x, q))
         if 0 < i < last:

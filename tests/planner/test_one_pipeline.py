@@ -194,3 +194,12 @@ def test_chain_failures_carry_the_paper_hands_report_fields(tmp_path):
     assert scripted["kind"] == "band closes"
     assert scripted.keys() == want["band"].keys()
     assert 0.0 < scripted["mu_closes"] < 0.2 and "mu in [0, " in scripted["message"]
+
+
+def test_a_chain_waypoint_without_a_grasp_names_the_bodies(tmp_path):
+    """A scripted waypoint where the fingers close onto nothing: the report names the body that overlaps the workpiece
+    with the fingers fully open (the paper hand's reports always named theirs)."""
+    report = _failure(_chain_task(tmp_path, "waypoint into the finger", "waypoints = [-0.06]"))
+    assert report["kind"] == "invalid configuration"
+    assert report["bodies"] == ["workpiece", "left_proximal link"] and report["overlap_area_m2"] > 0
+    assert "fully open" in report["reason"]
