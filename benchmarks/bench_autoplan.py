@@ -19,20 +19,19 @@ import argparse
 import time
 
 from qsplan.planner import load_task, plan_task, task_paths
-from qsplan.planner.plan.autoplan import plan_automatic
 from qsplan.planner.search.ompl_search import SEQUENCE_PLANNERS, search_route
 from qsplan.planner.search.tables import band_tables, table_grid
 
 
 def search_rows(task, iterations):
     """One row per planner: (planner, seconds, evaluations, width, regrasps) on the task's tables."""
-    from qsplan.hands.grasp_geometry import candidate_grasps
-    from qsplan.planner.plan.autoplan import goal_nodes, start_nodes
+    from qsplan.planner.plan.autoplan import goal_nodes, grasp_rows, start_nodes
 
     t0 = time.perf_counter()
     from qsplan.planner.task.goal import palm_x_range
 
-    tables = band_tables(task, candidate_grasps(task.hand), table_grid(task.start_x, task.goal.x, palm_x_range(task.hand)))
+    tables = band_tables(task, grasp_rows(task, task.start_x, task.goal.x),
+                         table_grid(task.start_x, task.goal.x, palm_x_range(task.hand)))
     t_tables = time.perf_counter() - t0
     starts, goals = start_nodes(tables, task), goal_nodes(tables, task)
     rows = []

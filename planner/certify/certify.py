@@ -38,7 +38,7 @@ from qsplan.mechanics import QsplanError
 
 from qsplan.planner.certify.bands import BAND_RTOL, band_checks, free_row_cells, recomputed_bands
 from qsplan.planner.certify.files import META_TOL, agreement_checks, metadata_checks, schema_checks
-from qsplan.planner.certify.inputs import (plan_columns_required, plan_file, plan_sources, read_plan,
+from qsplan.planner.certify.inputs import (plan_columns_required, plan_sources, read_plan,
                                            read_plan_file, task_from_metadata)  # fmt: skip
 from qsplan.planner.certify.modes import disturbance_checks, mode_checks, row_scene, slip_reversals, slip_velocities
 from qsplan.planner.certify.route import (ENDPOINT_TOL, FREE_PATH_STEP, endpoint_checks, free_path_checks,

@@ -57,7 +57,7 @@ def _paper_task_names() -> list:
 
 @pytest.mark.parametrize("name", _paper_task_names())
 def test_bundled_tasks_along_their_segments(name):
-    from qsplan.hands.grasp_geometry import candidate_grasps, grasp_configurations
+    from qsplan.hands.grasp_geometry import grasp_configurations
 
     task = load_task(task_paths()[name])
     end = [task.goal.x] if task.goal is not None else task.waypoints
@@ -174,7 +174,7 @@ def _assert_batch_is_the_closed_form(hand, poses, q) -> tuple:
 def test_batched_closed_form_is_the_one_state_closed_form_bit_for_bit():
     """Every grasp of the bundled goal tasks along the palm, the same turned by 1e-9 to 1e-3 rad or lifted and
     tilted (refusals at the margins), and random polygons at their vertices of tangency."""
-    from qsplan.hands.grasp_geometry import candidate_grasps, grasp_configurations
+    from qsplan.hands.grasp_geometry import grasp_configurations
 
     rng = np.random.default_rng(2025)
     found = tips = total = 0

@@ -117,7 +117,6 @@ def test_goal_on_a_vertex_the_finger_cannot_touch_is_named(tmp_path):
 
 def test_tables_agree_with_the_per_state_check():
     """The batched tables against check_contact_state (the per-state validity checker), state by state."""
-    from qsplan.hands.grasp_geometry import candidate_grasps
     from qsplan.planner.search.tables import band_tables, table_grid
     from qsplan.planner.states.contact import check_contact_state
 
@@ -161,7 +160,6 @@ def test_single_link_fingers_have_one_grasp_at_each_x():
     """Why the paper's hand never needs a regrasp onto another feature: a single-link finger turning about a fixed
     axis meets a convex workpiece on the palm in one configuration only, so at each workpiece x at most one
     candidate grasp is valid (checked on every bundled hand, 1 mm apart over the whole palm)."""
-    from qsplan.hands.grasp_geometry import candidate_grasps
     from qsplan.planner.search.tables import band_tables, table_grid
 
     seen = set()
@@ -185,7 +183,7 @@ def test_random_goal_tasks_plan_or_say_why(seed):
     QsplanError with a message; never another exception (a scene the polygons cannot give crashed the tables)."""
     from dataclasses import replace
 
-    from qsplan.hands.grasp_geometry import candidate_grasps, grasp_configurations
+    from qsplan.hands.grasp_geometry import grasp_configurations
     from qsplan.hands.grasps import OnVertex
     from qsplan.planner.plan.results import PlanFailure
     from qsplan.planner.plan.scripted import plan_task

@@ -1,6 +1,5 @@
 """The plan certifier: a genuine plan certifies; corrupted copies fail naming the row and the reason; ``qsplan verify``."""
 
-import argparse
 import csv
 import io
 import json
