@@ -32,6 +32,8 @@ from qsplan.hands.description import load_hand
 from qsplan.mechanics.bands.batched import LazyScenes, batch_from_arrays
 from qsplan.mechanics.bands.batched_robust import robust_band_arrays
 
+from bench_plan import table_rate  # the demo tables' rate, measured as bench_plan.py measures it
+
 #: Half the span (m) of the workpiece x judged: that of ``qsplan demo``'s band tables (the last line's).
 SPAN = 0.06
 
@@ -136,25 +138,9 @@ def main(argv=None):
         valid = sum(r.size for _, _, r in judged)
         print(f"{label:<28} {len(grasps):6d} {states:7d} {valid:6d} {states / best_geo:9.0f} {checks:7d} "
               f"{checks / best_all:9.0f} {BEFORE[name]:>8} {'10,000':>7}")  # fmt: skip
-    rate, checks = tables_rate(args.repeat)
+    rate, checks = table_rate(args.repeat)
     print(f"{'paper_hand: band tables today':<28} {'':>6} {'':>7} {'':>6} {'':>9} {checks:7d} {rate:9.0f} "
           f"{BEFORE['paper_hand']:>8} {'10,000':>7}")  # fmt: skip
-
-
-def tables_rate(repeat):
-    """``qsplan demo``'s band tables today (as ``benchmarks/bench_plan.py`` measures them): checks/s and checks."""
-    from qsplan.hands.grasp_geometry import candidate_grasps
-    from qsplan.planner import load_task, task_paths
-    from qsplan.planner.search.tables import band_tables, table_grid
-
-    task = load_task(task_paths()["demo_task"])
-    grasps, grid = candidate_grasps(task.hand), table_grid(-0.06, 0.06, 0.16, margin=0.0)
-    best, n = 0.0, 0
-    for _ in range(repeat):
-        t0 = time.perf_counter()
-        tables = band_tables(task, grasps, grid)
-        best, n = max(best, tables.band_states / (time.perf_counter() - t0)), tables.band_states
-    return best, n
 
 
 if __name__ == "__main__":

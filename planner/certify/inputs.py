@@ -3,8 +3,7 @@
 :func:`read_plan` reads a plan directory, ``plan.csv`` or ``plan.json``
 (:func:`qsplan.planner.export.plan_files.export_plan`) and checks that every column of the hand's joints
 is there (:func:`plan_columns_required`); :func:`task_from_metadata` rebuilds the task from ``plan.json``'s
-metadata: the paper's hand from its parameters, a described chain hand from its description and workpiece
-(:func:`qsplan.hands.interface.hand_from_metadata`).  Used by :mod:`qsplan.planner.certify.certify` and
+task record (:mod:`qsplan.planner.task.record`).  Used by :mod:`qsplan.planner.certify.certify` and
 ``qsplan verify``.  Units SI.
 """
 
@@ -215,87 +214,22 @@ def read_plan(path, joints=None) -> tuple:
 
 
 def task_from_metadata(meta, cols=None):
-    """The :class:`~qsplan.planner.task.task.Task` a plan's ``plan.json`` metadata records.
-
-    Since the task record (``metadata.task_record``, :mod:`qsplan.planner.task.record`) the task is read from it,
-    checked as a task file is.  Older plans: the metadata records the hand (the paper's hand by its parameters,
-    but not its palm thickness: the default is used; a described hand by its description and workpiece), the
-    friction set, the limits and the torque resolution; the start and the waypoints are read from its
-    ``task_tables``, or from the rows (``cols``) when it has none.
+    """The :class:`~qsplan.planner.task.task.Task` a plan's ``plan.json`` metadata records: its task record
+    (``metadata.task_record``, :mod:`qsplan.planner.task.record`), read as a task file is read (the one round trip).
+    ``cols`` (the rows) is not needed: the record names the start, the goal or the waypoints.
 
     Raises
     ------
     QsplanError
-        Naming ``task`` when the metadata does not record the task.
+        Naming ``task`` when the metadata holds no task record (a plan written before qsplan recorded its task) or
+        a record that is not a task: then name the task file.
     """
-    from qsplan.planner.task.task import make_task, task_from_record
+    from qsplan.planner.task.task import task_from_record
 
-    if isinstance(meta, dict) and "task_record" in meta:  # the one round trip (qsplan.planner.task.record)
-        try:
-            return task_from_record(meta["task_record"])
-        except QsplanError as exc:
-            raise QsplanError(f"task: the plan's metadata.task_record is not a task ({exc}); name the task file") from None
-    # plans written before the record: the task rebuilt from the metadata's other tables
-    if isinstance(meta, dict) and isinstance(meta.get("hand"), dict) and "description" in meta["hand"]:
-        return _chain_task_from_metadata(meta, cols)
+    if not (isinstance(meta, dict) and "task_record" in meta):
+        raise QsplanError("task: the plan's metadata does not record the task (no task_record: a plan written before "
+                          "qsplan recorded its task); name the task file")  # fmt: skip
     try:
-        h, lim = meta["hand"], meta["limits"]
-        hand = {"workpiece": h["workpiece_vertices_m"], "workpiece_mass": h["workpiece_mass_kg"],
-                "finger_base": h["finger_base_m"], "finger_length": h["finger_length_m"],
-                "finger_width": h["finger_width_m"], "finger_mass": h["finger_mass_kg"],
-                "palm_halfwidth": h["palm_halfwidth_m"], "gravity": h["gravity_m_s2"]}  # fmt: skip
-        friction = meta["friction"]
-        shared = "shared" in friction["model"]
-        start, waypoints, goal, start_table = _motion(meta, cols)
-        fm = meta.get("force_margin")  # recorded since force margins exist; older plans: the default
-        margin = None if fm is None else (fm["min_normal_force_N"], fm["min_coulomb_slack_N"])
-        per_joint = lim.get("joint_speeds_rad_s")  # recorded since per-joint limits exist; older plans: one speed
-        speeds = None if per_joint is None else dict(zip(("left", "right"), per_joint))
-        return make_task(hand, start, waypoints, friction["range"], meta["torque_resolution_N_m"], shared,
-                         lim["joints_rad"], None if speeds else lim["joint_speed_rad_s"], lim["workpiece_speed_m_s"],
-                         name=meta.get("task", "task"), force_margin=margin, joint_speeds=speeds, goal=goal,
-                         start=start_table)  # fmt: skip
-    except (KeyError, TypeError, AttributeError) as exc:
-        raise QsplanError(f"task: the plan's metadata does not record the task ({exc}); name the task file") from None
-
-
-def _motion(meta, cols) -> tuple:
-    """``(start_x, waypoints or None, goal table or None, start table or None)`` as ``metadata.task_tables`` records
-    them; plans written before it: the start and the ends of the in-contact stretches read from the rows."""
-    tables = meta.get("task_tables")
-    if isinstance(tables, dict):
-        motion = tables["motion"]
-        return motion["start_x"], motion.get("waypoints"), tables.get("goal"), tables.get("start")
-    start, waypoints = (0.0, [1.0]) if cols is None else _rows_motion(cols)
-    return start, waypoints, None, None
-
-
-def _rows_motion(cols) -> tuple:
-    """``(start x, [x at the end of each in-contact stretch])`` (m) of a plan's rows."""
-    x, contact = cols["x_workpiece"], cols["mode"] != "free"
-    ends = [i for i in range(x.size) if contact[i] and (i + 1 == x.size or not contact[i + 1])]
-    return float(x[0]), [float(x[i]) for i in ends]
-
-
-def _chain_task_from_metadata(meta, cols):
-    """:func:`task_from_metadata` of a described hand's plan (its description and workpiece, :func:`qsplan.hands.
-    interface.hand_from_metadata`; the joint limits by joint name; its joint speeds as recorded, at most the description's)."""
-    from qsplan.hands.interface import hand_from_metadata, joint_names
-    from qsplan.planner.task.task import make_task
-
-    hand = hand_from_metadata(meta["hand"])
-    try:
-        lim = meta["limits"]
-        joints = lim["joints"]
-        limits = [joints[n]["range"] for n in joint_names(hand)]
-        speeds = {n: joints[n]["speed"] for n in joint_names(hand)}
-        friction = meta["friction"]
-        start, waypoints, goal, start_table = _motion(meta, cols)
-        fm = meta.get("force_margin")
-        margin = None if fm is None else (fm["min_normal_force_N"], fm["min_coulomb_slack_N"])
-        return make_task(hand, start, waypoints, friction["range"], meta["torque_resolution_N_m"],
-                         "shared" in friction["model"], limits, workpiece_speed=lim["workpiece_speed_m_s"],
-                         name=meta.get("task", "task"), force_margin=margin, joint_speeds=speeds, goal=goal,
-                         start=start_table)  # fmt: skip
-    except (KeyError, TypeError, AttributeError) as exc:
-        raise QsplanError(f"task: the plan's metadata does not record the task ({exc}); name the task file") from None
+        return task_from_record(meta["task_record"])
+    except QsplanError as exc:
+        raise QsplanError(f"task: the plan's metadata.task_record is not a task ({exc}); name the task file") from None

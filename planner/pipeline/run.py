@@ -30,6 +30,8 @@ import json
 from dataclasses import dataclass, replace
 from pathlib import Path
 
+import numpy as np
+
 from qsplan.mechanics.errors import QsplanError
 
 from qsplan.planner.export.files import (atomic_write, check_out_dir, check_output_path, check_outputs, locked_out_dir,
@@ -214,10 +216,11 @@ def run_plan(task, out_dir, *, seed: int = 1, planner: str = "RRTConnect", time_
 def _scene(plan, stage) -> str:
     """``scene.xml``: the task's scene for MuJoCo (:func:`qsplan.planner.replay.mujoco_scene.scene_xml`), its keyframe
     the plan's first row; needs no MuJoCo to write (``qsplan replay DIR --engine mujoco`` runs it)."""
-    from qsplan.planner.export.plan_files import plan_columns
-    from qsplan.planner.replay.mujoco_scene import start_of, write_scene
+    from qsplan.planner.replay.mujoco_scene import write_scene
 
-    write_scene(plan.task, stage / "scene.xml", start=start_of(plan_columns(plan)[0]), force=True)
+    first = plan.phases[0]  # the plan's first row: the keyframe
+    start = (plan.task.pose(np.ravel(first.x)[0]), np.asarray(first.q[0], dtype=float))
+    write_scene(plan.task, stage / "scene.xml", start=start, force=True)
     return "scene.xml"
 
 
@@ -279,10 +282,11 @@ def _verify(plan, csv_path, n, seed, progress) -> list:
     from qsplan.planner.export.plan_files import read_plan_csv
     from qsplan.planner.replay.replay import friction_samples, replay_plan
 
-    mus = friction_samples(plan.task.mu_range, n, seed, shared=plan.task.shared_mu)
+    mus = friction_samples(plan.task.mu_range, n, seed, shared=plan.task.shared_mu,
+                           n_contacts=plan.task.formation.n_contacts)
     columns = read_plan_csv(csv_path)
     out, scenes = [], {}  # the scenes along the plan do not depend on friction: built once for all replays
     for mu in mus:
         progress(f"re-simulating the exported plan at mu = {[round(float(m), 4) for m in mu]}")
-        out.append(replay_plan(columns, plan.task.hand, mu, scenes=scenes))
+        out.append(replay_plan(columns, plan.task.hand, mu, scenes=scenes, formation=plan.task.formation))
     return out

@@ -100,23 +100,23 @@ class FreePath:
         return np.broadcast_to(np.asarray(self.slope, dtype=float) * float(speed), (n, len(self.slope))).copy()
 
 
+def _pieces(path, step):
+    """``(a, b, n)`` of each piece of ``path`` (k,) or (k, d): its ends and the number of steps that keep every
+    coordinate at most ``step`` apart (one number, or one per coordinate)."""
+    for a, b in zip(path[:-1], path[1:]):
+        yield a, b, max(1, int(np.ceil(np.max(np.abs(b - a) / step))))
+
+
 def densify(path_x, step):
     """``path_x`` (m, shape (k,)) with points added on each piece, at most ``step`` apart."""
-    xs = [path_x[:1]]
-    for a, b in zip(path_x[:-1], path_x[1:]):
-        n = max(1, int(np.ceil(abs(b - a) / step)))
-        xs.append(np.linspace(a, b, n + 1)[1:])
-    return np.concatenate(xs)
+    return np.concatenate([path_x[:1]] + [np.linspace(a, b, n + 1)[1:] for a, b, n in _pieces(path_x, step)])
 
 
 def densify_rows(path, step):
     """``path`` (n, d) with states added on each straight edge, at most ``step`` apart in every coordinate (``step``:
     one number, or one per coordinate, shape (d,))."""
-    out = [path[:1]]
-    for a, b in zip(path[:-1], path[1:]):
-        n = max(1, int(np.ceil(np.max(np.abs(b - a) / step))))
-        out.append(a + np.linspace(0.0, 1.0, n + 1)[1:, None] * (b - a))
-    return np.vstack(out)
+    edges = [a + np.linspace(0.0, 1.0, n + 1)[1:, None] * (b - a) for a, b, n in _pieces(path, step)]
+    return np.vstack([path[:1]] + edges)
 
 
 def straight_path(x0, x1):

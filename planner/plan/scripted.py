@@ -58,7 +58,6 @@ from qsplan.planner.plan.phases import (DEFAULT_OPTIONS, REGRASP_OPENING, SWEEP_
 from qsplan.planner.plan.results import ContactSegmentPlan, Plan, PlanFailure, RegraspPlan
 from qsplan.planner.search.ompl_bridge import PlannerOptions
 from qsplan.planner.states.contact import (
-    MODE,
     TOUCH_AREA,
     StateCheck,
     check_contact_state,
@@ -71,7 +70,6 @@ from qsplan.planner.task.task import Task
 
 __all__ = [
     "DEFAULT_OPTIONS",
-    "MODE",
     "REGRASP_OPENING",
     "SWEEP_STEP",
     "TOUCH_AREA",

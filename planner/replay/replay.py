@@ -84,7 +84,9 @@ class ReplaySystem:
         Each velocity-controlled joint's speed (rad/s or m/s), each effort-controlled joint's effort (N m or N);
         the other entries are not read.
     friction : qsplan.mechanics.motion.system.Friction
-        Of the four potential contacts (palm, palm, left finger, right finger).
+        Of the formation's contacts, in its order.
+    formation : qsplan.hands.formations.Formation
+        The contacts the replay keeps (their names and order).
     scenes : dict
         Scenes already built, by the state's bytes (a scene depends on the state alone): the
         integrator asks again for the scene at the end of every step (its event functions, then
@@ -99,9 +101,12 @@ class ReplaySystem:
     velocity: np.ndarray
     effort: np.ndarray
     friction: object
+    formation: object
     scenes: dict = field(default_factory=dict, repr=False)
 
-    contact_names = ("palm:0", "palm:1", "left", "right")
+    @property
+    def contact_names(self) -> tuple:
+        return self.formation.contact_names
 
     @property
     def state_names(self) -> tuple:
@@ -119,8 +124,9 @@ class ReplaySystem:
     def scene(self, x, contacts):
         from qsplan.hands.interface import scene_at
 
-        if tuple(contacts) != (0, 1, 2, 3):
-            raise QsplanError(f"contacts: the replay keeps all four contacts; got {tuple(contacts)}")
+        if tuple(contacts) != tuple(range(self.formation.n_contacts)):
+            raise QsplanError(f"contacts: the replay keeps all {self.formation.n_contacts} contacts of the formation; "
+                              f"got {tuple(contacts)}")  # fmt: skip
         key = np.asarray(x, dtype=float).tobytes()
         scene = self.scenes.get(key)
         if scene is None:
@@ -221,17 +227,19 @@ def _start_modes(system, x0, mu) -> tuple:
 
     from qsplan.mechanics.solver.all_modes import solve
 
-    scene = replace(system.scene(x0, (0, 1, 2, 3)), mu=np.asarray(mu, float))
+    scene = replace(system.scene(x0, tuple(range(len(system.contact_names)))), mu=np.asarray(mu, float))
     return tuple(solve(scene, residuals=False).feasible_modes)
 
 
-def friction_samples(mu_range, n, seed=1, shared=False) -> list:
-    """``n`` friction vectors (4,) from ``mu_range``: all at ``lo``, all at ``hi``, then seeded uniform draws
-    (one value for all four contacts when ``shared``)."""
+def friction_samples(mu_range, n, seed=1, shared=False, n_contacts: int = 4) -> list:
+    """``n`` friction vectors (``n_contacts``,: a formation's contact count, the default formation's 4) from
+    ``mu_range``: all at ``lo``, all at ``hi``, then seeded uniform draws (one value for every contact when
+    ``shared``)."""
     lo, hi = mu_range
     rng = np.random.default_rng(seed)
-    draws = [np.full(4, rng.uniform(lo, hi)) if shared else rng.uniform(lo, hi, 4) for _ in range(max(n - 2, 0))]
-    return ([np.full(4, float(lo)), np.full(4, float(hi))] + draws)[:n]
+    draws = [np.full(n_contacts, rng.uniform(lo, hi)) if shared else rng.uniform(lo, hi, n_contacts)
+             for _ in range(max(n - 2, 0))]  # fmt: skip
+    return ([np.full(n_contacts, float(lo)), np.full(n_contacts, float(hi))] + draws)[:n]
 
 
 def replay_segments(columns) -> list:
@@ -272,7 +280,7 @@ def rows_pose(columns, k) -> np.ndarray:
     return np.array([columns["x_workpiece"][k], columns["y_workpiece"][k], columns["theta_workpiece"][k]], float)
 
 
-def replay_plan(columns, hand, mu, options=None, scenes=None) -> Replay:
+def replay_plan(columns, hand, mu, options=None, scenes=None, formation=None) -> Replay:
     """Re-simulate every in-contact segment of an exported plan at the friction vector ``mu``.
 
     Parameters
@@ -281,20 +289,23 @@ def replay_plan(columns, hand, mu, options=None, scenes=None) -> Replay:
         The plan's columns as read by :func:`qsplan.planner.export.plan_files.read_plan_csv`.
     hand : qsplan.hands.protocol.Hand
         The task's hand.
-    mu : float or array-like, shape (4,)
-        Friction of the contacts palm:0, palm:1, left, right (static = kinetic).
+    mu : float or array-like, shape (n_c,)
+        Friction of the formation's contacts (static = kinetic).
     options : qsplan.mechanics.motion.simulator.MotionOptions, optional
         Default ``max_step`` :data:`REPLAY_STEP` (a described hand's: at most its ``simulation_travel`` of workpiece
         travel per step) and ``max_switches = 0`` (stop at the first mode change).
     scenes : dict, optional
         A cache of the scenes built, to pass again to the replays of the same ``columns`` and
         ``hand`` at other friction vectors (the scenes do not depend on friction); same results.
+    formation : qsplan.hands.formations.Formation or str, optional
+        The plan's formation (the task's); default the registry's default.
 
     Returns
     -------
     Replay
     """
     from qsplan.hands.described_build import as_hand
+    from qsplan.hands.formations import DEFAULT_FORMATION, Formation, formation as registered_formation
     from qsplan.mechanics.motion.simulator import simulate
     from qsplan.mechanics.motion.system import make_friction
 
@@ -305,9 +316,14 @@ def replay_plan(columns, hand, mu, options=None, scenes=None) -> Replay:
         raise QsplanError(f"plan: column {missing[0]!r} missing; expected the columns of every joint of the hand")
     given = options
     options = options or _default_options()
-    mu = np.broadcast_to(np.asarray(mu, float), (4,)).copy()
+    formation = formation if isinstance(formation, Formation) else registered_formation(formation or DEFAULT_FORMATION)
+    n_c = formation.n_contacts
+    try:
+        mu = np.broadcast_to(np.asarray(mu, float), (n_c,)).copy()
+    except ValueError:
+        raise QsplanError(f"mu: expected one friction coefficient or {n_c} (one per contact); got {np.shape(mu)}") from None
     if np.any(~np.isfinite(mu)) or np.any(mu < 0):
-        raise QsplanError(f"mu: expected four nonnegative friction coefficients; got {mu.tolist()}")
+        raise QsplanError(f"mu: expected {n_c} nonnegative friction coefficients; got {mu.tolist()}")
     friction = make_friction(mu, mu)
     scenes = {} if scenes is None else scenes
     out, x_prev = [], None
@@ -319,7 +335,7 @@ def replay_plan(columns, hand, mu, options=None, scenes=None) -> Replay:
         tau = np.column_stack([np.asarray(columns[f"tau_{n}"], float)[rows] for n in names])
         effort = np.isfinite(tau).any(axis=0) | (np.array(names) == e)  # effort joints: those with a torque command
         velocity = np.column_stack([np.asarray(columns[f"qd_{n}"], float)[rows] for n in names])
-        system = ReplaySystem(hand, effort, t, velocity, tau, friction, scenes.setdefault(seg["phase"], {}))
+        system = ReplaySystem(hand, effort, t, velocity, tau, friction, formation, scenes.setdefault(seg["phase"], {}))
         k = rows[0]
         pose = rows_pose(columns, k)
         if x_prev is not None:

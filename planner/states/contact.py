@@ -19,17 +19,12 @@ from qsplan.mechanics.errors import QsplanError
 
 from qsplan.planner.task.task import Task
 
-__all__ = ["MODE", "TOUCH_AREA", "StateCheck", "check_contact_state", "check_free_state", "configuration_problem",
+__all__ = ["TOUCH_AREA", "StateCheck", "check_contact_state", "check_free_state", "configuration_problem",
            "contact_samples", "free_state_problem", "limit_problem", "mode_name"]
 
 #: Intersection area (m^2) below which two polygons only touch (kept for callers; the checks now measure
 #: overlaps by depth: :data:`qsplan.hands.collision.CONTACT_DEPTH_TOL`).
 TOUCH_AREA = 1e-10
-
-#: The in-contact segments' mode of today's formation (:data:`qsplan.hands.formations.FORMATIONS`): the workpiece
-#: slides on the palm and both fingertips (4S); read a task's from ``task.formation.mode``.
-MODE = "SSSS"
-
 
 def mode_name(letters: str) -> str:
     """The paper's name of a mode (``"SSSS"`` -> ``"4S"``, ``"RBSS"`` -> ``"R1S3"``: :attr:`ContactMode.name`)."""
