@@ -19,8 +19,8 @@ column                 unit     meaning
                                 velocity-controlled (every regrasp row, and the other finger in contact)
 ``tau_<joint>_min``    N m      lower edge of its guaranteed band (``-inf``: unbounded below); ``nan`` as above
 ``tau_<joint>_max``    N m      upper edge of its guaranteed band (``inf``: unbounded above); ``nan`` as above
-``mode``               -        contact mode the command guarantees, one letter per contact (palm:0, palm:1,
-                                left, right; ``SSSS`` = 4S); ``free`` on regrasp rows
+``mode``               -        contact mode the command guarantees, one letter per contact in the formation's
+                                order (``metadata.formation``; all S = 4S); ``free`` on regrasp rows
 ``margin``             N m      distance from the torque command to the nearer band edge; ``nan`` on regrasps
 ``x_workpiece``        m        workpiece pose: x of its centre of mass
 ``y_workpiece``        m        workpiece pose: y of its centre of mass

@@ -53,7 +53,7 @@ SCHEDULE_COLUMNS = (
                            "where the sample has no band"),
     ("tau_<joint>_min", "N m", "lower edge of the guaranteed band (-inf, JSON null: unbounded below)"),
     ("tau_<joint>_max", "N m", "upper edge of the guaranteed band (inf, JSON null: unbounded above)"),
-    ("mode", None, "the contact mode the command guarantees, one letter per contact (SSSS = 4S)"),
+    ("mode", None, "the contact mode the command guarantees, one letter R, S or B per contact (all S = 4S)"),
     ("margin", "N m", "distance from the command to the nearer band edge"),
 )  # fmt: skip
 

@@ -3,7 +3,7 @@
 :func:`plan_task` turns a :class:`qsplan.planner.task.task.Task` into a :class:`Plan`:
 
 1. **In-contact segments.**  Segment ``i`` slides the workpiece along the palm from
-   the previous waypoint to the next in mode 4S (``"SSSS"``); its configuration
+   the previous waypoint to the next in the formation's mode (4S today); its configuration
    variable is the workpiece's ``x`` alone (the fingers follow by tangency,
    :func:`qsplan.hands.two_finger.finger_angles`), so the only path is the straight line
    and there is nothing to search: no OMPL here.  The line is swept every

@@ -27,8 +27,8 @@ PLAN_COLUMNS = (
                                "while velocity-controlled"),
     ("tau_<joint>_max", "N m", "upper edge of the guaranteed band (inf, JSON null: unbounded above); nan (null) "
                                "while velocity-controlled"),
-    ("mode", None, "contact mode the command guarantees, one letter per contact (palm:0, palm:1, left, right; "
-                   "SSSS = 4S); free on regrasp rows"),
+    ("mode", None, "contact mode the command guarantees, one letter R, S or B per contact in the formation's order "
+                   "(metadata.formation; all S = 4S); free on regrasp rows"),
     ("margin", "N m", "distance from the torque command to the nearer band edge, in the effort joint's unit (N for a "
                       "prismatic joint); nan (null) on regrasp rows"),
     ("x_workpiece", "m", "workpiece pose: x of its centre of mass"),
