@@ -138,6 +138,40 @@ FORMATIONS = {
         description="the bottom edge on the palm, one point of each finger; 4S: sliding on the palm and under both "
                     "fingers (Section 5.2, Fig. 9)",
     ),
+    # Issue 23's reorientation (qsplan.hands.reorient): the instant that ends the palm-edge slide with the left
+    # finger flush on the longest edge, and the pivot that follows.  The planner does not serve them yet
+    # (qsplan.hands.described_states.check_formation refuses them by name).
+    "flush_to_pivot_v1": Formation(
+        name="flush_to_pivot_v1",
+        contacts=(
+            ContactSlot("palm:0", "palm", "vertex", 0, "the workpiece's bottom-left vertex on the palm"),
+            ContactSlot("palm:1", "palm", "vertex", 1, "the workpiece's bottom-right vertex on the palm"),
+            ContactSlot("left:base", "left", "any", None, "the left finger flush on the longest edge: the overlap's "
+                                                          "end toward the finger's base (vertex 0)"),
+            ContactSlot("left:tip", "left", "any", None, "the left finger flush on the longest edge: the overlap's end "
+                                                         "toward the fingertip (vertex 3)"),
+            ContactSlot("right", "right", "any", None, "the right finger on the workpiece (vertex 2)"),
+        ),
+        mode="BSSSS",
+        closing="last",
+        description="the flush instant ending the palm-edge slide (the left finger along the longest edge); the "
+                    "transition mode BSSSS: vertex 0 lifts, the workpiece pivots on vertex 1 into pivot_v1",
+    ),
+    "pivot_v1": Formation(
+        name="pivot_v1",
+        contacts=(
+            ContactSlot("palm:1", "palm", "vertex", 1, "the workpiece's vertex 1 on the palm: the pivot"),
+            ContactSlot("left:base", "left", "any", None, "the left finger flush on the longest edge: the overlap's "
+                                                          "end toward the finger's base (vertex 0)"),
+            ContactSlot("left:tip", "left", "any", None, "the left finger flush on the longest edge: the overlap's end "
+                                                         "toward the fingertip (vertex 3, later the fingertip's corner)"),
+            ContactSlot("right", "right", "any", None, "the right finger on the workpiece (vertex 2)"),
+        ),
+        mode="SSSS",
+        closing="last",
+        description="pivoting on vertex 1, the left finger flush on the longest edge (two contacts), the right finger "
+                    "on vertex 2; 4S: sliding at every contact while the workpiece turns clockwise",
+    ),
 }
 
 #: The formation of every task today.
