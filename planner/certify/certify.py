@@ -41,6 +41,7 @@ from qsplan.planner.certify.files import META_TOL, agreement_checks, metadata_ch
 from qsplan.planner.certify.inputs import (plan_columns_required, plan_sources, read_plan,
                                            read_plan_file, task_from_metadata)  # fmt: skip
 from qsplan.planner.certify.modes import disturbance_checks, mode_checks, row_scene, slip_reversals, slip_velocities
+from qsplan.planner.certify.timing import row_velocity, timing_checks
 from qsplan.planner.certify.route import (ENDPOINT_TOL, FREE_PATH_STEP, endpoint_checks, free_path_checks,
                                           rest_checks, structure_checks)  # fmt: skip
 from qsplan.planner.certify.rows import (
@@ -77,6 +78,10 @@ CHECKS = {
     "joint limit": "every joint inside the task's range (the hand's, narrowed by the task)",
     "speed": "joint and workpiece speeds within the task's limits over every step, and every velocity command",
     "continuity": "no jump where two rows share a time",
+    "timing": "every phase starts and ends at rest (speed_scale 0, every velocity command 0); the velocity commands "
+              "follow the time scaling's rule between rows",
+    "acceleration": "every velocity command changes within its joint's acceleration limit; the workpiece's inertial "
+                    "wrench between rows lies in the disturbance box every band was recomputed with",
     "motion": "velocity commands reach the next row; the solver moves the workpiece as the rows do",
     "contact": "every contact of the planned mode present on in-contact rows",
     "band": "the exported band recomputed from the task (every friction in the set, every competitor precluded), "
@@ -219,14 +224,13 @@ def _num(v):
     return float(v) if v is not None and math.isfinite(v) else None
 
 
-def _xdot_rows(cols, k) -> float:
-    """The workpiece's x velocity (m/s) at in-contact row ``k`` by a finite difference inside its phase."""
-    t, x, ph = cols["t"], cols["x_workpiece"], cols.get("phase")
-    same = (lambda i: ph[i] == ph[k]) if ph is not None else (lambda i: cols["mode"][i] != "free")
-    for a, b in ((k, k + 1), (k - 1, k)):
-        if 0 <= a and b < t.size and same(a) and same(b) and t[b] > t[a]:
-            return float((x[b] - x[a]) / (t[b] - t[a]))
-    return math.nan
+def _xdot_rows(cols, k, names) -> float:
+    """The workpiece's x velocity (m/s) the rows give at in-contact row ``k`` (the time scaling's rule,
+    :func:`qsplan.planner.certify.timing.row_velocity`); nan for a phase of one row."""
+    if "phase" not in cols or ("speed_scale" in cols and cols["speed_scale"][k] == 0.0):
+        return math.nan  # no phase; or at rest: no speed to compare (its direction is the band's and the modes')
+    moving = row_velocity(cols, k, names)
+    return math.nan if moving is None else float(moving[1])
 
 
 def certify_plan(plan, task, *, n_random: int = 8, seed: int = 0, force_margin: float = 0.0,
@@ -286,6 +290,8 @@ def certify_plan(plan, task, *, n_random: int = 8, seed: int = 0, force_margin: 
         whole += schema_checks(doc)
         whole += metadata_checks(doc.get("metadata"), task, cols)
     whole += structure_checks(cols)
+    if "phase" in cols:
+        whole += timing_checks(task, cols)
     rng = np.random.default_rng(seed)
     n = cols["t"].size
     roots = joint_housings(task.hand)
@@ -322,7 +328,7 @@ def certify_plan(plan, task, *, n_random: int = 8, seed: int = 0, force_margin: 
                     found.append(("contact", f"the row's scene cannot be built: {exc}"))
                 else:
                     scenes[k] = scene
-                    more, excluded = mode_checks(task, cols, k, mus, force_margin, _xdot_rows(cols, k), batched, scene)
+                    more, excluded = mode_checks(task, cols, k, mus, force_margin, _xdot_rows(cols, k, names), batched, scene)
                     found += more
                     if task.disturbance is not None:
                         found += disturbance_checks(task, cols, k, mus, force_margin, batched, scene)

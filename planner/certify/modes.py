@@ -46,7 +46,8 @@ def _fmt_mu(mu) -> str:
 
 def row_scene(task, cols, k):
     """The scene of in-contact row ``k`` rebuilt from the task (:func:`qsplan.hands.interface.scene_at`): the joints
-    with a torque command (and the row's ``effort_joint``) effort-controlled at it, the others at their ``qd``.
+    with a torque command (and the row's ``effort_joint``) effort-controlled at it, the others at their ``qd`` (a row
+    at rest: the direction of the motion that leaves or reaches it, :func:`qsplan.planner.certify.timing.row_velocity`).
 
     Raises
     ------
@@ -61,6 +62,11 @@ def row_scene(task, cols, k):
     tau = np.array([cols[f"tau_{n}"][k] for n in names], dtype=float)
     effort = np.isfinite(tau) | (np.array(names) == str(cols["effort_joint"][k]))
     qd = np.array([cols[f"qd_{n}"][k] for n in names], dtype=float)
+    if "speed_scale" in cols and cols["speed_scale"][k] == 0.0:  # at rest: the motion that leaves or reaches it
+        from qsplan.planner.certify.timing import row_velocity
+
+        moving = row_velocity(cols, k, names)
+        qd = np.where(effort, np.nan, moving[0]) if moving is not None else qd
     # method="generic": contacts found by polygon contact finding, the reference path, not the
     # closed-form grasp the planner uses (qsplan.hands.two_finger_analytic): a certifier shares no
     # shortcut with what it certifies (~2 ms per row); a chain hand's contacts are always found so

@@ -29,6 +29,8 @@ column                 unit     meaning
                                 in time order); ``metadata.phases[phase]`` names and describes it
 ``effort_joint``       -        the torque-controlled joint (``left``, ``right``; a described hand's joint
                                 name); ``none`` on regrasp rows
+``control_<joint>``    -        the joint's control at the row: ``torque``, ``velocity`` or ``hold``
+``speed_scale``        -        the time scaling: the fraction of the quasistatic speed commanded (0 at rest)
 =====================  =======  ==============================================================================
 
 Times are continuous over the plan; a phase's last row and the next phase's first row share a
@@ -53,7 +55,14 @@ import numpy as np
 from qsplan.planner.export.files import atomic_write, check_out_dir, check_outputs, csv_cell, json_value
 from qsplan.planner.export.schedule import FORMAT, VERSION
 from qsplan.planner.plan.table import PLAN_COLUMNS, column_family, is_word_column, plan_columns, plan_joints
+from qsplan.planner.task.dynamics import dynamics_metadata
 from qsplan.planner.task.record import task_record, task_tables
+
+#: ``metadata.time_scaling.rule``: how the rows are timed (:mod:`qsplan.planner.plan.timing`).
+TIME_SCALING_RULE = ("every phase starts and ends at rest (speed_scale 0, every qd 0); a slide is one rest-to-rest "
+                     "piece, a regrasp one per straight leg; between two rows the speed scale changes linearly in "
+                     "time (constant acceleration) and every joint moves along the straight line between the rows in "
+                     "proportion to the path covered; qd at a row is the quasistatic velocity times speed_scale")
 
 __all__ = ["PLAN_COLUMNS", "PLAN_FORMAT", "column_meanings", "export_plan", "plan_columns", "plan_joints",
            "disturbance_metadata", "plan_metadata", "plan_metadata_limits", "plain_json", "read_plan_csv", "task_tables"]
@@ -102,6 +111,8 @@ def plan_metadata(plan) -> dict:
             d["effort_unit"] = _joint_units(task.hand)[ph.effort_joint]["tau"]
         else:
             d.update(kind="regrasp", x_workpiece_m=float(np.ravel(ph.x)[0]))
+        if plan.timing:
+            d["time_scaling"] = plan.timing[i].as_dict()
         phases.append(d)
     doc = {
         "source": "qsplan: Trinkle & Zeng (1995), Section 5.2, Figs. 9-13; planned with OMPL",
@@ -121,6 +132,7 @@ def plan_metadata(plan) -> dict:
                     "max_margin_resolutions": MAX_MARGIN_RESOLUTIONS, "torque_resolution_N_m": task.torque_resolution,
                     "velocity_controlled_torque_cells": "nan in CSV, null in JSON"},
         "limits": plan_metadata_limits(task),
+        "time_scaling": dict(dynamics_metadata(task), rule=TIME_SCALING_RULE),
         "task_tables": task_tables(task),
         "task_record": task_record(task),
         "narrowest_band": {"phase": name, "t_s": _num(t), "width_N_m": _num(w)},

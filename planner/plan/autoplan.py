@@ -35,9 +35,11 @@ from qsplan.mechanics.errors import QsplanError
 
 from qsplan.planner.plan.results import ContactSegmentPlan, Plan, PlanFailure
 from qsplan.planner.plan.steps import RegraspStep, SearchSummary, SlideStep
+from qsplan.planner.plan.timing import time_scale
 from qsplan.planner.search.ompl_search import search_route
 from qsplan.planner.search.tables import band_tables, table_grid
 from qsplan.planner.task.goal import feature_text
+from qsplan.hands.interface import joint_units
 
 __all__ = ["FREE_GRID", "FREE_SEARCH_MARGIN", "MAX_GOAL_GRASPS", "MAX_ROUNDS", "grasp_rows", "goal_nodes",
            "plan_automatic", "route_phases", "start_nodes"]
@@ -309,8 +311,11 @@ def plan_automatic(task, options=None, progress=None, planner: str = "widest", t
             raise PlanFailure(no_route_report(task, tables, graph, starts, i_start, goals, forbidden))
         best = max(found, key=lambda r: (r.route.width, -r.route.regrasps, -len(r.route.steps)))
         route = best.route
+        tau_units = dict(zip(task.hand.joint_names, joint_units(task.hand, "tau")))
+        units = sorted({tau_units[e] for e in tables.efforts})  # a jaw's force in N
         progress(f"route ({planner}, round {rounds}): {len(route.steps)} steps, {route.regrasps} regrasps, narrowest "
-                 f"band {route.width:.4g} N m, {best.evaluations} evaluations in {best.seconds:.3f} s")  # fmt: skip
+                 f"band {route.width:.4g} {' or '.join(units)}, {best.evaluations} evaluations in "
+                 f"{best.seconds:.3f} s")  # fmt: skip
         try:
             phases, seq = _realise(task, tables, route, options, progress, counters)
             break
@@ -332,6 +337,7 @@ def plan_automatic(task, options=None, progress=None, planner: str = "widest", t
     # precluded, per configuration, torque-controlled finger and direction), then the dense sweeps and OMPL's checks
     plan = Plan(task, tuple(phases), time.perf_counter() - t_start, counters[0] + tables.band_states,
                 counters[1] + tables.seconds, options, tuple(seq) + (meta,))  # fmt: skip
+    plan = time_scale(plan)
     plan.check()
     if not any(isinstance(p, ContactSegmentPlan) for p in plan.phases):
         raise QsplanError("goal: reached by regrasps alone; the plan has no in-contact segment to export")

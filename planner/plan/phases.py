@@ -247,7 +247,7 @@ def slide_phase(task, name, x0, x1, effort, direction, touching, comps, t0, opti
     # the configuration is the workpiece's x (the fingers follow the grasp, a described hand's free joints their
     # path): the only path is the straight line, and its dense sweep is the whole check
     line = straight_path(x0, x1)
-    x = densify(line[:, 0], SWEEP_STEP)
+    x = densify(line[:, 0], min(SWEEP_STEP, 0.5 * abs(x1 - x0)))  # at least 3 rows: the slide starts and ends at rest
     t_check = time.perf_counter()
     k, S, band, speed, why = sweep_contact_segment(task, name, x, effort, direction, touching, comps, grasp, path)
     seconds = time.perf_counter() - t_check

@@ -55,6 +55,9 @@ class ContactSegmentPlan:
         Workpiece speed (m/s).
     planning : qsplan.planner.search.ompl_bridge.PlanResult
         The dense sweep's outcome (no OMPL query: the path is the straight line).
+    speed_scale : ndarray, shape (n,), or None
+        The time scaling at each row (:mod:`qsplan.planner.plan.timing`): the fraction of the quasistatic speed
+        commanded, 0 at rest (the first and last rows), 1 cruising; None before the time scaling.
     """
 
     name: str
@@ -72,6 +75,7 @@ class ContactSegmentPlan:
     competitors: tuple
     speed: float
     planning: object
+    speed_scale: np.ndarray | None = None
     in_contact = True  # the workpiece held in a contact mode (a class constant, not a field)
 
     @property
@@ -94,6 +98,8 @@ class RegraspPlan:
         Joint angles (rad) and velocities (rad/s), both joints velocity-controlled.
     planning : tuple of qsplan.planner.search.ompl_bridge.PlanResult
         Opening and closing.
+    speed_scale : ndarray, shape (n,), or None
+        As :attr:`ContactSegmentPlan.speed_scale`: 0 at every row where the straight-line motion turns.
     """
 
     name: str
@@ -102,6 +108,7 @@ class RegraspPlan:
     q: np.ndarray
     qd: np.ndarray
     planning: tuple
+    speed_scale: np.ndarray | None = None
     in_contact = False  # the fingers move in free space (a class constant, not a field)
 
 
@@ -126,6 +133,8 @@ class Plan:
         The sequence the planner chose (automatic planning, :mod:`qsplan.planner.search`): one typed step per
         phase (:class:`qsplan.planner.plan.steps.SlideStep`, :class:`~qsplan.planner.plan.steps.RegraspStep`),
         then the search's :class:`~qsplan.planner.plan.steps.SearchSummary`; empty for a scripted task.
+    timing : tuple of qsplan.planner.plan.timing.PhaseTiming
+        Each phase's time scaling (stops and acceleration limits, :mod:`qsplan.planner.plan.timing`); empty before it.
     """
 
     task: Task
@@ -135,6 +144,7 @@ class Plan:
     ompl_seconds: float
     options: PlannerOptions = field(default_factory=PlannerOptions)
     sequence: tuple = ()
+    timing: tuple = ()
 
     @property
     def segments(self) -> tuple:

@@ -10,15 +10,19 @@ at its own rate; :func:`sample_columns` turns the rows into its ticks, by one ru
 * **control mode** of a joint, per phase: ``torque`` where the plan gives it a torque (``tau_<joint>``, the
   phase's effort joint), else ``velocity``; ``hold`` is a velocity-controlled joint that does not move over
   the tick (``qd = 0``, ``q`` held).
-* **position** ``q``: linear in time between the rows of the tick's phase (exact at the rows).
+* **position** ``q``: along the straight line between the rows of the tick's phase, in proportion to the path
+  covered (exact at the rows): between rows ``k`` and ``k + 1`` (``dt`` apart, speed scales ``u_k``, ``u_{k+1}``:
+  the ``speed_scale`` column, :mod:`qsplan.planner.plan.timing`) the speed scale changes linearly in time, so at
+  ``tau`` after row ``k`` the fraction covered is
+  ``sigma = (u_k tau + (u_{k+1} - u_k) tau^2 / (2 dt)) / ((u_k + u_{k+1}) dt / 2)`` (constant acceleration; linear
+  in time where the speed scale is constant, or where a plan has no ``speed_scale`` column).
 * **velocity** ``qd``: the rate of that position over the tick, ``(q(t_{i+1}) - q(t_i)) / (t_{i+1} - t_i)``
-  (the last tick: the rate of the rows' interval it ends).  A controller that holds each tick's ``qd``
-  until the next tick lands on ``q`` at every tick, so on every row that falls on a tick.  On a regrasp
-  row it is the row's ``qd`` (held until the next row, to 1e-9 rad per row: the certifier's check); in
-  contact the rows' ``qd`` sample the rate of the smooth slide, and the linear rule differs from them
-  by the path's curvature between rows (a few 1e-4 rad/s on the bundled plans).
-* **torque** ``tau``: linear in time between the rows of the tick's phase.  The band guarantee holds at
-  the rows (every 0.5 mm of travel); between them the command is the interpolation of guaranteed ones.
+  (the last tick: the rate at its instant, 0 at the plan's final rest).  A controller that holds each tick's
+  ``qd`` until the next tick lands on ``q`` at every tick, so on every row that falls on a tick.  Every phase
+  starts and ends at rest, so ticks near a switch command small velocities, never a step.
+* **torque** ``tau``: along the path like ``q`` (``tau_k + (tau_{k+1} - tau_k) sigma``): bands are functions of
+  the configuration.  The band guarantee holds at the rows (every 0.5 mm of travel); between them the command is
+  the interpolation of guaranteed ones.
 
 ``q`` is the command of a velocity or held joint (``nan`` under torque control), ``qd`` of a velocity joint
 (0 when held, ``nan`` under torque), ``tau`` of a torque joint (``nan`` otherwise); :attr:`PlanSamples.q_plan`
@@ -37,7 +41,7 @@ import numpy as np
 from qsplan.hands.interface import JOINT_UNITS
 from qsplan.mechanics.errors import QsplanError
 
-__all__ = ["CONTROL_MODES", "MAX_TICKS", "TIME_SNAP", "PlanSamples", "sample_columns", "tick_times"]
+__all__ = ["CONTROL_MODES", "MAX_TICKS", "TIME_SNAP", "PlanSamples", "path_fraction", "sample_columns", "tick_times"]
 
 #: A joint's control modes at a tick: track ``q`` and ``qd``; apply ``tau``; hold ``q`` (``qd = 0``).
 CONTROL_MODES = ("velocity", "torque", "hold")
@@ -149,8 +153,29 @@ def _phases(cols, joints) -> list:
     return out
 
 
+def path_fraction(tc, tr, u) -> tuple:
+    """Where ticks ``tc`` (s, within ``tr[0]``..``tr[-1]``) fall between a phase's rows (times ``tr``, speed scales
+    ``u``): ``(interval k, fraction sigma of it covered, d sigma / dt at the tick (1/s))``, each shape (n,), by the
+    module's rule (constant acceleration of the speed scale between rows)."""
+    if tr.size < 2:
+        z = np.zeros(tc.size)
+        return np.zeros(tc.size, dtype=int), z, z
+    k = np.clip(np.searchsorted(tr, tc, side="right") - 1, 0, tr.size - 2)
+    dt = tr[k + 1] - tr[k]
+    tau = np.clip(tc - tr[k], 0.0, dt)
+    a, b = u[k], u[k + 1]
+    total = 0.5 * (a + b) * dt
+    ok = total > 0
+    safe = np.where(ok, total, 1.0)
+    sigma = np.where(ok, (a * tau + 0.5 * (b - a) * tau**2 / dt) / safe, tau / dt)
+    rate = np.where(ok, (a + (b - a) * tau / dt) / safe, 1.0 / dt)
+    return k, np.clip(sigma, 0.0, 1.0), rate
+
+
 def tick_times(duration, rate) -> np.ndarray:
-    """The ticks ``k / rate`` (s) from 0 to ``duration`` (s, within :data:`TIME_SNAP`), shape (n,).
+    """The ticks ``k / rate`` (s) from 0 to ``duration`` (s), shape (n,); the last tick is ``duration`` itself (a plan
+    ends at rest there: its last command is its final position): the tick within :data:`TIME_SNAP` of it, or one
+    more tick when it falls between two.
 
     Raises
     ------
@@ -160,10 +185,16 @@ def tick_times(duration, rate) -> np.ndarray:
     rate = float(rate)
     if not (np.isfinite(rate) and rate > 0):
         raise QsplanError(f"rate: expected a positive number of ticks per second (Hz); got {rate!r}")
-    n = int(np.floor((float(duration) + TIME_SNAP) * rate)) + 1
+    duration = float(duration)
+    n = int(np.floor((duration + TIME_SNAP) * rate)) + 1
     if n > MAX_TICKS:
         raise QsplanError(f"rate: {rate:g} Hz gives {n} ticks over {duration:g} s; at most {MAX_TICKS} (a lower rate)")
-    return np.arange(n) / rate
+    t = np.arange(n) / rate
+    if duration - t[-1] <= TIME_SNAP:
+        t[-1] = duration if n > 1 else t[-1]
+    else:
+        t = np.append(t, duration)
+    return t
 
 
 def sample_columns(cols, units, times) -> PlanSamples:
@@ -212,19 +243,21 @@ def sample_columns(cols, units, times) -> PlanSamples:
     torque = np.zeros((n, nj), dtype=bool)
     phase, mode = np.zeros(n, dtype=int), np.empty(n, dtype=object)
     last_rate = np.zeros(nj)
+    scale = np.asarray(cols["speed_scale"], float) if "speed_scale" in cols else np.ones(t_rows.size)
     for i, (p, rows, effort) in enumerate(phases):
         at = np.flatnonzero(which == i)
         tr = t_rows[rows]
         tc = np.clip(ts[at], tr[0], tr[-1])
         phase[at], mode[at], torque[at] = p, str(cols["mode"][rows[0]]), effort
+        k, sigma, rate = path_fraction(tc, tr, scale[rows])
         for j, name in enumerate(joints):
             qr = np.asarray(cols[f"q_{name}"], float)[rows]
-            q_plan[at, j] = np.interp(tc, tr, qr)
+            q_plan[at, j] = qr[k] + (qr[k + 1] - qr[k]) * sigma if tr.size > 1 else qr[0]
             if effort[j]:
-                tau[at, j] = np.interp(tc, tr, np.asarray(cols[f"tau_{name}"], float)[rows])
-            if i == which[-1] and tr.size > 1:  # the last tick: the rate of the rows' interval it ends
-                k = int(np.clip(np.searchsorted(tr, tc[-1], side="left"), 1, tr.size - 1))
-                last_rate[j] = (qr[k] - qr[k - 1]) / (tr[k] - tr[k - 1])
+                tr_tau = np.asarray(cols[f"tau_{name}"], float)[rows]
+                tau[at, j] = tr_tau[k] + (tr_tau[k + 1] - tr_tau[k]) * sigma if tr.size > 1 else tr_tau[0]
+            if i == which[-1] and tr.size > 1:  # the last tick: the rate at its instant
+                last_rate[j] = (qr[k[-1] + 1] - qr[k[-1]]) * rate[-1]
     qd = np.empty((n, nj))
     qd[:-1] = np.diff(q_plan, axis=0) / np.diff(ts)[:, None]
     qd[-1] = last_rate

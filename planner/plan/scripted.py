@@ -56,6 +56,7 @@ from qsplan.planner.plan.failure import configuration_report, failure_report
 from qsplan.planner.plan.phases import (DEFAULT_OPTIONS, REGRASP_OPENING, SWEEP_STEP, regrasp_phase, slide_phase,
                                         sweep_contact_segment)
 from qsplan.planner.plan.results import ContactSegmentPlan, Plan, PlanFailure, RegraspPlan
+from qsplan.planner.plan.timing import time_scale
 from qsplan.planner.search.ompl_bridge import PlannerOptions
 from qsplan.planner.states.contact import (
     TOUCH_AREA,
@@ -286,6 +287,6 @@ def plan_task(task: Task, options: PlannerOptions | None = None, progress=None, 
         seg = _segment(task, i, x0, x1, t0, options, progress, counters, path)
         phases.append(seg)
         t0 = float(seg.t[-1])
-    plan = Plan(task, tuple(phases), time.perf_counter() - t_start, counters[0], counters[1], options)
+    plan = time_scale(Plan(task, tuple(phases), time.perf_counter() - t_start, counters[0], counters[1], options))
     plan.check()
     return plan

@@ -3,7 +3,7 @@ belong to the plan; :mod:`qsplan.planner.export.plan_files` writes them as CSV a
 results.Plan.sample` samples them at a controller's rate).
 
 Columns (:data:`PLAN_COLUMNS`): ``t``; per joint ``q_<joint>``, ``qd_<joint>``, ``tau_<joint>`` and its band
-``tau_<joint>_min`` / ``_max``; ``mode``, ``margin``, the workpiece pose, ``phase``, ``effort_joint``.  Units SI, a
+``tau_<joint>_min`` / ``_max``; ``mode``, ``margin``, the workpiece pose, ``phase``, ``effort_joint``, per joint ``control_<joint>``, ``speed_scale``.  Units SI, a
 joint's by its kind (rad, rad/s, N m; m, m/s, N).
 """
 
@@ -40,6 +40,10 @@ PLAN_COLUMNS = (
     ("control_<joint>", None, "the joint's control at this row: torque (apply tau_<joint>, a force for a prismatic "
                               "joint), velocity (track q_<joint> with qd_<joint>) or hold (velocity-controlled at "
                               "rest: hold q_<joint>)"),
+    ("speed_scale", None, "the time scaling at this row: the fraction of the phase's quasistatic speed commanded (0 at "
+                          "rest: every phase starts and ends at rest; 1 cruising); between two rows it changes linearly "
+                          "in time and every joint moves along the straight line between them in proportion to the "
+                          "path (metadata.time_scaling)"),
 )  # fmt: skip
 
 #: A joint's control at a row (``control_<joint>``; the same words as :data:`qsplan.planner.plan.sampling.CONTROL_MODES`).
@@ -108,6 +112,7 @@ def plan_columns(plan) -> tuple:
         order += [f"tau_{n}", f"tau_{n}_min", f"tau_{n}_max"]
     order += ["mode", "margin", "x_workpiece", "y_workpiece", "theta_workpiece", "phase", "effort_joint"]
     order += [f"control_{n}" for n in joints]  # after every earlier column: extended, never reordered
+    order += ["speed_scale"]
     cols = {k: [] for k in order}
     y0 = plan.task.hand.rest_height
     for i, ph in enumerate(plan.phases):
@@ -133,6 +138,7 @@ def plan_columns(plan) -> tuple:
         for j, name in enumerate(joints):
             mine = contact and ph.effort_joint == name
             cols[f"control_{name}"] += [row_control(mine, float(v)) for v in ph.qd[:, j]]
+        cols["speed_scale"] += (np.ones(n) if ph.speed_scale is None else ph.speed_scale).tolist()
     units = {}
     for k in order:
         (family, unit, _), joint = column_family(k, joints)

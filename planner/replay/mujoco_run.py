@@ -94,7 +94,7 @@ class MujocoSim:
             raise QsplanError("plan: it lasts no longer than one control tick; nothing to execute")
         k = np.clip(np.searchsorted(t, rows_t), 1, t.size - 1)
         self.row_tick = np.where(np.abs(t[k - 1] - rows_t) <= np.abs(t[k] - rows_t), k - 1, k)  # the nearest tick
-        half = 0.5 * float(np.min(dt, initial=np.inf))
+        half = 0.5 * float(np.max(dt))  # the control period (a last tick at the plan's end may be closer)
         if np.any(np.abs(t[self.row_tick] - rows_t) > half):
             raise QsplanError("plan: a row lies outside the sampled ticks")
         # the ticks judged for each row: to the next row of its phase, a phase's last row's from the previous one
@@ -115,9 +115,12 @@ class MujocoSim:
         s, d, m = self.samples, self.data, self.model
         torque = s.control[i] == "torque"
         qd = np.where(torque | hold, 0.0, np.nan_to_num(s.qd[i]))
+        taken = ~torque & self.was_torque  # torque -> position: latch the measured position (bumpless transfer)
+        self.offset = np.where(torque, 0.0, np.where(taken, d.qpos[self.qadr] - np.nan_to_num(s.q[i]), self.offset))
+        self.was_torque = torque
         m.actuator_gainprm[self.servo, 0] = np.where(torque, 0.0, self.gain)
         m.actuator_biasprm[self.servo, 1:3] = np.where(torque[:, None], 0.0, self.bias)
-        d.act[self.act] = np.where(torque, 0.0, np.nan_to_num(s.q[i]) + qd * self.lead)
+        d.act[self.act] = np.where(torque, 0.0, np.nan_to_num(s.q[i]) + self.offset + qd * self.lead)
         d.ctrl[self.servo] = qd
         d.ctrl[self.motor] = np.where(torque, np.nan_to_num(s.tau[i]), 0.0)
 
@@ -164,6 +167,8 @@ class MujocoSim:
         d.qpos[:3] = self.start_pose
         d.qpos[self.qadr] = s.q_plan[0]
         mj.mj_forward(m, d)
+        self.offset = np.zeros(len(self.qadr))
+        self.was_torque = np.zeros(len(self.qadr), dtype=bool)
         self._command(0, hold=True)
         if self.n_preload:
             mj.mj_step(m, d, nstep=self.n_preload)

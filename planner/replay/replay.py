@@ -15,7 +15,10 @@ The simulated system (:class:`ReplaySystem`) has the state
 ``[x, y, theta, q_0, ..., q_{n_j - 1}, t]`` (m, m, rad, the joints in the hand's order in
 rad or m, s): the workpiece pose, the joint positions and the plan's clock, which indexes
 the commands.  Every velocity-controlled joint follows its joint-velocity column and the
-effort-controlled joint its torque column, both interpolated linearly in time between rows;
+effort-controlled joint its torque column, both interpolated linearly between rows, along the path at
+quasistatic speed (:func:`qsplan.planner.plan.timing.quasistatic_rows`: the model is homogeneous in the velocity
+input, so the plan's stops and accelerations, which change no path, are left out; the plan's clock is then the
+path parameter);
 scenes come from :func:`qsplan.hands.interface.scene_at`.  Between segments the plan's regrasp
 puts both fingers back on the workpiece where it is, so each segment starts from the simulated
 end of the previous one (errors carry over): the paper's fingers by tangency with the planned
@@ -308,6 +311,7 @@ def replay_plan(columns, hand, mu, options=None, scenes=None, formation=None) ->
     from qsplan.hands.formations import DEFAULT_FORMATION, Formation, formation as registered_formation
     from qsplan.mechanics.motion.simulator import simulate
     from qsplan.mechanics.motion.system import make_friction
+    from qsplan.planner.plan.timing import quasistatic_rows
 
     hand = as_hand(hand)
     names = hand.joint_names
@@ -331,10 +335,14 @@ def replay_plan(columns, hand, mu, options=None, scenes=None, formation=None) ->
         rows, e = seg["rows"], seg["effort_joint"]
         if e not in names:
             raise QsplanError(f"plan: effort_joint {e!r} in phase {seg['phase']} is no joint of the hand {names}")
-        t = np.asarray(columns["t"], float)[rows]
         tau = np.column_stack([np.asarray(columns[f"tau_{n}"], float)[rows] for n in names])
         effort = np.isfinite(tau).any(axis=0) | (np.array(names) == e)  # effort joints: those with a torque command
-        velocity = np.column_stack([np.asarray(columns[f"qd_{n}"], float)[rows] for n in names])
+        # the model is quasistatic: replay along the path at speed scale 1 (the phase's stops carry no motion)
+        u = np.asarray(columns["speed_scale"], float)[rows] if "speed_scale" in columns else np.ones(len(rows))
+        q_rows = np.column_stack([np.asarray(columns[f"q_{n}"], float)[rows] for n in names])
+        qd_rows = np.column_stack([np.asarray(columns[f"qd_{n}"], float)[rows] for n in names])
+        s, velocity = quasistatic_rows(np.asarray(columns["t"], float)[rows], u, q_rows, qd_rows)
+        t = float(columns["t"][rows[0]]) + s  # the replay's clock: the plan's start time plus the path parameter
         system = ReplaySystem(hand, effort, t, velocity, tau, friction, formation, scenes.setdefault(seg["phase"], {}))
         k = rows[0]
         pose = rows_pose(columns, k)

@@ -18,7 +18,7 @@ from qsplan.mechanics.errors import QsplanError
 from qsplan.mechanics.model.fields import in_range, short_repr
 
 __all__ = ["PLAN_FORCE_MARGIN", "TASK_RANGES", "WORKPIECE_KEYS", "HandChoice", "check_hand", "hand_from_task_table",
-           "task_disturbance",
+           "start_joints_of", "task_disturbance",
            "in_task_range", "plan_force_margin", "short_repr", "task_number", "field_name"]
 
 #: Plausible physical range ``(lo, hi)`` of every number of a task, with its unit; outside it a value is
@@ -259,3 +259,24 @@ def task_disturbance(table, field: str = "controller.disturbance"):
         return check_wrench_box(WrenchBox(*corners))
     except QsplanError as exc:
         raise QsplanError(f"controller.{exc}") from None
+
+
+def start_joints_of(hand, table) -> np.ndarray | None:
+    """A described hand's ``[start]``: every free joint by name (rad or m), or none of them (the planner chooses)."""
+    if not isinstance(table, dict):
+        raise QsplanError(f"start: expected a table of the free joints' positions; got {short_repr(table)}")
+    free = [hand.joint_names[j] for j in hand.free_joints]
+    extra = sorted(set(table) - set(free))
+    if extra:
+        raise QsplanError(f"start.{field_name(extra[0])}: unknown field; expected the free joints {', '.join(free)} (each finger's "
+                          "last joint closes onto the workpiece)")  # fmt: skip
+    if not table:
+        return None
+    missing = [n for n in free if n not in table]
+    if missing:
+        raise QsplanError(f"start.{missing[0]}: missing (give every free joint: {', '.join(free)})")
+    q = np.zeros(len(hand.joint_names))
+    for j in hand.free_joints:
+        q[j] = task_number(table[hand.joint_names[j]], f"start.{hand.joint_names[j]}", "rad or m")
+    q.setflags(write=False)
+    return q

@@ -31,7 +31,8 @@ __all__ = ["PAPER_DEFAULTS", "LIMIT_KEYS", "JointLimits", "resolve_limits"]
 PAPER_DEFAULTS = {"range": (0.05, 3.09), "speed": 0.5}
 
 #: The keys of ``[limits]`` besides the joints' names.
-LIMIT_KEYS = ("joint_speed", "speed", "workpiece_speed")
+LIMIT_KEYS = ("joint_speed", "speed", "workpiece_speed", "workpiece_acceleration", "joint_acceleration", "acceleration",
+              "release_acceleration")
 
 #: A task's range may touch the hand's edge up to rounding of decimal values written in two files (rad or m).
 EDGE_TOL = 1e-12

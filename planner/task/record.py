@@ -60,10 +60,17 @@ def task_tables(task) -> dict:
 def task_record(task) -> dict:
     """The task as a task file's tables (see the module docstring); :func:`qsplan.planner.task.task.task_from_record`
     reads it back to an equal task."""
+    from qsplan.planner.task.dynamics import task_dynamics
+
     hand = task.hand
     limits = {n: [float(v) for v in task.joint_limits[j]] for j, n in enumerate(hand.joint_names)}
     limits["speed"] = {n: float(task.joint_speeds[j]) for j, n in enumerate(hand.joint_names)}
     limits["workpiece_speed"] = float(task.workpiece_speed)
+    dyn = task_dynamics(task)
+    limits["workpiece_acceleration"] = float(dyn.workpiece_acceleration)
+    limits["acceleration"] = {n: float(dyn.joint_accelerations[j]) for j, n in enumerate(hand.joint_names)}
+    if "revolute" in hand.joint_kinds:
+        limits["release_acceleration"] = float(dyn.release_accelerations[list(hand.joint_kinds).index("revolute")])
     doc = {"version": RECORD_VERSION, "name": task.name, "formation": task.formation.name, "hand": hand_record(hand),
            **task_tables(task),
            "friction": {"range": [float(v) for v in task.mu_range], "shared": bool(task.shared_mu)},
@@ -71,6 +78,6 @@ def task_record(task) -> dict:
                           "min_normal_force": float(task.force_margin.normal),
                           "min_coulomb_slack": float(task.force_margin.slack)},
            "limits": limits}  # fmt: skip
-    if task.disturbance is not None:
+    if task.disturbance is not None and dyn.source == "task":  # the default box follows from the limits
         doc["controller"]["disturbance"] = {"lo": list(task.disturbance.lo), "hi": list(task.disturbance.hi)}
     return doc

@@ -1,15 +1,13 @@
 """Planning tasks for the two-finger hand (Section 5.2, Fig. 9): what a plan must achieve, and nothing more.
 
-A task names the hand and its workpiece, the workpiece's start and the goal of
-each in-contact segment, the friction uncertainty, the torque resolution of the
-effort-controlled joint's controller and the joint and speed limits.  Everything
-else is derived by :mod:`qsplan.planner.plan.scripted`: the contacts (from the polygons), the
-desired mode of each segment (4S: the workpiece slides on the palm and under
-both fingers), which finger is effort-controlled (the control-mode partitioner
-and the guaranteed bands) and the grasps (the fingers' tangency with the workpiece).
+A task names the hand and its workpiece, the workpiece's start and the goal of each in-contact segment, the
+friction uncertainty, the torque resolution of the effort-controlled joint's controller and the joint, speed and
+acceleration limits.  Everything else is derived by :mod:`qsplan.planner.plan.scripted`: the contacts (from the
+polygons), the desired mode of each segment (4S), which finger is effort-controlled (the control-mode
+partitioner and the guaranteed bands) and the grasps (the fingers' tangency with the workpiece).
 
-The workpiece always rests on its bottom edge on the palm (``y`` = the hand's
-rest height, ``theta = 0``), so its pose in a task is its centre-of-mass ``x``.
+The workpiece rests on its bottom edge on the palm (``y`` = the hand's rest height, ``theta = 0``), so its
+pose in a task is its centre-of-mass ``x``.
 
 TOML form (all SI: m, kg, rad, s, N m)::
 
@@ -38,6 +36,9 @@ TOML form (all SI: m, kg, rad, s, N m)::
     joint_speed = 0.5            # rad/s, every revolute joint
     speed = { left = 0.4 }       # optional: a joint's speed by name, in its unit (rad/s, m/s)
     workpiece_speed = 0.01       # m/s
+    workpiece_acceleration = 0.02  # m/s^2, optional: phases start and end at rest (qsplan.planner.task.dynamics)
+    joint_acceleration = 0.5     # rad/s^2, optional, every revolute joint; [limits.acceleration] by joint name
+    release_acceleration = 0.15  # rad/s^2, optional: the regrasp legs that leave and reach the workpiece
 
 :func:`load_task` reads it; :func:`make_task` is the Python equivalent; :func:`task_from_record` reads the same
 tables from a dict (:func:`qsplan.planner.task.record.task_record` writes a task as one: the round trip
@@ -56,8 +57,9 @@ import numpy as np
 from qsplan.mechanics.bands.effort import ForceMargin, check_force_margin
 from qsplan.mechanics.errors import QsplanError
 from qsplan.mechanics.model.friction import check_mu_range
+from qsplan.planner.task.dynamics import resolve_dynamics
 from qsplan.planner.task.fields import (PLAN_FORCE_MARGIN, TASK_RANGES, check_hand, field_name, hand_from_task_table,
-                                        in_task_range, plan_force_margin, short_repr, task_disturbance,
+                                        in_task_range, plan_force_margin, short_repr, start_joints_of, task_disturbance,
                                         task_number)  # fmt: skip
 from qsplan.hands.formations import DEFAULT_FORMATION, FORMATIONS, Formation
 from qsplan.planner.task.goal import Goal, make_goal, make_start_features
@@ -128,7 +130,11 @@ class Task:
         :data:`qsplan.hands.formations.FORMATIONS`, the bottom edge on the palm and a point of each finger, 4S).
     disturbance : qsplan.mechanics.bands.disturbance.WrenchBox or None
         A box of external wrenches on the workpiece (N, N, N m) every guaranteed band and preclusion withstands
-        (:mod:`qsplan.mechanics.bands.disturbance`); None: none.
+        (:mod:`qsplan.mechanics.bands.disturbance`): the task's, else the inertial load of the time scaling
+        (:func:`qsplan.planner.task.dynamics.inertial_box`); None only for a Task built by hand.
+    dynamics : qsplan.planner.task.dynamics.Dynamics or None
+        The time scaling's limits (accelerations; the box's source); None only for a Task built by hand
+        (:func:`qsplan.planner.task.dynamics.task_dynamics` gives the defaults).
     """
 
     name: str
@@ -148,6 +154,7 @@ class Task:
     start_joints: np.ndarray | None = None
     formation: Formation = FORMATIONS[DEFAULT_FORMATION]
     disturbance: object = None
+    dynamics: object = None
 
     @property
     def joint_speeds(self) -> np.ndarray:
@@ -176,7 +183,8 @@ def _pair(value, field, unit) -> tuple:
 def make_task(hand, start_x, waypoints=None, mu_range=(0.0, 0.2), torque_resolution=0.02, shared_mu=False,
               joint_limits=None, joint_speed=None, workpiece_speed=0.01,
               name="task", force_margin=None, goal=None, start=None, base_dir=None, joint_speeds=None,
-              formation=None, disturbance=None) -> Task:  # fmt: skip
+              formation=None, disturbance=None, workpiece_acceleration=None, joint_acceleration=None,
+              joint_accelerations=None, release_acceleration=None) -> Task:  # fmt: skip
     """Validate and build a :class:`Task` (parameters as its attributes; ``hand`` a TwoFingerHand or a dict of
     :func:`qsplan.hands.two_finger.make_two_finger_hand` arguments).  Either ``waypoints`` (a scripted
     sequence) or ``goal`` (the ``[goal]`` table as a dict, or a :class:`Goal`: the planner finds the sequence);
@@ -211,7 +219,7 @@ def make_task(hand, start_x, waypoints=None, mu_range=(0.0, 0.2), torque_resolut
     n_v = len(hand.workpiece)
     start_joints = None
     if chain:
-        start_joints = _start_joints(hand, {} if start is None else start)
+        start_joints = start_joints_of(hand, {} if start is None else start)
         start_features = (("inner", None), ("inner", None))
     else:
         start_features = make_start_features({} if start is None else start, n_v)
@@ -265,30 +273,11 @@ def make_task(hand, start_x, waypoints=None, mu_range=(0.0, 0.2), torque_resolut
         from qsplan.hands.formations import formation as registered
 
         formation = registered(formation)
+    dyn = resolve_dynamics(hand, task_disturbance(disturbance), workpiece_acceleration, joint_acceleration,
+                           joint_accelerations, release_acceleration)  # fmt: skip
     return Task(name, hand, start_x, wp, (lo, hi), bool(shared_mu), checked["torque_resolution"], limits,
                 float(np.min(speeds)), checked["workpiece_speed"], force_margin, goal, start_features, speeds,
-                start_joints, formation, task_disturbance(disturbance))  # fmt: skip
-
-
-def _start_joints(hand, table) -> np.ndarray | None:
-    """A described hand's ``[start]``: every free joint by name (rad or m), or none of them (the planner chooses)."""
-    if not isinstance(table, dict):
-        raise QsplanError(f"start: expected a table of the free joints' positions; got {short_repr(table)}")
-    free = [hand.joint_names[j] for j in hand.free_joints]
-    extra = sorted(set(table) - set(free))
-    if extra:
-        raise QsplanError(f"start.{field_name(extra[0])}: unknown field; expected the free joints {', '.join(free)} (each finger's "
-                          "last joint closes onto the workpiece)")  # fmt: skip
-    if not table:
-        return None
-    missing = [n for n in free if n not in table]
-    if missing:
-        raise QsplanError(f"start.{missing[0]}: missing (give every free joint: {', '.join(free)})")
-    q = np.zeros(len(hand.joint_names))
-    for j in hand.free_joints:
-        q[j] = task_number(table[hand.joint_names[j]], f"start.{hand.joint_names[j]}", "rad or m")
-    q.setflags(write=False)
-    return q
+                start_joints, formation, dyn.disturbance, dyn)  # fmt: skip
 
 
 _KNOWN = {"name", "hand", "motion", "friction", "controller", "limits", "goal", "start", "formation", "version"}
@@ -367,9 +356,11 @@ def task_from_record(doc, base_dir=None, default_name: str = "task") -> Task:
     if "speed" in limits:
         kw["joint_speeds"] = limits["speed"]
     kw["base_dir"] = base_dir
-    for key in ("joint_speed", "workpiece_speed"):
+    for key in ("joint_speed", "workpiece_speed", "workpiece_acceleration", "joint_acceleration", "release_acceleration"):
         if key in limits:
             kw[key] = limits[key]
+    if "acceleration" in limits:
+        kw["joint_accelerations"] = limits["acceleration"]
     if doc.get("version", RECORD_VERSION) != RECORD_VERSION:
         raise QsplanError(f"version: expected {RECORD_VERSION} (a task record of this qsplan); got {short_repr(doc['version'])}")
     if "formation" in doc:

@@ -24,6 +24,7 @@ from qsplan.planner.export.plan_files import export_plan, plan_columns, read_pla
 from qsplan.planner.plan.table import is_word_column
 from qsplan.planner.export.schema import check_schedule_document, check_schedule_files
 from qsplan.planner.plan.results import ContactSegmentPlan, Plan, RegraspPlan
+from qsplan.planner.plan.timing import time_scale
 from qsplan.planner.replay.replay import replay_plan
 from qsplan.planner.search.ompl_bridge import PlanResult
 from qsplan.hands.collision import find_collisions, find_collisions_batch, shapely_collisions
@@ -68,7 +69,8 @@ def segment(task, name, x0, x1, free, effort_joint, t0=0.0, n=21) -> ContactSegm
         qd[:, hand.free_joints()] = 0.0  # held: exactly zero, not a rounding of it
     scenes = [chain_scene(hand, task.pose(x), qk, e, np.where(e, 0.0, d)) for x, qk, d in zip(xs, q, qd)]
     mode = kinematic_mode(scenes[0], qd[0], np.sign(x1 - x0) * v)
-    bands = robust_bands(scenes, mode, task.mu_range, shared=task.shared_mu, force_margin=task.force_margin)
+    bands = robust_bands(scenes, mode, task.mu_range, shared=task.shared_mu, force_margin=task.force_margin,
+                         disturbance=task.disturbance)
     assert all(b.feasible for b in bands), next(b.reason for b in bands if not b.feasible)
     lower, upper = np.array([b.lower for b in bands]), np.array([b.upper for b in bands])
     m = min(0.5 * float(np.min(upper - lower)), MAX_MARGIN_RESOLUTIONS * task.torque_resolution)
@@ -86,7 +88,8 @@ def regrasp(name, x, q_from, q_open, t0, duration=0.5) -> RegraspPlan:
 
 
 def plan_of(task, phases) -> Plan:
-    return Plan(task, tuple(phases), 0.0, sum(p.t.size for p in phases), 0.0)
+    """The phases as a plan, timed as the planner times its plans (stops at every phase's ends)."""
+    return time_scale(Plan(task, tuple(phases), 0.0, sum(p.t.size for p in phases), 0.0))
 
 
 @pytest.fixture(scope="module")

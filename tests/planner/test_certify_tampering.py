@@ -190,21 +190,45 @@ def swap_controls(rows, doc):
         rows[k][c] = v
 
 
+def no_stop_at_phase_end(rows, doc):
+    """The first phase ends at speed (issue 24): its last row's speed scale and velocity commands as the row before."""
+    k = max(i for i, r in enumerate(rows) if r["phase"] == rows[0]["phase"])
+    for c in rows[k]:
+        if c.startswith("qd_") or c == "speed_scale":
+            rows[k][c] = rows[k - 1][c]
+
+
+def rush_the_plan(rows, doc):
+    """Every time quartered: the same commands, four times the accelerations and sixteen times the inertial load."""
+    for r in rows:
+        r["t"] = repr(0.25 * float(r["t"]))
+
+
+def drop_speed_scale(rows, doc):
+    """The time scaling's column removed: nothing says the phases start and end at rest."""
+    for r in rows:
+        del r["speed_scale"]
+
+
 BOTH = [drop_first_row, drop_second_half, relabel_slide_as_free, raise_during_regrasp, widen_band, narrow_band,
         double_margin, bump_phase, swap_times, shift_torque_out, misstate_phase_rows, misstate_friction,
-        swap_controls]  # fmt: skip
+        swap_controls, no_stop_at_phase_end, rush_the_plan, drop_speed_scale]  # fmt: skip
 
 #: The edits each hand's plan gets: every edit on the paper hand's (certified in ~1 s); on the chain hands' (~3 s
 #: each) those whose checks read the hand (its start and goal, its regrasp, its bands), so the suite stays short.
 EDITS = {"paper": BOTH,
          "two_link": [drop_first_row, drop_second_half, relabel_slide_as_free, raise_during_regrasp, widen_band,
                       narrow_band, double_margin],
-         "jaw": [drop_first_row, drop_second_half, relabel_slide_as_free, widen_band, narrow_band, swap_controls]}  # fmt: skip
+         "jaw": [drop_first_row, drop_second_half, relabel_slide_as_free, widen_band, narrow_band, swap_controls,
+                 no_stop_at_phase_end]}  # fmt: skip
 CASES = [(hand, edit) for hand, edits in EDITS.items() for edit in edits]
 
 #: The kinds each edit must be named by (at least one of them).
 EXPECTED = {
     "swap_controls": {"control"},
+    "no_stop_at_phase_end": {"timing"},
+    "rush_the_plan": {"acceleration"},
+    "drop_speed_scale": {"timing"},
     "drop_first_row": {"start", "time"},
     "drop_second_half": {"goal"},
     "relabel_slide_as_free": {"rest"},

@@ -11,6 +11,7 @@ from shapely.geometry import Polygon
 from qsplan.hands.chain_hand import chain_polygons
 from qsplan.planner import load_task, plan_task, task_paths
 from qsplan.planner.task.task import make_task
+from qsplan.planner.plan.timing import quasistatic_rows
 
 #: Overlap (m^2) and gap (m) tolerated by the checks: the contact finder's micron, squared for areas.
 GAP = 1e-6
@@ -66,10 +67,12 @@ def test_velocity_commands_keep_the_finger_contacts_closed(two_link_plan):
     hand = task.hand
     (seg,) = two_link_plan.segments
     e = hand.joint_names.index(seg.effort_joint)
-    xdot = np.gradient(seg.x, seg.t)
+    s, _ = quasistatic_rows(seg.t, seg.speed_scale, seg.q, seg.qd)  # the path parameter: x and q smooth in it
+    u = seg.speed_scale
+    xdot = np.gradient(seg.x, s) * u
     for k in range(1, len(seg.t) - 1, 7):
         qd = seg.qd[k].copy()
-        qd[e] = (seg.q[k + 1, e] - seg.q[k - 1, e]) / (seg.t[k + 1] - seg.t[k - 1])  # the effort joint follows
+        qd[e] = (seg.q[k + 1, e] - seg.q[k - 1, e]) / (s[k + 1] - s[k - 1]) * u[k]  # the effort joint follows
         for dt in (1e-3,):
             polys = chain_polygons(hand, task.pose(seg.x[k] + xdot[k] * dt), seg.q[k] + qd * dt)
             W = Polygon(polys["workpiece"])

@@ -118,7 +118,10 @@ def test_task_force_margin_validation(tmp_path, line, match):
 def test_planned_bands_keep_the_margin_at_their_edges(tmp_path):
     """A one-segment plan: metadata records the margin, and just inside every exported band edge the
     all-modes solver at the friction box's corners finds 4S with every normal force at least the margin."""
+    from dataclasses import replace
     from itertools import product
+
+    from tests.planner.rest_rows import moving_velocity
 
     from qsplan.hands import hand_scene
     from qsplan.mechanics import solve
@@ -143,10 +146,17 @@ def test_planned_bands_keep_the_margin_at_their_edges(tmp_path):
         for tau in (d[f"tau_{e}_min"][k] + 1e-9, d[f"tau_{e}_max"][k] - 1e-9):
             if not np.isfinite(tau):
                 continue
-            scene = hand_scene(task.hand.paper, pose, q, e, velocity=float(d[f"qd_{v}"][k]), effort=float(tau))
-            for mu in product((lo, hi), repeat=4):
-                sol = solve(scene.with_mu(np.array(mu)), residuals=False, workers=1, search="all").solution("SSSS")
-                worst = min(worst, -np.inf if sol is None else float(sol.c_n.min()))
-                checked += 1
+            # a row at rest (qd 0): the direction of the motion that leaves or reaches it, the adjacent row's
+            nb = k + 1 if k + 1 < len(d["t"]) and d["phase"][k + 1] == d["phase"][k] else k - 1
+            speed = float(d[f"qd_{v}"][k]) or float(np.sign(d[f"q_{v}"][max(k, nb)] - d[f"q_{v}"][min(k, nb)]))
+            calm = hand_scene(task.hand.paper, pose, q, e, velocity=speed, effort=float(tau))
+            # the bands withstand the task's disturbance box (the time scaling's inertial load): the margin is
+            # reached at the worst of its vertices
+            for w in task.disturbance.vertices():
+                scene = replace(calm, g_obj=calm.g_obj + w)
+                for mu in product((lo, hi), repeat=4):
+                    sol = solve(scene.with_mu(np.array(mu)), residuals=False, workers=1, search="all").solution("SSSS")
+                    worst = min(worst, -np.inf if sol is None else float(sol.c_n.min()))
+                    checked += 1
     assert checked >= 100
     assert 0.08 - 1e-7 <= worst < 0.08 + 1e-3  # held everywhere, and reached at an edge

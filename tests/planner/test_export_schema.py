@@ -206,6 +206,7 @@ def test_plan_columns_keep_every_name(small_run):
     assert list(cols)[:18] == ["t", "q_left", "q_right", "qd_left", "qd_right", "tau_left", "tau_left_min",
                                "tau_left_max", "tau_right", "tau_right_min", "tau_right_max", "mode", "margin",
                                "x_workpiece", "y_workpiece", "theta_workpiece", "phase", "effort_joint"]  # fmt: skip
-    assert list(cols)[18:] == ["control_left", "control_right"]  # extended after every earlier column, never renamed
+    assert list(cols)[18:] == ["control_left", "control_right", "speed_scale"]  # extended after every earlier column
+    assert cols["speed_scale"][0] == 0.0 and cols["speed_scale"][-1] == 0.0 and max(cols["speed_scale"]) <= 1.0
     assert set(cols["control_left"]) | set(cols["control_right"]) <= {"velocity", "torque", "hold"}
     assert units["phase"] is None and units["tau_right"] == "N m"

@@ -1,9 +1,11 @@
 """One pipeline for every hand (issue 22).
 
-- The paper hand's bundled plans and failure report equal the ones the pre-pipeline planner wrote
-  (``tests/data/reference_plans``, written by commit 0ca5728 before the three planners became one):
-  numerically to 1e-12 on every machine, every cell byte for byte on the BLAS kernel that wrote them (the
-  columns added since, after the old ones, are not in the references).
+- The paper hand's bundled plans and failure report equal the reference ones (``tests/data/reference_plans``):
+  numerically to 1e-12 on every machine, every cell byte for byte on the BLAS kernel that wrote them (columns
+  added later, after the old ones, are not in the references).  The pre-pipeline planner wrote them (commit
+  0ca5728) and the one pipeline reproduced them byte for byte (commit 252da7f); issue 24's stops and time
+  scaling changed every plan on purpose (times, velocity commands, the inertial load in every band, rows added
+  to regrasps), and they were written again by that commit, from the same pipeline.
 - The paper hand planned through the generic described-hand path (closed forms off) gives the same
   phases and the same narrowest band to 1e-9 as the accelerated path, on every bundled paper task.
 - A chain hand runs waypoint tasks, and its failures carry the same report fields as the paper hand's.

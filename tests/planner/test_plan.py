@@ -15,6 +15,7 @@ from qsplan.planner.export.plan_files import export_plan, read_plan_csv
 from qsplan.planner.plan.scripted import check_free_state
 from qsplan.planner.replay.replay import friction_samples, replay_plan
 from qsplan.planner.task.task import load_task, make_task, task_paths
+from tests.planner.rest_rows import moving_velocity
 
 
 def test_bundled_tasks_load():
@@ -73,7 +74,7 @@ def test_demo_export_keeps_every_command_inside_the_desired_modes_exact_band(dem
     assert set(d["mode"]) == {"SSSS", "free"} and np.sum(d["mode"] == "SSSS") > 200
     for k, pose, q, e, v in _rows(d):
         assert np.allclose(q, finger_angles(hand, pose)[0], atol=1e-9)  # the grasp is the tangency
-        scene = hand_scene(hand, pose, q, e, velocity=d[f"qd_{v}"][k])
+        scene = hand_scene(hand, pose, q, e, velocity=moving_velocity(d, k, v))
         band = guaranteed_band_box(scene, ContactMode("SSSS"), lo, hi)  # exact, over the corners of the mu box
         assert band.feasible and band.lower - 1e-9 <= d[f"tau_{e}_min"][k] and d[f"tau_{e}_max"][k] <= band.upper + 1e-9
         assert d[f"tau_{e}_min"][k] < d[f"tau_{e}"][k] < d[f"tau_{e}_max"][k]
@@ -94,7 +95,7 @@ def test_demo_commands_leave_4s_the_only_feasible_mode_at_sampled_friction(demo_
     mus = np.vstack([corners, rng.uniform(lo, hi, (4, 4))])
     checked = 0
     for k, pose, q, e, v in list(_rows(d))[::3]:
-        scene = hand_scene(plan.task.hand, pose, q, e, velocity=d[f"qd_{v}"][k], effort=d[f"tau_{e}"][k])
+        scene = hand_scene(plan.task.hand, pose, q, e, velocity=moving_velocity(d, k, v), effort=d[f"tau_{e}"][k])
         nxt = min(k + 1, d["t"].size - 1)
         direction = np.sign(d["x_workpiece"][nxt] - d["x_workpiece"][k - 1 if nxt == k else k])
         for mu in mus:

@@ -16,6 +16,7 @@ import pytest
 
 from qsplan.mechanics import solve_many
 from qsplan.mechanics.bands.disturbance import WrenchBox
+from qsplan.planner.task.dynamics import inertial_box
 from qsplan.mechanics.errors import QsplanError
 from qsplan.planner.certify.certify import certify_plan, read_plan
 from qsplan.planner.certify.modes import row_scene
@@ -65,9 +66,12 @@ def test_a_bad_box_names_its_field(tmp_path, box, message):
         load_task(path)
 
 
-def test_zero_box_is_no_disturbance(tmp_path):
+def test_zero_box_is_no_box_the_inertial_one_stays(tmp_path):
+    """A zero box adds nothing: the bands withstand the time scaling's inertial load, as without a box."""
     task = _task(tmp_path, {"lo": [0.0, 0.0, 0.0], "hi": [0.0, 0.0, 0.0]})
-    assert task.disturbance is None
+    m, y, a = task.hand.workpiece_mass, task.hand.rest_height, task.dynamics.workpiece_acceleration
+    assert task.dynamics.source == "inertia" and task.disturbance == inertial_box(m, y, a)
+    assert task.disturbance.hi[0] == m * a and task.disturbance.hi[2] >= y * m * a  # rounded up, never down
 
 
 def test_the_box_narrows_the_plans_bands(planned):

@@ -1,6 +1,7 @@
 """A task's ``[hand]``: the paper hand's parameters, a hand file (bundled or a path), or a description inline
 (qsplan.planner.task.fields); bad hands are refused in one line naming the field."""
 
+import re
 import numpy as np
 import pytest
 
@@ -87,5 +88,5 @@ def test_plan_takes_a_bundled_tasks_name(tmp_path, capsys):
     code = main(["plan", "parallel_jaw_task", "--out", str(tmp_path / "out"), "--quiet", "--no-plots", "--verify", "1"])
     out, err = capsys.readouterr()
     assert code == 0 and "parallel-jaw gripper: slide a hexagon left 2 cm" in out
-    assert "narrowest guaranteed band: 2.5 N at" in out  # a jaw's force, in N
+    assert re.search(r"narrowest guaranteed band: 2\.\d+ N at", out)  # a jaw's force, in N
     assert (tmp_path / "out" / "plan.csv").exists()

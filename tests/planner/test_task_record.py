@@ -72,7 +72,7 @@ def _record(**changes):
 @pytest.mark.parametrize("changes, message", [
     ({"friction__range": [0.3, 0.1]}, r"friction\.range: expected lo <= hi"),
     ({"version": 99}, r"version: expected 1"),
-    ({"formation": "no_such"}, r"formation: expected one of palm_edge"),
+    ({"formation": "no_such"}, r"formation: expected one of (\w+, )*palm_edge"),
     ({"limits__left": [0.0, 9.0]}, r"limits\.left"),
     ({"controller__torque_resolution": -1.0}, r"controller\.torque_resolution"),
     ({"hand__fingers": []}, r"hand\.fingers"),

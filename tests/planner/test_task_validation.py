@@ -31,7 +31,7 @@ def test_bundled_tasks_load():
 @pytest.mark.parametrize(
     "table,key,value,match",
     [
-        ("limits", "joint_sped", 0.05, r"limits\.joint_sped: unknown field; expected some of joint_speed, left"),
+        ("limits", "joint_sped", 0.05, r"limits\.joint_sped: unknown field; expected some of (\w+, )*joint_speed, left"),
         ("motion", "goal", 0.1, r"motion\.goal: unknown field"),
         ("friction", "rnage", [0, 1], r"friction\.rnage: unknown field"),
         ("controller", "torque_res", 0.1, r"controller\.torque_res: unknown field"),
