@@ -52,6 +52,9 @@ from qsplan import lazy_attributes
 # ``qsplan.mechanics.errors``, which the CLI's light commands need -- imports neither numpy nor the solver.
 _LAZY = {
     # bands
+    "HoldProof": "qsplan.mechanics.bands.hold",
+    "prove_hold": "qsplan.mechanics.bands.hold",
+    "hold_torque_interval": "qsplan.mechanics.bands.hold",
     "Band": "qsplan.mechanics.bands.effort",
     "ForceMargin": "qsplan.mechanics.bands.effort",
     "effort_band": "qsplan.mechanics.bands.effort",

@@ -8,6 +8,7 @@
 * :mod:`.robust` - the guaranteed band of one scene with every competitor precluded (Fig. 13)
 * :mod:`.disturbance` - a box of disturbance wrenches on the workpiece every band above may be asked to withstand
   (``disturbance=``; the paper's ref. [39]): why the vertex argument extends, and where a projection needs the search
+* :mod:`.hold` - certified holds: nothing moves while the hand holds still and ramps a torque, for every friction
 * :mod:`.batched`, :mod:`.batched_modes`, :mod:`.batched_preclusion`, :mod:`.batched_robust` - the same for a
   batch of states (and many modes) at once, bit-identical and fast; :func:`.batched_robust.robust_band_arrays`
   gives the numbers alone (the band tables)
