@@ -41,7 +41,7 @@ from qsplan.planner.certify.files import META_TOL, agreement_checks, metadata_ch
 from qsplan.planner.certify.inputs import (plan_columns_required, plan_sources, read_plan,
                                            read_plan_file, task_from_metadata)  # fmt: skip
 from qsplan.planner.certify.modes import disturbance_checks, mode_checks, row_scene, slip_reversals, slip_velocities
-from qsplan.planner.certify.timing import row_velocity, timing_checks
+from qsplan.planner.certify.timing import hold_checks, row_velocity, timing_checks
 from qsplan.planner.certify.route import (ENDPOINT_TOL, FREE_PATH_STEP, endpoint_checks, free_path_checks,
                                           rest_checks, structure_checks)  # fmt: skip
 from qsplan.planner.certify.rows import (
@@ -82,6 +82,9 @@ CHECKS = {
               "follow the time scaling's rule between rows",
     "acceleration": "every velocity command changes within its joint's acceleration limit; the workpiece's inertial "
                     "wrench between rows lies in the disturbance box every band was recomputed with",
+    "hold": "at every in-contact row at rest nothing moves, the velocity-controlled joints held and the effort joint at "
+            "its command, for every friction and disturbance wrench (a frictionless equilibrium with every contact "
+            "loaded; the certificate's holds record each proof)",
     "motion": "velocity commands reach the next row; the solver moves the workpiece as the rows do",
     "contact": "every contact of the planned mode present on in-contact rows",
     "band": "the exported band recomputed from the task (every friction in the set, every competitor precluded), "
@@ -183,6 +186,9 @@ class Certificate:
         Wall time of the certification.
     files : tuple of str
         Every file checked (the other file's cells compared with ``source``'s).
+    holds : tuple of dict
+        Each in-contact row at rest: ``{row, t_s, proved, margin_N, proof}`` (:func:`qsplan.planner.certify.timing.
+        hold_checks`).
     """
 
     ok: bool
@@ -194,6 +200,7 @@ class Certificate:
     settings: dict = field(default_factory=dict)
     seconds: float = 0.0
     files: tuple = ()
+    holds: tuple = ()
 
     @property
     def contact_rows(self) -> int:
@@ -217,7 +224,8 @@ class Certificate:
         return {"certified": self.ok, "summary": self.summary(), "source": self.source, "files": list(self.files),
                 "task": self.task, "rows": len(self.rows), "contact_rows": self.contact_rows, "checks": checks,
                 "counts": dict(self.counts), "violations": [v.to_dict() for v in self.violations],
-                "excluded_degenerate_modes": excluded, "settings": self.settings, "seconds": self.seconds}  # fmt: skip
+                "excluded_degenerate_modes": excluded, "holds": list(self.holds), "settings": self.settings,
+                "seconds": self.seconds}  # fmt: skip
 
 
 def _num(v):
@@ -343,6 +351,9 @@ def certify_plan(plan, task, *, n_random: int = 8, seed: int = 0, force_margin: 
             progress(f"certified {k + 1} of {n} rows")
     for k, rb in recomputed_bands(task, cols, scenes).items():
         found_at[k] += band_checks(task, cols, k, rb)
+    held, holds = hold_checks(task, cols, scenes)
+    for k, kind, msg in held:
+        found_at[k].append((kind, msg))
     if 0 in ends and n - 1 in ends:
         whole += endpoint_checks(task, cols, ends[0], ends[n - 1])
     plan_level = []
@@ -367,4 +378,4 @@ def certify_plan(plan, task, *, n_random: int = 8, seed: int = 0, force_margin: 
                                "command_rel": COMMAND_RTOL, "band_rel": BAND_RTOL, "metadata_rel": META_TOL,
                                "endpoint_m": ENDPOINT_TOL, "free_path_step_m": FREE_PATH_STEP}}  # fmt: skip
     return Certificate(not every, str(source), task.name, tuple(verdicts), tuple(every), counts, settings,
-                       time.perf_counter() - start, tuple(str(p) for p in sources))  # fmt: skip
+                       time.perf_counter() - start, tuple(str(p) for p in sources), tuple(holds))  # fmt: skip

@@ -20,14 +20,18 @@ From the rows alone, then, each interval's velocities at its ends and its accele
 At a row at rest the quasistatic model decides nothing (every mode degenerate at zero input).  The model is
 homogeneous in the velocity input: its modes and bands are those of any positive speed in the same direction.  A
 row at rest is therefore judged for the motion that leaves it (a phase's first row) or reaches it (its last): the
-straight line to the adjacent row, as the controller moves (:func:`row_velocity`).  Units SI.
+straight line to the adjacent row, as the controller moves (:func:`row_velocity`).  And at the instant of rest
+itself :func:`hold_checks` proves that nothing moves, the velocity-controlled joints held and the effort joint at
+its command, for every friction and every wrench of the box (kind ``hold``;
+:func:`qsplan.mechanics.bands.hold.prove_hold`: a frictionless equilibrium with every contact strictly loaded);
+the certificate records each proof.  Units SI.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["ACCEL_RTOL", "RATE_TOL", "interval_rates", "row_velocity", "timing_checks"]
+__all__ = ["ACCEL_RTOL", "HOLD_PROOF", "RATE_TOL", "hold_checks", "interval_rates", "row_velocity", "timing_checks"]
 
 #: Relative excess tolerated on an acceleration limit and on the disturbance box: the planner times the rows to
 #: reach the limits exactly, and the rows' times are sums of durations, positions differences of nearby floats
@@ -146,3 +150,33 @@ def timing_checks(task, cols) -> list:
                                                  "withstand no disturbance")  # fmt: skip
         out += [(row, kind, msg) for kind, (row, msg) in found.items()]
     return out
+
+
+#: What :func:`hold_checks` records as the proof of a hold (the certificate's ``holds``).
+HOLD_PROOF = ("frictionless equilibrium with every contact strictly loaded, at the row's torque and every vertex of "
+              "the disturbance box: the loads do negative work along every admissible motion, so nothing moves for "
+              "any friction (qsplan.mechanics.bands.hold)")
+
+
+def hold_checks(task, cols, scenes) -> tuple:
+    """Every in-contact row at rest (``speed_scale`` 0; ``scenes``: ``{row: Scene}``) holds: ``(violations [(row,
+    kind, message)], records [{row, t_s, proved, margin_N, proof}])``."""
+    from qsplan.mechanics.bands.hold import prove_hold
+
+    if "speed_scale" not in cols:
+        return [], []
+    found, records = [], []
+    for k in sorted(scenes):
+        if cols["speed_scale"][k] != 0.0:
+            continue
+        e = str(cols["effort_joint"][k])
+        tau = float(cols[f"tau_{e}"][k]) if f"tau_{e}" in cols else float("nan")
+        if not np.isfinite(tau):
+            continue  # no command: the torque check names it
+        proof = prove_hold(scenes[k], torques=[tau], disturbance=task.disturbance)
+        records.append({"row": int(k), "t_s": float(cols["t"][k]), "proved": bool(proof.proved),
+                        "margin_N": float(proof.margin), "proof": HOLD_PROOF})  # fmt: skip
+        if not proof.proved:
+            found.append((int(k), "hold", f"at rest, with {e} at {tau:.6g} and every other joint held, nothing is proved "
+                                          f"to stay: {proof.reason}"))  # fmt: skip
+    return found, records

@@ -38,7 +38,7 @@ TOML form (all SI: m, kg, rad, s, N m)::
     workpiece_speed = 0.01       # m/s
     workpiece_acceleration = 0.02  # m/s^2, optional: phases start and end at rest (qsplan.planner.task.dynamics)
     joint_acceleration = 0.5     # rad/s^2, optional, every revolute joint; [limits.acceleration] by joint name
-    release_acceleration = 0.15  # rad/s^2, optional: the regrasp legs that leave and reach the workpiece
+    release_acceleration = 0.05  # rad/s^2, optional: the regrasp legs that leave and reach the workpiece
 
 :func:`load_task` reads it; :func:`make_task` is the Python equivalent; :func:`task_from_record` reads the same
 tables from a dict (:func:`qsplan.planner.task.record.task_record` writes a task as one: the round trip

@@ -150,3 +150,24 @@ def test_a_regrasp_keeps_the_workpiece_within_0_1_mm_in_mujoco_without_palm_fric
         assert not run.contacts_lost
         free = run.planned == "free"
         assert free.any() and run.max_error(free) <= 1e-4 and run.max_error() <= 1e-4, run.summary()
+
+
+def test_every_rest_in_contact_is_a_proved_hold(small_run):
+    """The certificate proves each in-contact row at rest a hold and records the proof; a torque that pulls the
+    finger off the workpiece (its command reversed) is refused at such a row, naming the motion."""
+    from qsplan.planner.certify.modes import row_scene
+    from qsplan.planner.certify.timing import hold_checks
+
+    cert = small_run.certificate
+    d = read_plan_csv(small_run.out_dir / "plan.csv")
+    rest = [int(k) for k in np.flatnonzero((d["speed_scale"] == 0.0) & (d["mode"] != "free"))]
+    assert [h["row"] for h in cert.holds] == rest and len(rest) == 4  # two slides, each starting and ending at rest
+    assert all(h["proved"] and h["margin_N"] > 0.05 and "frictionless equilibrium" in h["proof"] for h in cert.holds)
+    task = small_run.plan.task
+    k = rest[-1]
+    e = str(d["effort_joint"][k])
+    d[f"tau_{e}"] = d[f"tau_{e}"].copy()
+    d[f"tau_{e}"][k] = -d[f"tau_{e}"][k]
+    found, records = hold_checks(task, d, {k: row_scene(task, d, k)})
+    assert [(row, kind) for row, kind, _ in found] == [(k, "hold")] and not records[0]["proved"]
+    assert "the load does work along" in found[0][2]
