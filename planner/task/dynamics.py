@@ -34,7 +34,7 @@ __all__ = ["DEFAULT_JOINT_ACCELERATION", "DEFAULT_RELEASE_ACCELERATION", "DEFAUL
 
 #: The workpiece's largest acceleration by default (m/s^2): it reaches the default 0.01 m/s workpiece speed in
 #: 0.5 s over 2.5 mm (five of the slides' 0.5 mm rows).  Its inertial force on the demo workpiece (0.2 kg) is
-#: 4 mN, 0.2 % of its weight: the bands it costs are a few mN m (0.238 -> 0.236 N m on the demo's narrowest).
+#: 4 mN, 0.2 % of its weight: the bands it costs are a few mN m (0.238 -> 0.234 N m on the demo's narrowest).
 DEFAULT_WORKPIECE_ACCELERATION = 0.02
 
 #: Every joint's largest acceleration by default, by kind (rad/s^2; m/s^2): a revolute finger reaches the default
