@@ -52,12 +52,12 @@ def _phase_rows(cols) -> list:
 def interval_rates(cols, a: int, b: int):
     """``(rate at a, rate at b, acceleration)`` (1/s, 1/s, 1/s^2) of the fraction of the interval from row ``a`` to
     row ``b`` covered, by the rule: a quantity ``z`` moves at ``dz * rate`` and accelerates at ``dz * acceleration``."""
-    dt = float(cols["t"][b] - cols["t"][a])
-    u0, u1 = float(cols["speed_scale"][a]), float(cols["speed_scale"][b])
-    total = 0.5 * (u0 + u1) * dt
-    if not total > 0:
-        return 1.0 / dt, 1.0 / dt, 0.0
-    return u0 / total, u1 / total, (u1 - u0) / dt / total
+    from qsplan.planner.plan.sampling import path_fraction  # the rule, in one place
+
+    tr = np.array([cols["t"][a], cols["t"][b]], dtype=float)
+    u = np.array([cols["speed_scale"][a], cols["speed_scale"][b]], dtype=float)
+    _, _, rate = path_fraction(tr, tr, u)
+    return float(rate[0]), float(rate[1]), float((rate[1] - rate[0]) / (tr[1] - tr[0]))
 
 
 def row_velocity(cols, k, names):
