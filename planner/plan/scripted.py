@@ -57,6 +57,7 @@ from qsplan.planner.plan.phases import (DEFAULT_OPTIONS, REGRASP_OPENING, SWEEP_
                                         sweep_contact_segment)
 from qsplan.planner.plan.results import ContactSegmentPlan, Plan, PlanFailure, RegraspPlan
 from qsplan.planner.plan.timing import time_scale
+from qsplan.planner.task.goal import check_goal_served
 from qsplan.planner.search.ompl_bridge import PlannerOptions
 from qsplan.planner.states.contact import (
     TOUCH_AREA,
@@ -265,6 +266,7 @@ def plan_task(task: Task, options: PlannerOptions | None = None, progress=None, 
         options = DEFAULT_OPTIONS
     from qsplan.planner.plan.failure import palm_report
 
+    check_goal_served(task)  # a goal in another formation (theta, another palm feature): refused by name first
     beyond = palm_report(task)  # from the task's geometry alone, before any table or grid is built
     if beyond is not None:
         raise PlanFailure(beyond)

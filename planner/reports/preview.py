@@ -206,20 +206,24 @@ def preview_task(task, progress=None) -> Preview:
     from qsplan.planner.plan.failure import palm_report
     from qsplan.planner.search.tables import SEARCH_MARGIN, band_tables, table_grid
     from qsplan.planner.states.contact import mode_name
-    from qsplan.planner.task.goal import palm_x_range
+    from qsplan.planner.task.goal import goal_refusal, palm_x_range
 
     t0 = time.perf_counter()
     progress = progress or (lambda line: None)
     hand = task.hand
-    goal_x = float(task.goal.x) if task.goal is not None else float(task.waypoints[-1])
+    refusal = goal_refusal(task)  # a goal the planner refuses (another orientation, no x): the verdict, as plan says
+    if task.goal is None:
+        goal_x = float(task.waypoints[-1])
+    else:  # a goal without x (refused) previewed at the start's x
+        goal_x = float(task.start_x if task.goal.x is None else task.goal.x)
     lo, hi = palm_x_range(hand)
-    beyond = palm_report(task)
-    if beyond is None:
+    beyond = palm_report(task) if refusal is None else None  # (palm_report refuses such a goal: it has no position)
+    if beyond is None and refusal is None:
         x = table_grid(task.start_x, goal_x, (lo, hi), margin=hi - lo)  # the planner's grid, across the whole palm
         margin = FREE_SEARCH_MARGIN if hand.free_joints else SEARCH_MARGIN
         window = (max(min(task.start_x, goal_x) - margin, lo), min(max(task.start_x, goal_x) + margin, hi))
-    else:  # a position beyond the palm: the grid across the palm all the same (through the start and the goal where
-        # they are on it), the verdict says why
+    else:  # a position beyond the palm, or a refused goal: the grid across the palm all the same (through the start
+        # and the goal where they are on it), the verdict says why
         x = table_grid(float(np.clip(task.start_x, lo, hi)), float(np.clip(goal_x, lo, hi)), (lo, hi), margin=hi - lo)
         window = (lo, hi)
     rows = grasp_rows(task, float(np.clip(task.start_x, lo, hi)), float(np.clip(goal_x, lo, hi)))
@@ -235,7 +239,9 @@ def preview_task(task, progress=None) -> Preview:
 
     i_start, i_goal = tables.index(task.start_x), tables.index(goal_x)
     starts = [g for g, _ in start_nodes(tables, task)]
-    if task.goal is not None:
+    if refusal is not None:
+        goals = []
+    elif task.goal is not None:
         goals = goal_nodes(tables, task)
     else:  # a scripted task ends in its start's grasp
         goals = [(g, i_goal) for g in starts if tables.graph.valid[g, i_goal]]
@@ -250,7 +256,12 @@ def preview_task(task, progress=None) -> Preview:
     if beyond is not None:  # the start or the goal beyond the palm is not valid; a waypoint's the verdict says
         start = _beyond(start, beyond, task.start_x) if beyond.where == "the start" else start
         goal = _beyond(goal, beyond, goal_x) if beyond.where == "the goal" else goal
-    ok, route, verdict, ends = route_verdict(task, tables, bars, window, start, goal, starts, goals, beyond)
+    if refusal is not None:  # no grasp of the formation meets such a goal: the refusal is its problem and the verdict
+        where = "" if task.goal.x is not None else " (the goal gives no x: drawn at the start's)"
+        goal = ConfigurationCheck("goal", goal_x, None, None, None, 0, goal.candidates, f"{refusal}{where}")
+        ok, route, verdict, ends = False, (), str(refusal), None
+    else:
+        ok, route, verdict, ends = route_verdict(task, tables, bars, window, start, goal, starts, goals, beyond)
     if ends is not None:  # draw the route's own first and last grasps
         start, goal = checks([ends[0]] + [g for g in starts if g != ends[0]],
                              [ends[1]] + [g for g, _ in goals if g != ends[1]])  # fmt: skip

@@ -7,6 +7,8 @@ A task without scripted ``[motion] waypoints`` has a ``[goal]`` table and the pl
     x = -0.03            # m: the workpiece's centre-of-mass x at the goal
     left = "edge:2"      # optional: the feature the left finger touches at the goal
     right = "vertex:1"   # optional: the same for the right finger
+    theta = -0.5         # optional (rad, counter-clockwise; 0: resting on its palm edge, as at the start)
+    palm = "vertex:1"    # optional: what rests on the palm at the goal, "edge:K" or "vertex:K"
     [start]              # optional: where each finger touches at the start (default: "inner")
     left = "inner"
     right = "edge:1"
@@ -15,7 +17,15 @@ A feature is ``"edge:K"`` (the fingertip on edge ``K``, from vertex ``K`` to ver
 or ``"vertex:K"`` (the finger's inner long edge on vertex ``K``), ``K`` the 0-based index into
 the ``workpiece`` polygon **as written** in the task; at the start, ``"inner"`` means the inner
 long edge on whichever vertex the geometry puts it (the only placement of the scripted tasks).
-Units SI (m).
+
+A goal gives at least one of ``x``, ``theta`` and ``palm``; with ``theta`` or ``palm``, ``x`` is optional.
+``theta`` is the workpiece's orientation (rad, counter-clockwise, in [-pi, pi]): 0 is the workpiece resting on its
+palm edge (its bottom edge, or the ``[hand] palm_edge``), as every task starts.  ``palm`` names what rests on the
+palm at the goal, ``K`` as for the fingers.  The planner serves one formation today, ``palm_edge`` (the resting edge
+on the palm, ``theta = 0``), placed by its ``x``: a goal that asks another orientation (``theta`` beyond
+:data:`THETA_TOL` of 0, ``palm`` naming another edge or a vertex) or gives no ``x`` is a valid task that the planner
+refuses (:func:`check_goal_served`, a :class:`GoalNotServedError`), before any planning.
+Units SI (m, rad).
 """
 
 from __future__ import annotations
@@ -25,13 +35,22 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from qsplan.mechanics.errors import QsplanError
+from qsplan.mechanics.errors import NoAnswerError, QsplanError
+from qsplan.planner.task.fields import task_number
 
-__all__ = ["Goal", "FEATURE_KINDS", "feature_text", "parse_feature", "make_goal", "make_start_features", "palm_x_range",
-           "task_positions"]
+__all__ = ["Goal", "FEATURE_KINDS", "GOAL_KEYS", "THETA_TOL", "GoalNotServedError", "check_goal_served", "feature_text",
+           "goal_refusal", "parse_feature", "make_goal", "make_start_features", "palm_x_range", "task_positions"]
 
 #: The feature kinds of a goal: the fingertip on an edge, the inner long edge on a vertex.
 FEATURE_KINDS = ("edge", "vertex")
+
+#: The keys of a ``[goal]`` table (a file contract: keys are added, never renamed).
+GOAL_KEYS = ("x", "left", "right", "theta", "palm")
+
+#: Largest |theta| (rad) of a goal that the palm-edge formation (theta = 0) serves: a TOML 0 or -0.0 parses exactly,
+#: so this only absorbs the round-off of a computed value; 1e-9 rad turns a 0.1 m workpiece's corner by 1e-10 m,
+#: far below any hand's accuracy.
+THETA_TOL = 1e-9
 
 _FEATURE = re.compile(r"^(edge|vertex):(\d{1,3})$")
 
@@ -65,20 +84,30 @@ class Goal:
 
     Attributes
     ----------
-    x : float
-        Workpiece centre-of-mass x at the goal (m).
+    x : float or None
+        Workpiece centre-of-mass x at the goal (m); None: not given (a goal with ``theta`` or ``palm``).
     left, right : (str, int) or None
         The feature each finger must touch at the goal, ``(kind, K)`` with ``K`` in the polygon's
         order as written; None: any.
+    theta : float or None
+        The workpiece's orientation at the goal (rad, counter-clockwise; 0: resting on its palm edge); None: not given.
+    palm : (str, int) or None
+        What rests on the palm at the goal, ``(kind, K)`` as the fingers' features; None: not given.
     """
 
-    x: float
+    x: float | None
     left: tuple | None = None
     right: tuple | None = None
+    theta: float | None = None
+    palm: tuple | None = None
 
     def describe(self) -> str:
         """The goal in words."""
-        parts = [f"x = {self.x:.4g} m"]
+        parts = [] if self.x is None else [f"x = {self.x:.4g} m"]
+        if self.theta is not None:
+            parts.append(f"theta = {self.theta:.4g} rad")
+        if self.palm is not None:
+            parts.append(f"{self.palm[0]} {self.palm[1]} on the palm")
         for side, feat in (("left", self.left), ("right", self.right)):
             if feat is not None:
                 parts.append(f"{side} finger on {feat[0]} {feat[1]}")
@@ -94,16 +123,72 @@ def make_goal(table, n_vertices: int, number) -> Goal:
         Naming the field.
     """
     if not isinstance(table, dict):
-        raise QsplanError(f"goal: expected a table with x (m) and optionally left, right; got {table!r}")
-    extra = sorted(set(table) - {"x", "left", "right"})
+        raise QsplanError(f"goal: expected a table with x (m), theta (rad) or palm and optionally left, right; "
+                          f"got {table!r}")  # fmt: skip
+    extra = sorted(set(table) - set(GOAL_KEYS))
     if extra:
-        raise QsplanError(f"goal.{extra[0]}: unknown field; expected some of left, right, x")
-    if "x" not in table:
-        raise QsplanError("goal.x: missing (m, the workpiece's x at the goal)")
-    x = number(table["x"], "goal.x", "m")
+        raise QsplanError(f"goal.{extra[0]}: unknown field; expected some of {', '.join(sorted(GOAL_KEYS))}")
+    if not {"x", "theta", "palm"} & set(table):
+        raise QsplanError("goal: give x, theta or palm (m: the workpiece's x; rad: its orientation; \"edge:K\" or "
+                          "\"vertex:K\": what rests on the palm)")  # fmt: skip
+    x = number(table["x"], "goal.x", "m") if "x" in table else None
+    theta = None
+    if "theta" in table:
+        theta = task_number(table["theta"], "goal.theta", "rad")
+        if not -np.pi <= theta <= np.pi:
+            raise QsplanError(f"goal.theta: expected an angle within [-pi, pi] rad (the workpiece's orientation, "
+                              f"counter-clockwise); got {theta:g}")  # fmt: skip
     feats = {side: parse_feature(table[side], f"goal.{side}", n_vertices) if side in table else None
-             for side in ("left", "right")}  # fmt: skip
-    return Goal(x, feats["left"], feats["right"])
+             for side in ("left", "right", "palm")}  # fmt: skip
+    return Goal(x, feats["left"], feats["right"], theta, feats["palm"])
+
+
+class GoalNotServedError(NoAnswerError):
+    """A valid goal the planner cannot plan to yet: an orientation other than the palm-edge formation's, or no ``x``.
+
+    Not bad input (the task is valid): no answer exists from today's planner.  ``field`` names the goal's field
+    (``goal.theta``, ``goal.palm`` or ``goal.x``); the message says what exists and what is missing.
+    """
+
+    def __init__(self, field: str, message: str):
+        super().__init__(message)
+        self.field = field
+
+
+#: What the mechanics already computes toward a reorienting goal (said in every refusal of one).
+_REORIENTATION = ("the mechanics of the demo's flush instant and its pivot on vertex 1 exist (docs/reorientation.md), "
+                  "a route through them does not")  # fmt: skip
+
+
+def goal_refusal(task) -> GoalNotServedError | None:
+    """Why the planner refuses ``task``'s goal (a :class:`GoalNotServedError`, not raised), or None: it serves it.
+
+    The planner serves the palm-edge formation only (the resting edge on the palm, theta = 0), placed by its x: a
+    ``theta`` beyond :data:`THETA_TOL` of 0, a ``palm`` other than the resting edge, or a goal without ``x`` is
+    refused, in that order.
+    """
+    goal = task.goal
+    if goal is None:
+        return None
+    resting = int(task.hand.user_edges[0])  # the edge the workpiece rests on, as the task's polygon numbers it
+    serves = f"the planner serves the palm_edge formation: edge {resting} on the palm, theta = 0"
+    if goal.theta is not None and abs(goal.theta) > THETA_TOL:
+        return GoalNotServedError("goal.theta", f"goal.theta: reorienting the workpiece (theta = {goal.theta:g} rad) "
+                                                f"is not planned yet ({serves}); {_REORIENTATION}")  # fmt: skip
+    if goal.palm is not None and goal.palm != ("edge", resting):
+        return GoalNotServedError("goal.palm", f"goal.palm: {goal.palm[0]} {goal.palm[1]} on the palm is not planned "
+                                               f"yet ({serves}); {_REORIENTATION}")  # fmt: skip
+    if goal.x is None:
+        return GoalNotServedError("goal.x", f"goal.x: missing: the goal keeps the start's orientation ({serves}), "
+                                            f"and the planner places it by the workpiece's x (m)")  # fmt: skip
+    return None
+
+
+def check_goal_served(task) -> None:
+    """Raise :func:`goal_refusal`'s :class:`GoalNotServedError` if the planner refuses ``task``'s goal."""
+    refusal = goal_refusal(task)
+    if refusal is not None:
+        raise refusal
 
 
 def make_start_features(table, n_vertices: int) -> tuple:
@@ -134,7 +219,17 @@ def palm_x_range(hand) -> tuple:
 
 
 def task_positions(task) -> list:
-    """Every workpiece x (m) a task names, in order: ``[(where, field, x)]`` (the start, each waypoint, the goal)."""
+    """Every workpiece x (m) a task names, in order: ``[(where, field, x)]`` (the start, each waypoint, the goal).
+
+    Positions are x along the palm-edge formation, the one the planner serves; the palm check that opens planning
+    and the preview (:func:`qsplan.planner.plan.failure.palm_report`) reads them here.
+
+    Raises
+    ------
+    GoalNotServedError
+        The goal is not one of the palm-edge formation (:func:`check_goal_served`): it has no such position.
+    """
+    check_goal_served(task)
     out = [("the start", "motion.start_x", float(task.start_x))]
     last = len(task.waypoints) - 1
     for i, x in enumerate(task.waypoints):

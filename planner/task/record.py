@@ -37,8 +37,8 @@ def hand_record(hand) -> dict:
 
 def task_tables(task) -> dict:
     """Where the task starts and ends, as its file's ``[motion]``, ``[start]`` and ``[goal]`` tables say it (features
-    ``"edge:K"``/``"vertex:K"``/``"inner"`` in the polygon's numbering as written; a hand with free joints: its
-    ``[start]`` by joint name)."""
+    ``"edge:K"``/``"vertex:K"``/``"inner"`` in the polygon's numbering as written; the goal's ``x``, ``theta`` and
+    ``palm`` where it gives them; a hand with free joints: its ``[start]`` by joint name)."""
 
     def feature(f):
         return "inner" if f is None or f[0] == "inner" else f"{f[0]}:{f[1]}"
@@ -47,8 +47,10 @@ def task_tables(task) -> dict:
     if task.goal is None:
         out["motion"]["waypoints"] = [float(v) for v in task.waypoints]
     else:
-        out["goal"] = {"x": float(task.goal.x), **{side: feature(f) for side, f in (("left", task.goal.left),
-                                                                                  ("right", task.goal.right)) if f}}
+        goal = task.goal  # only the keys the goal gives: a goal without x stays one
+        out["goal"] = {key: float(v) for key, v in (("x", goal.x), ("theta", goal.theta)) if v is not None}
+        out["goal"].update({key: feature(f) for key, f in (("left", goal.left), ("right", goal.right),
+                                                           ("palm", goal.palm)) if f})  # fmt: skip
     if task.hand.free_joints:  # a hand with free joints starts from them (by name); the others from features
         if task.start_joints is not None:
             out["start"] = {task.hand.joint_names[j]: float(task.start_joints[j]) for j in task.hand.free_joints}

@@ -1,0 +1,161 @@
+"""Goals that say orientation (issue 23, item 4): ``[goal] theta`` and ``palm``, their validation, the record round
+trip, and the planner's honest refusal of every goal but the palm-edge formation's (``qsplan plan`` exit 2 in one
+line, ``qsplan check`` with the same refusal as its verdict)."""
+
+from __future__ import annotations
+
+import copy
+import json
+import math
+import tomllib
+
+import pytest
+
+from qsplan.mechanics.errors import NoAnswerError, QsplanError
+from qsplan.planner.cli.main import main
+from qsplan.planner.task.goal import THETA_TOL, Goal, GoalNotServedError, check_goal_served, goal_refusal
+from qsplan.planner.task.record import task_record
+from qsplan.planner.task.task import demo_task_path, load_task, task_from_record, task_paths
+
+#: The demo's workpiece written from its vertex 1 on: the edge it rests on is then edge 3 as written.
+ROTATED = [[0.080, 0.0], [0.085, 0.080], [0.008, 0.100], [0.0, 0.0]]
+
+
+def demo_doc(goal, workpiece=None) -> dict:
+    """The demo task's tables with ``goal`` as its ``[goal]`` (and another ``workpiece``, written otherwise)."""
+    doc = tomllib.loads(demo_task_path().read_text())
+    doc["goal"] = goal
+    if workpiece is not None:
+        doc["hand"]["workpiece"] = workpiece
+    return doc
+
+
+def demo_with(goal, workpiece=None):
+    return task_from_record(demo_doc(goal, workpiece), base_dir=demo_task_path().parent)
+
+
+def tilt_file(tmp_path):
+    """The issue's example: the demo's hand and start, ``[goal] theta = -0.5`` and no x."""
+    text = demo_task_path().read_text()
+    assert "\n[goal]\nx = -0.04\nleft = \"vertex:3\"\n" in text  # the lines replaced below
+    path = tmp_path / "tilt.toml"
+    path.write_text(text.replace("\n[goal]\nx = -0.04\nleft = \"vertex:3\"\n", "\n[goal]\ntheta = -0.5\n"))
+    return path
+
+
+def test_theta_and_palm_parse_and_x_becomes_optional():
+    assert demo_with({"theta": -0.5}).goal == Goal(None, theta=-0.5)
+    assert demo_with({"palm": "vertex:1"}).goal == Goal(None, palm=("vertex", 1))
+    goal = demo_with({"x": -0.04, "theta": -0.5, "palm": " edge:2 ", "left": "vertex:3"}).goal
+    assert goal == Goal(-0.04, ("vertex", 3), None, -0.5, ("edge", 2))
+    assert goal.describe() == "x = -0.04 m, theta = -0.5 rad, edge 2 on the palm, left finger on vertex 3"
+    assert demo_with({"theta": math.pi}).goal.theta == math.pi and demo_with({"theta": -3}).goal.theta == -3.0
+
+
+@pytest.mark.parametrize("goal, match", [
+    ({"x": -0.04, "yaw": 0.1}, r"^goal\.yaw: unknown field; expected some of left, palm, right, theta, x$"),
+    ({"left": "vertex:3"}, r"^goal: give x, theta or palm"),
+    ({"theta": "-0.5"}, r"^goal\.theta: expected a number \(rad\); got '-0\.5'"),
+    ({"theta": float("nan")}, r"^goal\.theta: expected a finite number \(rad\)"),
+    ({"theta": -3.2}, r"^goal\.theta: expected an angle within \[-pi, pi\] rad .*; got -3\.2$"),
+    ({"palm": "corner:1"}, r'^goal\.palm: expected "edge:K" or "vertex:K"'),
+    ({"palm": "vertex:4"}, r"^goal\.palm: the workpiece has 4 vertices and edges \(0 to 3\); got 'vertex:4'$"),
+])  # fmt: skip
+def test_bad_goal_is_refused_naming_the_field(goal, match):
+    with pytest.raises(QsplanError, match=match):
+        demo_with(goal)
+
+
+@pytest.mark.parametrize("goal", [{"theta": -0.5}, {"palm": "vertex:1"}, {"x": -0.03, "theta": 0.25, "palm": "edge:2"},
+                                  {"palm": "edge:0", "right": "vertex:2"}])  # fmt: skip
+def test_record_round_trip_keeps_theta_and_palm(goal):
+    task = demo_with(goal)
+    record = json.loads(json.dumps(task_record(task)))  # plain JSON, as plan.json stores it
+    assert set(record["goal"]) == set(goal)  # only the keys the goal gives: no x invented
+    again = task_from_record(copy.deepcopy(record))
+    assert again.goal == task.goal and task_record(again)["goal"] == record["goal"]
+
+
+@pytest.mark.parametrize("goal, field", [
+    ({"theta": -0.5}, "goal.theta"),
+    ({"x": -0.04, "theta": -0.5}, "goal.theta"),  # an x does not make the orientation served
+    ({"theta": 2 * THETA_TOL, "x": -0.04}, "goal.theta"),
+    ({"theta": 0.3, "palm": "vertex:1"}, "goal.theta"),  # theta first
+    ({"palm": "vertex:1", "x": -0.04}, "goal.palm"),
+    ({"palm": "edge:1", "x": -0.04}, "goal.palm"),
+    ({"palm": "edge:0"}, "goal.x"),  # the resting edge, but nowhere to place it
+    ({"theta": 0.0}, "goal.x"),
+])  # fmt: skip
+def test_goals_off_the_palm_edge_formation_are_refused(goal, field):
+    task = demo_with(goal)
+    refusal = goal_refusal(task)
+    assert isinstance(refusal, GoalNotServedError) and isinstance(refusal, NoAnswerError)
+    assert not isinstance(refusal, ValueError)  # a valid task without an answer, not bad input
+    assert refusal.field == field and str(refusal).startswith(f"{field}: ")
+    assert "palm_edge formation: edge 0 on the palm, theta = 0" in str(refusal)
+    with pytest.raises(GoalNotServedError, match=f"^{field}: "):
+        check_goal_served(task)
+
+
+@pytest.mark.parametrize("goal", [{"x": -0.04, "theta": 0.0}, {"x": -0.04, "theta": -THETA_TOL / 2},
+                                  {"x": -0.04, "palm": "edge:0"},
+                                  {"x": -0.04, "palm": "edge:0", "theta": 0.0}])  # fmt: skip
+def test_the_palm_edge_formation_at_an_x_is_served(goal):
+    assert goal_refusal(demo_with(goal)) is None
+
+
+def test_palm_names_the_resting_edge_as_the_polygon_is_written():
+    assert goal_refusal(demo_with({"x": -0.04, "palm": "edge:3"}, ROTATED)) is None
+    refusal = goal_refusal(demo_with({"x": -0.04, "palm": "edge:0"}, ROTATED))
+    assert refusal.field == "goal.palm" and "edge 3 on the palm" in str(refusal)
+
+
+@pytest.mark.parametrize("name", sorted(n for n, p in task_paths().items() if "[goal]" in p.read_text()))
+def test_existing_goals_are_unchanged(name):
+    table = tomllib.loads(task_paths()[name].read_text())["goal"]
+    goal = load_task(task_paths()[name]).goal
+
+    def feature(key):
+        if key not in table:
+            return None
+        kind, k = table[key].split(":")
+        return (kind, int(k))
+
+    assert goal == Goal(float(table["x"]), feature("left"), feature("right"))  # the fields as before, nothing new
+    assert goal.theta is None and goal.palm is None and goal_refusal(load_task(task_paths()[name])) is None
+
+
+def test_plan_refuses_the_issues_example_in_one_line(tmp_path, capsys, monkeypatch):
+    from qsplan.planner.plan import autoplan
+
+    def never(*args, **kwargs):
+        raise AssertionError("the planner ran on a goal it refuses")
+
+    monkeypatch.setattr(autoplan, "plan_automatic", never)
+    out = tmp_path / "out"
+    code = main(["plan", str(tilt_file(tmp_path)), "--out", str(out), "--no-plots", "--verify", "0", "--quiet"])
+    stdout, err = capsys.readouterr()
+    assert code == 2 and stdout == "" and len(err.splitlines()) == 1 and "Traceback" not in err
+    assert err.startswith("qsplan: error: goal.theta: reorienting the workpiece (theta = -0.5 rad) is not planned yet")
+    assert "docs/reorientation.md" in err
+    assert not (out / "plan.csv").exists() and not (out / "plan.json").exists()
+
+
+def test_plan_task_raises_the_refusal(tmp_path):
+    from qsplan.planner.plan.scripted import plan_task
+
+    with pytest.raises(GoalNotServedError, match=r"^goal\.theta: reorienting"):
+        plan_task(load_task(tilt_file(tmp_path)))
+
+
+def test_check_reports_the_refusal_as_its_verdict(tmp_path, capsys):
+    task = load_task(tilt_file(tmp_path))
+    refusal = str(goal_refusal(task))
+    code = main(["check", str(tilt_file(tmp_path)), "--json", "--out", str(tmp_path / "check")])
+    stdout, err = capsys.readouterr()
+    doc = json.loads(stdout)
+    assert code == 0 and err == "" and doc["verdict"] == refusal and not doc["ok"] and doc["route"] == []
+    assert doc["start"]["ok"] and not doc["goal"]["ok"] and refusal in doc["goal"]["message"]
+    assert (tmp_path / "check" / "check.png").is_file() and (tmp_path / "check" / "check.json").is_file()
+    code = main(["check", str(tilt_file(tmp_path))])
+    assert code == 0 and capsys.readouterr().out.splitlines()[-1] == f"verdict: {refusal}"
