@@ -129,8 +129,8 @@ def make_goal(table, n_vertices: int, number) -> Goal:
     if extra:
         raise QsplanError(f"goal.{extra[0]}: unknown field; expected some of {', '.join(sorted(GOAL_KEYS))}")
     if not {"x", "theta", "palm"} & set(table):
-        raise QsplanError("goal: give x, theta or palm (m: the workpiece's x; rad: its orientation; \"edge:K\" or "
-                          "\"vertex:K\": what rests on the palm)")  # fmt: skip
+        raise QsplanError("goal.x: missing: give x (m: the workpiece's x), or theta (rad: its orientation) or palm "
+                          "(\"edge:K\" or \"vertex:K\": what rests on the palm)")  # fmt: skip
     x = number(table["x"], "goal.x", "m") if "x" in table else None
     theta = None
     if "theta" in table:

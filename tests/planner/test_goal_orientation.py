@@ -54,7 +54,7 @@ def test_theta_and_palm_parse_and_x_becomes_optional():
 
 @pytest.mark.parametrize("goal, match", [
     ({"x": -0.04, "yaw": 0.1}, r"^goal\.yaw: unknown field; expected some of left, palm, right, theta, x$"),
-    ({"left": "vertex:3"}, r"^goal: give x, theta or palm"),
+    ({"left": "vertex:3"}, r"^goal\.x: missing: give x \(m: the workpiece's x\), or theta .* or palm"),
     ({"theta": "-0.5"}, r"^goal\.theta: expected a number \(rad\); got '-0\.5'"),
     ({"theta": float("nan")}, r"^goal\.theta: expected a finite number \(rad\)"),
     ({"theta": -3.2}, r"^goal\.theta: expected an angle within \[-pi, pi\] rad .*; got -3\.2$"),
