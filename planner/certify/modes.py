@@ -123,7 +123,8 @@ def mode_checks(task, cols, k, mus, force_margin=0.0, xdot_rows=np.nan, batched=
     mus : ndarray, shape (m, 4)
         Friction vectors (palm:0, palm:1, left finger, right finger).
     force_margin : float
-        N: the planned mode's normal forces must be at least this at every contact.
+        N: the planned mode's normal forces must be at least this at every contact it keeps (a breaking contact,
+        ``B``, carries none).
     xdot_rows : float
         The workpiece's ``x`` velocity (m/s) the rows show (finite difference); nan: not checked.
     batched : bool
@@ -160,6 +161,7 @@ def mode_checks(task, cols, k, mus, force_margin=0.0, xdot_rows=np.nan, batched=
     planned = feasible[:, j_mode] if j_mode is not None else np.zeros(len(mus), dtype=bool)
     degenerate = np.isin(sv.codes, degenerate_codes)
     excluded = np.zeros(len(letters), dtype=bool)
+    held = np.array([i for i, letter in enumerate(mode) if letter != "B"], dtype=int)
     for i, mu in enumerate(mus):
         row = sv.codes[i]
         if n_feasible[i] > planned[i] and "mode" not in found:
@@ -184,8 +186,9 @@ def mode_checks(task, cols, k, mus, force_margin=0.0, xdot_rows=np.nan, batched=
         if not planned[i]:
             continue
         c_n, qdot = sv.c_n[i, j_mode], sv.qdot[i, j_mode]
-        if force_margin > 0 and c_n.min() < force_margin and "force margin" not in found:
-            i_c = int(np.argmin(c_n))
+        loaded = c_n[held]  # a breaking contact carries no force: the margin binds the others (eq. 28 made strict)
+        if force_margin > 0 and loaded.size and loaded.min() < force_margin and "force margin" not in found:
+            i_c = int(held[np.argmin(loaded)])
             found["force margin"] = (f"normal force {c_n[i_c]:.4g} N at contact {i_c} below the margin "
                                      f"{force_margin:g} N at mu = {_fmt_mu(mu)}")  # fmt: skip
         xdot = qdot[0] - qdot[2] * float(cols["y_workpiece"][k])  # qdot is the world origin's velocity

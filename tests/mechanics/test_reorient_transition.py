@@ -160,3 +160,18 @@ def test_pivot_sweep_bands_and_their_events():
         assert [pivot_band(hand, t, name.rpartition("_")[2], task.mu_range, task.force_margin).feasible
                 for t in (at + 1e-5, at - 1e-5)] == [True, False]  # fmt: skip
     assert events["right_flush_12"] < events["band_right"] < events["slip_right"] < events["com"] < events["left_tip"] < 0.0
+
+
+def test_the_certifier_s_force_margin_binds_the_contacts_the_mode_keeps():
+    """BSSSS breaks palm:0 (no force there by definition): the certifier's force-margin check binds the four
+    contacts the mode keeps, so just inside the margin's band it finds nothing, and just outside it names one."""
+    task, hand = _task(), _task().hand
+    scene = transition_scene(hand, flush_instant(hand), "right")
+    mode = formation(TRANSITION_FORMATION).mode
+    band = robust_band(scene, mode, task.mu_range, force_margin=task.force_margin)
+    mus = _frictions(scene.n_contacts, 5)
+    cols = {"mode": np.array([mode]), "y_workpiece": np.array([0.0])}
+    for tau, clean in ((band.lower + INSIDE, True), (band.lower - OUTSIDE, False)):
+        s = replace(scene, joint_effort=np.where(scene.effort_controlled, tau, np.nan))
+        found, _ = mode_checks(task, cols, 0, mus, task.force_margin.normal, scene=s)
+        assert (found == []) is clean, (tau, found)
