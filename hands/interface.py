@@ -118,6 +118,11 @@ def joint_units(hand, quantity: str = "q") -> tuple:
     return tuple(JOINT_UNITS[k][quantity] for k in joint_kinds(hand))
 
 
+def joint_unit(hand, joint: str, quantity: str = "q") -> str:
+    """The unit of joint ``joint``'s ``quantity`` (:func:`joint_units`): a jaw's effort in N, a finger's in N m."""
+    return joint_units(hand, quantity)[joint_names(hand).index(joint)]
+
+
 def finger_joint_names(hand) -> tuple:
     """``(left finger's joints, right finger's joints)``, each a tuple of names from the palm to the tip."""
     hand = _record(hand)

@@ -17,7 +17,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from qsplan.mechanics.errors import NoAnswerError, QsplanError
+from qsplan.mechanics.errors import QsplanError
 
 from qsplan.planner.plan.failure import configuration_report, failure_report
 from qsplan.planner.plan.results import ContactSegmentPlan, PlanFailure, RegraspPlan
@@ -233,7 +233,7 @@ def slide_phase(task, name, x0, x1, effort, direction, touching, comps, t0, opti
                 grasp=None, path=None) -> ContactSegmentPlan:  # fmt: skip
     """The in-contact phase sliding the workpiece from ``x0`` to ``x1`` (m) in the formation's mode: the dense sweep
     judges every sample (:func:`sweep_contact_segment`), then the commands are chosen (the largest margin kept
-    along the whole segment, :func:`qsplan.planner.torque.command.choose_command`).  ``path``: a described hand's
+    along the whole segment, :func:`qsplan.planner.torque.command.plan_command`).  ``path``: a described hand's
     free joints along it (:class:`FreePath`; default held).
 
     Raises
@@ -242,7 +242,7 @@ def slide_phase(task, name, x0, x1, effort, direction, touching, comps, t0, opti
         With a :func:`qsplan.planner.plan.failure.failure_report` of the first invalid sample.
     """
     from qsplan.planner.search.ompl_bridge import PlanResult
-    from qsplan.planner.torque.command import choose_command, default_safety_margin
+    from qsplan.planner.torque.command import plan_command
 
     # the configuration is the workpiece's x (the fingers follow the grasp, a described hand's free joints their
     # path): the only path is the straight line, and its dense sweep is the whole check
@@ -261,11 +261,7 @@ def slide_phase(task, name, x0, x1, effort, direction, touching, comps, t0, opti
     res = PlanResult(line, True, f"dense sweep: all {len(x)} states valid", len(x), seconds, options)
     mode = task.formation.mode
     progress(f"  {res.status} (overlaps, limits, contacts, {mode_name(mode)} kinematics, guaranteed band) in {seconds:.2f} s")
-    try:
-        safety = default_safety_margin(band, task.torque_resolution)
-    except NoAnswerError:  # unbounded everywhere: keep the controller's resolution from the finite edge
-        safety = task.torque_resolution
-    command, margin = choose_command(band.lower, band.upper, safety, max_margin=safety)
+    command, margin = plan_command(band.lower, band.upper, task.torque_resolution, band.feasible)
     s = np.concatenate([[0.0], np.cumsum(np.abs(np.diff(x)))])
     qd = S.qd.copy()
     qd[:, task.hand.joint_names.index(effort)] = np.nan  # the effort-controlled joint gets no velocity command

@@ -122,15 +122,13 @@ def _rest_bands(task, ph):
     A row at rest has no velocity; the certifier judges it for the straight line to the adjacent row, the motion the
     controller makes there (:func:`qsplan.planner.certify.timing.row_velocity`).  The planner's band at that row is
     for the path's tangent; both motions pass the row, so the band kept is their intersection, and the commands
-    are chosen again by the slide's rule (:func:`qsplan.planner.torque.command.choose_command`).  With one
+    are chosen again by the slide's rule (:func:`qsplan.planner.torque.command.plan_command`).  With one
     velocity-controlled joint the two directions agree (same sign): nothing changes.
     """
-    from types import SimpleNamespace
-
     from qsplan.hands.interface import scene_at
     from qsplan.mechanics.bands.batched_robust import robust_bands
-    from qsplan.mechanics.errors import NoAnswerError, QsplanError
-    from qsplan.planner.torque.command import choose_command, default_safety_margin
+    from qsplan.mechanics.errors import QsplanError
+    from qsplan.planner.torque.command import plan_command
 
     names = task.hand.joint_names
     effort = np.array(names) == ph.effort_joint
@@ -148,14 +146,7 @@ def _rest_bands(task, ph):
         lower[k], upper[k] = max(lower[k], rb.lower), min(upper[k], rb.upper)
     if np.array_equal(lower, ph.lower) and np.array_equal(upper, ph.upper):
         return ph.lower, ph.upper, ph.command, ph.margin
-    width = upper - lower
-    try:
-        safety = default_safety_margin(SimpleNamespace(lower=lower, upper=upper, width=width,
-                                                       feasible=np.ones(width.size, bool)), task.torque_resolution)
-    except NoAnswerError:
-        safety = task.torque_resolution
-    command, margin = choose_command(lower, upper, safety, max_margin=safety)
-    return lower, upper, command, margin
+    return (lower, upper, *plan_command(lower, upper, task.torque_resolution))
 
 
 def _leg(task, qa, qb, limits, what):
@@ -169,12 +160,9 @@ def _leg(task, qa, qb, limits, what):
     binding = min(cands, key=cands.get)
     alpha = cands[binding]
     ramp = 1.0 / (2.0 * alpha)  # s covered from rest to the quasistatic speed
-    if S > 2.0 * ramp:
-        s = np.array([0.0, ramp, S - ramp, S])
-        v, peak = np.array([0.0, 1.0, 1.0, 0.0]), 1.0
-    else:
-        peak = float(np.sqrt(alpha * S))
-        s, v = np.array([0.0, 0.5 * S, S]), np.array([0.0, peak, 0.0])
+    s = np.array([0.0, ramp, S - ramp, S]) if S > 2.0 * ramp else np.array([0.0, 0.5 * S, S])  # where ramps end
+    v = piece_scale(s, alpha)
+    peak = float(v.max())
     q = qa[None, :] + (s[1:, None] / S) * dq[None, :]
     q[-1] = qb  # exactly the planned row
     return q, v[1:], _durations(s, v), rate, alpha, peak, binding

@@ -82,7 +82,7 @@ def joint_title(name) -> str:
 
 
 def phase_label(phase, hand=None) -> tuple:
-    """``(mode, control)`` in words: ``("4S (SSSS)", "right finger torque")`` or ``("regrasp", "fingers velocity")``;
+    """``(mode, control)`` in words: ``("4S (<letters>)", "right finger torque")`` or ``("regrasp", "fingers velocity")``;
     a described ``hand``'s joints by name (``"left_jaw joint force"``)."""
     from qsplan.mechanics.modes.contact_mode import ContactMode
 
@@ -254,7 +254,7 @@ def plot_mode_timeline(plan, ax=None, marks=None, legend=True, xlabel=True, comp
     legend, xlabel : bool
         Draw the colour legend (below) and the time label (the plan card draws its own).
     compact : bool
-        One line per box (the plan card's thin bar): ``"phase 0: 4S (SSSS), right finger torque"``, else
+        One line per box (the plan card's thin bar): ``"phase 0: 4S (<letters>), right finger torque"``, else
         ``"phase 0"``, else ``"0"``.
 
     Returns

@@ -156,7 +156,7 @@ class SegmentReplay:
         The plan's phase index (the ``phase`` column).
     planned_mode : str
     labels : tuple of str
-        Mode labels of the simulated stretches, in order (``("SSSS",)`` when followed).
+        Mode labels of the simulated stretches, in order (the planned mode alone when followed).
     stop : str or None
         The simulator's stop message, None when it reached the segment's end.
     x_error : float

@@ -36,9 +36,9 @@ def _effort_words(task, name) -> str:
 
 
 def _unit(task, name) -> str:
-    from qsplan.hands.interface import JOINT_UNITS
+    from qsplan.hands.interface import joint_unit
 
-    return JOINT_UNITS[task.hand.joint_kinds[task.hand.joint_names.index(name)]]["tau"]
+    return joint_unit(task.hand, name, "tau")
 
 
 def _width(w: float, unit: str) -> str:

@@ -27,7 +27,7 @@ __all__ = ["TOUCH_AREA", "StateCheck", "check_contact_state", "check_free_state"
 TOUCH_AREA = 1e-10
 
 def mode_name(letters: str) -> str:
-    """The paper's name of a mode (``"SSSS"`` -> ``"4S"``, ``"RBSS"`` -> ``"R1S3"``: :attr:`ContactMode.name`)."""
+    """The paper's name of a mode (four S -> ``"4S"``, ``"RBSS"`` -> ``"R1S3"``: :attr:`ContactMode.name`)."""
     from qsplan.mechanics.modes.contact_mode import ContactMode
 
     return ContactMode(letters).name

@@ -18,7 +18,7 @@ import numpy as np
 
 from qsplan.mechanics.errors import NoAnswerError, QsplanError
 
-__all__ = ["MAX_MARGIN_RESOLUTIONS", "choose_command", "command_rule", "default_safety_margin", "segment_command",
+__all__ = ["MAX_MARGIN_RESOLUTIONS", "choose_command", "command_rule", "default_safety_margin", "plan_command", "segment_command",
            "with_segment_command"]
 
 #: The largest margin (in torque resolutions) a command keeps from its band's edges.  A plan
@@ -155,6 +155,21 @@ def default_safety_margin(band, resolution=None) -> float:
         floor = 0.0 if resolution is None else 0.5 * float(resolution)
         return min(max(float(edges.max()), floor), cap)
     raise NoAnswerError("safety margin: no bounded band along the segment to size it from; pass one explicitly")
+
+
+def plan_command(lower, upper, resolution, feasible=None) -> tuple:
+    """A planned segment's command and margin from its band arrays (N m or N, shape (n,)): the margin sized by
+    :func:`default_safety_margin` (the torque ``resolution`` where no band along it is bounded), kept from both
+    edges (:func:`segment_command`).  ``feasible``: where a band exists (default everywhere)."""
+    from types import SimpleNamespace
+
+    lower, upper = np.asarray(lower, float), np.asarray(upper, float)
+    ok = np.ones(lower.shape, bool) if feasible is None else np.asarray(feasible, bool)
+    try:
+        m = default_safety_margin(SimpleNamespace(lower=lower, upper=upper, width=upper - lower, feasible=ok), resolution)
+    except NoAnswerError:  # unbounded everywhere: keep the controller's resolution from the finite edge
+        m = float(resolution)
+    return segment_command(lower, upper, m)
 
 
 def with_segment_command(bands, resolution=None, safety_margin=None, max_margin=None):
