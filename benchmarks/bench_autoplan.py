@@ -10,7 +10,9 @@ its regrasps; and the same on seeded synthetic tables of six grasps (what a hand
 gives).  Then each task planned end to end by :func:`qsplan.planner.plan_task` (tables, search, dense
 sweeps, OMPL regrasps; wall time), the described hands' (issue 15: the two-link hand, the parallel-jaw
 gripper) on their contact manifolds: time, states evaluated (the planner's validity checks and dense
-samples), phases and the narrowest guaranteed band.  ``qsplan demo``'s whole-command time is in ``bench_plan.py``.
+samples), phases and the narrowest guaranteed band.  The goals that turn the workpiece (issue 23: the slide to the
+flush instant, a certified hold, the pivot) in a table of their own: time, states, phases, the narrowest band, the
+holds and their proof margin, the motion's duration.  ``qsplan demo``'s whole-command time is in ``bench_plan.py``.
 
 Run: ``python3 benchmarks/bench_autoplan.py [--iterations N]``.
 """
@@ -74,7 +76,8 @@ def main(argv=None):
     args = ap.parse_args(argv)
     tasks = {stem: load_task(p) for stem, p in task_paths().items()}
     tasks = {k: t for k, t in tasks.items() if t.goal is not None}
-    paper = {k: t for k, t in tasks.items() if hasattr(t.hand, "finger_length")}  # the band tables: the paper's hand
+    # the band tables: the paper's hand, goals on the palm edge (a turning goal: its own table below)
+    paper = {k: t for k, t in tasks.items() if hasattr(t.hand, "finger_length") and t.goal.x is not None}
     print(f"{'task':<22} {'planner':<9} {'search s':>9} {'evaluated':>10} {'narrowest N m':>14} {'regrasps':>9}")
     planned = {}
     for stem, task in paper.items():
@@ -89,6 +92,7 @@ def main(argv=None):
         w = "no route" if width is None else f"{width:.4g}"
         print(f"{label:<22} {name:<9} {secs:9.3f} {evals:10d} {w:>14} {'-' if regrasps is None else regrasps:>9}")
         label = ""
+    turning_rows({k: t for k, t in tasks.items() if t.goal.x is None})
     print()
     print(f"{'task':<30} {'hand':<22} {'plan s':>7} {'states':>7} {'segments':>9} {'regrasps':>9} {'narrowest':>12}")
     for stem, task in tasks.items():
@@ -103,6 +107,40 @@ def main(argv=None):
                   f"{len(plan.segments):9d} {len(plan.phases) - len(plan.segments):9d} {w:8.4g} {unit}")  # fmt: skip
         except Exception as exc:  # an infeasible task: its report
             print(f"{stem:<30} {hand:<22} {time.perf_counter() - t0:7.2f} no plan: {str(exc)[:80]}")
+
+
+def hold_margin(task, ph) -> float:
+    """The smallest margin (N) of the hold proofs at a hold phase's ramp ends (qsplan.mechanics.bands.hold)."""
+    import numpy as np
+
+    from qsplan.hands.found_contacts import row_contact_scene
+    from qsplan.mechanics.bands.hold import prove_hold
+
+    pose = ph.poses(task.hand.rest_height)[0]
+    effort = np.array(task.hand.joint_names) == ph.effort_joint
+    scene = row_contact_scene(task.hand, pose, ph.q[0], effort, np.zeros(effort.size))
+    return min(prove_hold(scene, torques=[t], disturbance=task.disturbance).margin for t in ph.command[[0, -1]])
+
+
+def turning_rows(tasks):
+    """The goals that turn the workpiece (issue 23: slide, hold, pivot): time, states, the route's phases, the
+    narrowest band, the holds and their smallest proof margin, the motion's duration."""
+    print()
+    print(f"{'turning task':<22} {'plan s':>7} {'states':>7} {'phases':<20} {'narrowest N m':>14} {'holds':>6} "
+          f"{'hold margin N':>14} {'motion s':>9}")  # fmt: skip
+    for stem, task in tasks.items():
+        t0 = time.perf_counter()
+        try:
+            plan = plan_task(task)
+        except Exception as exc:  # a refused goal: its reason
+            print(f"{stem:<22} {time.perf_counter() - t0:7.2f} refused: {str(exc)[:90]}")
+            continue
+        secs = time.perf_counter() - t0
+        holds = [p for p in plan.segments if p.kind == "hold"]
+        margin = min((hold_margin(task, h) for h in holds), default=float("nan"))
+        kinds = " ".join(p.kind if p.in_contact else "regrasp" for p in plan.phases)
+        print(f"{stem:<22} {secs:7.2f} {plan.validity_checks:7d} {kinds:<20} {plan.narrowest()[2]:14.4g} "
+              f"{len(holds):6d} {margin:14.4g} {plan.duration:9.2f}")  # fmt: skip
 
 
 if __name__ == "__main__":

@@ -279,30 +279,11 @@ def contact_set_scene(hand, pose, q, contacts, effort_controlled, velocity, effo
         Contacts in the order and with the names of ``contacts``; ``W_n, W_t`` (eq. 1), ``J_n, J_t`` (eq. 5),
         ``g_obj`` the workpiece's weight at its centre of mass (the pose's point, eq. 2), ``g_man`` (eq. 3).
     """
-    from qsplan.hands.interface import joint_names, manipulator_of
-    from qsplan.mechanics.model.contact import point_wrench, wrench_matrices
-    from qsplan.mechanics.model.manipulator import contact_jacobian, gravity_efforts
-    from qsplan.mechanics.model.scene import make_scene
+    from qsplan.hands.point_scene import points_scene
 
     found = locate_contacts(hand, pose, q, contacts, tol)
-    pose, q, _ = _configuration(hand, pose, q)
-    man, names, n_c = manipulator_of(hand), joint_names(hand), len(found.specs)
-    n_j = len(names)
-    e = np.asarray(effort_controlled, dtype=bool).reshape(-1)
-    if e.shape != (n_j,):
-        raise QsplanError(f"effort_controlled: expected {n_j} flags (one per joint); got shape {e.shape}")
-    v = np.broadcast_to(np.asarray(velocity, dtype=float), (n_j,))
-    tau = np.zeros(n_j) if effort is None else np.broadcast_to(np.asarray(effort, dtype=float), (n_j,))
-    Wn, Wt = wrench_matrices(found.points, found.normals)
-    Jn, Jt = np.zeros((n_c, n_j)), np.zeros((n_c, n_j))
-    for i, link in enumerate(found.links):
-        if link >= 0:
-            Jn[i], Jt[i] = contact_jacobian(man, q, int(link), found.points[i], found.normals[i])
-    mu = np.full(n_c, float(hand.mu)) if mu is None else np.broadcast_to(np.asarray(mu, dtype=float), (n_c,))
-    g_obj = point_wrench(pose[:2], (0.0, -float(hand.workpiece_mass) * man.gravity))
-    return make_scene(Wn, Wt, Jn, Jt, mu, g_obj, g_man=gravity_efforts(man, q), effort_controlled=e,
-                      joint_velocity=np.where(e, np.nan, v), joint_effort=np.where(e, tau, np.nan),
-                      joint_names=names, contact_names=found.names)  # fmt: skip
+    return points_scene(hand, pose, q, found.points, found.normals, found.links, found.names, effort_controlled,
+                        velocity, effort, mu)
 
 
 def flush_contacts(hand, pose, q, body: str, workpiece_edge: int, body_edge: int, names=None,

@@ -15,7 +15,7 @@ import numpy as np
 
 from qsplan.mechanics.errors import SceneError
 
-__all__ = ["FLAT_TOL", "PreparedWorkpiece", "prepare_workpiece", "rotation", "workpiece_world"]
+__all__ = ["polygon_inertia", "FLAT_TOL", "PreparedWorkpiece", "prepare_workpiece", "rotation", "workpiece_world"]
 
 #: Relative tolerance (of the workpiece's size) within which the two lowest
 #: vertices count as one horizontal bottom edge; polygon coordinates are
@@ -130,3 +130,18 @@ def _lay_on_edge(V, perm, of_user, palm_edge):
         raise SceneError(f"palm_edge: the workpiece cannot rest on edge {palm_edge}: its centroid (x = {poly.centroid.x:.6g} m "
                          f"along the edge) is not over the edge [{V[a, 0]:.6g}, {V[b, 0]:.6g}] m")  # fmt: skip
     return V, poly
+
+
+def polygon_inertia(polygon, mass) -> tuple:
+    """``(centroid (2,), inertia about it)`` of a uniform lamina of ``mass`` (kg) over ``polygon`` (k, 2) (m): the
+    polar second moment (kg m^2), by the shoelace sums."""
+    p = np.asarray(polygon, dtype=float)
+    a, b = p, np.roll(p, -1, axis=0)
+    cross = a[:, 0] * b[:, 1] - b[:, 0] * a[:, 1]
+    area = cross.sum() / 2.0
+    c = ((a + b) * cross[:, None]).sum(axis=0) / (6.0 * area)
+    a, b = a - c, b - c
+    cross = a[:, 0] * b[:, 1] - b[:, 0] * a[:, 1]
+    j = (cross * (a[:, 0] ** 2 + a[:, 0] * b[:, 0] + b[:, 0] ** 2 + a[:, 1] ** 2 + a[:, 1] * b[:, 1]
+                  + b[:, 1] ** 2)).sum() / 12.0  # fmt: skip
+    return c, abs(float(mass) * j / area)

@@ -25,7 +25,7 @@ import math
 
 import numpy as np
 
-__all__ = ["BAND_RTOL", "band_checks", "free_row_cells", "recomputed_bands"]
+__all__ = ["BAND_RTOL", "band_checks", "free_row_cells", "hold_band", "recomputed_bands"]
 
 #: Relative excess (of the larger finite edge, at least 1 N m) tolerated of an exported band edge over the
 #: recomputed one.  Planner and certifier compute the band with the same equations from scenes that agree to
@@ -47,15 +47,35 @@ def recomputed_bands(task, cols, scenes: dict) -> dict:
     """
     from qsplan.mechanics.bands.batched_robust import robust_bands
 
+    from qsplan.planner.certify.contacts import hold_row
+
     groups = {}
     for k in scenes:
         groups.setdefault(str(cols["mode"][k]), []).append(k)
     out = {}
     for mode, rows in groups.items():
+        if all(hold_row(cols, k) for k in rows):  # a hold: its band is the proved hold interval
+            out.update((k, hold_band(task, scenes[k])) for k in rows)
+            continue
         bands = robust_bands([scenes[k] for k in rows], mode, task.mu_range, shared=task.shared_mu,
                              force_margin=task.force_margin, disturbance=task.disturbance)  # fmt: skip
         out.update(zip(rows, bands))
     return out
+
+
+def hold_band(task, scene):
+    """A hold row's band recomputed: the torques at which a hold is proved with every contact loaded by at least the
+    task's force margin, at every vertex of the disturbance box (:func:`qsplan.mechanics.bands.hold.
+    hold_torque_interval`; exact: the proved set is an interval), in :func:`band_checks`' terms."""
+    from types import SimpleNamespace
+
+    from qsplan.mechanics.bands.hold import hold_torque_interval
+
+    lo, hi = hold_torque_interval(scene, task.disturbance, margin=task.force_margin.normal)
+    ok = not (np.isnan(lo) or np.isnan(hi))
+    return SimpleNamespace(feasible=ok, lower=lo, upper=hi, exact=True,
+                           reason=None if ok else "no torque proves the hold (no frictionless equilibrium with every "
+                                                  "contact loaded by the force margin)")  # fmt: skip
 
 
 def band_checks(task, cols, k, rb) -> list:

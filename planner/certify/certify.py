@@ -37,6 +37,7 @@ import numpy as np
 from qsplan.mechanics import QsplanError
 
 from qsplan.planner.certify.bands import BAND_RTOL, band_checks, free_row_cells, recomputed_bands
+from qsplan.planner.certify.contacts import general_form, hold_row, judged_contact_checks, judged_contacts
 from qsplan.planner.certify.files import META_TOL, agreement_checks, metadata_checks, schema_checks
 from qsplan.planner.certify.inputs import (plan_columns_required, plan_sources, read_plan,
                                            read_plan_file, task_from_metadata)  # fmt: skip
@@ -307,6 +308,7 @@ def certify_plan(plan, task, *, n_random: int = 8, seed: int = 0, force_margin: 
     found_at = [[] for _ in range(n)]
     verdict_info, slip, ends = [], None, {}  # slip: (row, phase, sliding velocities) of the last in-contact row
     scenes = {}  # in-contact rows' scenes: their bands recomputed in one batch per mode
+    general = general_form(task)
     for k in range(n):
         mode = str(cols["mode"][k])
         found = limit_checks(task, cols, k)
@@ -326,25 +328,37 @@ def certify_plan(plan, task, *, n_random: int = 8, seed: int = 0, force_margin: 
                 if k + 1 < n and str(cols["mode"][k + 1]) == "free" and phase[k + 1] == phase[k]:
                     found += free_path_checks(task, cols, k, roots)
         elif not any(kind == "input" for kind, _ in found):
-            contact = contact_checks(task, cols, k, bodies)
+            judged = None
+            if general:  # any formation: the contacts the polygons show, in the canonical order
+                try:
+                    judged = judged_contacts(task, cols, k)
+                except QsplanError as exc:
+                    contact = [("contact", f"the row's contacts cannot be found: {exc}")]
+                else:
+                    contact = judged_contact_checks(task, cols, k, judged)
+            else:
+                contact = contact_checks(task, cols, k, bodies)
             found += contact
             if not contact:
-                mus = friction_points(task, int(n_random), rng)
                 try:
-                    scene = row_scene(task, cols, k)
+                    scene = row_scene(task, cols, k, judged)
                 except QsplanError as exc:
                     found.append(("contact", f"the row's scene cannot be built: {exc}"))
                 else:
                     scenes[k] = scene
-                    more, excluded = mode_checks(task, cols, k, mus, force_margin, _xdot_rows(cols, k, names), batched, scene)
-                    found += more
-                    if task.disturbance is not None:
-                        found += disturbance_checks(task, cols, k, mus, force_margin, batched, scene)
+                    mus = friction_points(task, int(n_random), rng, len(scene.contact_names))
+                    pts = len(mus)
+                    if not hold_row(cols, k):  # a hold: nothing moves, the hold proof decides (hold_checks)
+                        more, excluded = mode_checks(task, cols, k, mus, force_margin, _xdot_rows(cols, k, names),
+                                                     batched, scene)  # fmt: skip
+                        found += more
+                        if task.disturbance is not None:
+                            found += disturbance_checks(task, cols, k, mus, force_margin, batched, scene)
                     slips = slip_velocities(task, cols, k, scene)
-                    if slips is not None and slip is not None and slip[:2] == (k - 1, phase[k]):
+                    if (slips is not None and slip is not None and slip[:2] == (k - 1, phase[k])
+                            and len(slip[2]) == len(slips)):  # fmt: skip
                         found += slip_reversals(mode, scene.contact_names, slip[2], slips)
                     slip = None if slips is None else (k, phase[k], slips)
-                pts = len(mus)
         found_at[k] += found
         verdict_info.append((mode, pts, excluded))
         if progress is not None and (k + 1) % 50 == 0:

@@ -44,7 +44,7 @@ def _fmt_mu(mu) -> str:
     return "[" + ", ".join(f"{m:.4g}" for m in mu) + "]"
 
 
-def row_scene(task, cols, k):
+def row_scene(task, cols, k, judged=None):
     """The scene of in-contact row ``k`` rebuilt from the task (:func:`qsplan.hands.interface.scene_at`): the joints
     with a torque command (and the row's ``effort_joint``) effort-controlled at it, the others at their ``qd`` (a row
     at rest: the direction of the motion that leaves or reaches it, :func:`qsplan.planner.certify.timing.row_velocity`).
@@ -67,6 +67,10 @@ def row_scene(task, cols, k):
 
         moving = row_velocity(cols, k, names)
         qd = np.where(effort, np.nan, moving[0]) if moving is not None else qd
+    if judged is not None:  # any formation: the row's judged contacts (qsplan.planner.certify.contacts)
+        from qsplan.planner.certify.contacts import judged_scene
+
+        return judged_scene(task, cols, k, judged, effort, qd, tau)
     # method="generic": contacts found by polygon contact finding, the reference path, not the
     # closed-form grasp the planner uses (qsplan.hands.two_finger_analytic): a certifier shares no
     # shortcut with what it certifies (~2 ms per row); a chain hand's contacts are always found so
@@ -120,8 +124,8 @@ def mode_checks(task, cols, k, mus, force_margin=0.0, xdot_rows=np.nan, batched=
 
     Parameters
     ----------
-    mus : ndarray, shape (m, 4)
-        Friction vectors (palm:0, palm:1, left finger, right finger).
+    mus : ndarray, shape (m, n_c)
+        Friction vectors, one coefficient per contact of the row's scene.
     force_margin : float
         N: the planned mode's normal forces must be at least this at every contact it keeps (a breaking contact,
         ``B``, carries none).

@@ -26,7 +26,7 @@ import math
 
 import numpy as np
 
-__all__ = ["ENDPOINT_TOL", "FEATURE_TOL", "FREE_PATH_STEP", "endpoint_checks", "free_path_checks", "rest_checks",
+__all__ = ["ENDPOINT_TOL", "FEATURE_TOL", "FREE_PATH_STEP", "endpoint_checks", "free_path_checks", "orientation_checks", "rest_checks",
            "structure_checks", "touched_features"]
 
 #: Distance (m) between a row's workpiece x and the task's start, goal or waypoint still counted as there: the
@@ -64,7 +64,11 @@ def structure_checks(cols) -> list:
     for k in np.flatnonzero(same & ~(dt > 0))[:1]:
         out.append((int(k), "time", f"time goes from {t[k]:.17g} s to {t[k + 1]:.17g} s inside phase {int(ph[k])}; "
                                     "expected it to grow"))  # fmt: skip
-    for k in np.flatnonzero(same & ((mode[:-1] != mode[1:]) | (eff[:-1] != eff[1:])))[:1]:
+    # a phase keeps its mode and effort joint; its mode's letters change only where its contact set does (a pivot's
+    # first row judges the transition with the contact that lifts: qsplan.planner.certify.contacts)
+    letters = np.array([len(str(m)) for m in mode])
+    changed = (mode[:-1] != mode[1:]) & (letters[:-1] == letters[1:])
+    for k in np.flatnonzero(same & (changed | (eff[:-1] != eff[1:])))[:1]:
         out.append((int(k) + 1, "phase", f"mode {mode[k + 1]} / effort joint {eff[k + 1]} inside phase {int(ph[k])}, "
                                          f"whose rows before are {mode[k]} / {eff[k]}"))  # fmt: skip
     return out
@@ -138,7 +142,8 @@ def endpoint_checks(task, cols, first_bodies, last_bodies) -> list:
                 out.append((0, "start", f"joint {names[j]} starts at {q0:.9g}; the task's [start] gives "
                                         f"{task.start_joints[j]:.9g}"))  # fmt: skip
     if task.goal is not None:
-        if abs(x[-1] - task.goal.x) > ENDPOINT_TOL:
+        out += orientation_checks(task, cols, last_bodies)
+        if task.goal.x is not None and abs(x[-1] - task.goal.x) > ENDPOINT_TOL:
             out.append((n - 1, "goal", f"the plan ends with the workpiece at x = {x[-1]:.9g} m; the goal is "
                                        f"{task.goal.x:.9g} m"))  # fmt: skip
         out += _finger_claims(task, last_bodies, (task.goal.left, task.goal.right), "goal", n - 1)
@@ -151,6 +156,34 @@ def endpoint_checks(task, cols, first_bodies, last_bodies) -> list:
     for i, (k, w) in enumerate(zip(ends, wp)):
         if abs(x[k] - w) > ENDPOINT_TOL:
             out.append((k, "goal", f"in-contact stretch {i + 1} ends at x = {x[k]:.9g} m; the task's waypoint {i} is {w:.9g} m"))
+    return out
+
+
+def orientation_checks(task, cols, last_bodies) -> list:
+    """The plan ends at the goal's orientation: ``theta`` within :data:`ENDPOINT_TOL` (rad), and what the goal's
+    ``palm`` names on the palm (``edge:K``: both its ends; ``vertex:K``: that vertex), K as the task writes it."""
+    from shapely.geometry import Point
+
+    from qsplan.hands.workpiece import workpiece_world
+
+    from qsplan.planner.certify.rows import CONTACT_GAP_TOL, row_pose
+
+    goal, n = task.goal, cols["t"].size
+    pose = row_pose(cols, n - 1)
+    out = []
+    if goal.theta is not None and abs(pose[2] - goal.theta) > ENDPOINT_TOL:
+        out.append((n - 1, "goal", f"the plan ends with the workpiece at theta = {pose[2]:.9g} rad; the goal is "
+                                   f"{goal.theta:.9g} rad"))  # fmt: skip
+    if goal.palm is not None:
+        kind, k = goal.palm
+        hand = task.hand
+        internal = list(hand.user_edges if kind == "edge" else hand.user_vertices).index(k)
+        ends = [internal, (internal + 1) % len(hand.workpiece)] if kind == "edge" else [internal]
+        W = workpiece_world(hand, pose)
+        gaps = [Point(W[i]).distance(last_bodies["polys"]["palm"]) for i in ends]
+        if max(gaps) > CONTACT_GAP_TOL:
+            out.append((n - 1, "goal", f"the goal rests {kind} {k} on the palm; at the plan's end it is "
+                                       f"{max(gaps) * 1e3:.4g} mm above it"))  # fmt: skip
     return out
 
 

@@ -345,18 +345,19 @@ def command_step_checks(cols, k, names, units, dq, dt) -> list:
     return out
 
 
-def friction_points(task, n_random, rng) -> np.ndarray:
-    """Friction vectors (4,) to test, shape (m, 4): every vertex of the friction set, then ``n_random`` seeded draws.
+def friction_points(task, n_random, rng, n_contacts: int = 4) -> np.ndarray:
+    """Friction vectors to test, shape (m, n_contacts): every vertex of the friction set, then ``n_random`` seeded draws.
 
-    Box (independent coefficients): the 16 corners of ``[lo, hi]^4``; shared: ``lo`` and ``hi``.
+    Box (independent coefficients): the ``2^n_contacts`` corners of ``[lo, hi]^n_contacts``; shared: ``lo`` and ``hi``.
     """
     lo, hi = task.mu_range
+    n = int(n_contacts)
     if task.shared_mu:
-        vertices = np.array([[lo] * 4, [hi] * 4], dtype=float)
-        draws = np.repeat(rng.uniform(lo, hi, (n_random, 1)), 4, axis=1)
+        vertices = np.array([[lo] * n, [hi] * n], dtype=float)
+        draws = np.repeat(rng.uniform(lo, hi, (n_random, 1)), n, axis=1)
     else:
-        vertices = np.array(np.meshgrid(*[[lo, hi]] * 4, indexing="ij")).reshape(4, -1).T.astype(float)
-        draws = rng.uniform(lo, hi, (n_random, 4))
+        vertices = np.array(np.meshgrid(*[[lo, hi]] * n, indexing="ij")).reshape(n, -1).T.astype(float)
+        draws = rng.uniform(lo, hi, (n_random, n))
     return np.unique(np.vstack([vertices, draws]), axis=0) if lo == hi else np.vstack([vertices, draws])
 
 

@@ -89,7 +89,7 @@ def timing_checks(task, cols) -> list:
     from qsplan.hands.interface import joint_names, joint_units
 
     from qsplan.planner.certify.rows import COMMAND_RTOL, path_bend
-    from qsplan.planner.task.dynamics import inertial_wrench, task_dynamics
+    from qsplan.planner.task.dynamics import task_dynamics, turning_wrench
 
     if "speed_scale" not in cols:
         return [(None, "timing", "the plan has no speed_scale column: its phases do not start and end at rest")]
@@ -102,6 +102,9 @@ def timing_checks(task, cols) -> list:
     dyn = task_dynamics(task)
     box = task.disturbance
     m = float(task.hand.workpiece_mass)
+    from qsplan.hands.workpiece import polygon_inertia
+
+    inertia = polygon_inertia(task.hand.workpiece, m)[1]  # about the centre of mass: the turning term
     for rows in _phase_rows(cols):
         found = {}
         for k in (rows[0], rows[-1]):
@@ -136,17 +139,21 @@ def timing_checks(task, cols) -> list:
                     found["acceleration"] = (int(a), f"{n} joint's velocity command changes at {rate:.4g} "
                                                      f"{units[j]}/s^2 to the next row; {what} {acc[j]:g} "
                                                      f"{units[j]}/s^2")  # fmt: skip
-            ax = float(cols["x_workpiece"][b] - cols["x_workpiece"][a]) * ra
+            dp = np.array([float(cols[f"{c}_workpiece"][b] - cols[f"{c}_workpiece"][a]) for c in ("x", "y", "theta")])
+            acc = dp * ra  # the pose moves along the chord in proportion to the path (the rule)
+            ax = float(np.max(np.abs(acc)))
             if box is not None and ax != 0.0 and "acceleration" not in found:
-                w = inertial_wrench(m, float(cols["y_workpiece"][a]), ax)
+                com = np.array([cols["x_workpiece"][a], cols["y_workpiece"][a]], dtype=float)
+                w = turning_wrench(m, inertia, com, acc[:2], acc[2])
                 lo, hi = np.asarray(box.lo, float), np.asarray(box.hi, float)
                 slack = ACCEL_RTOL * np.maximum(np.abs(lo), np.abs(hi))
                 if np.any(w < lo - slack) or np.any(w > hi + slack):
-                    found["acceleration"] = (int(a), f"the workpiece accelerates at {ax:.4g} m/s^2 to the next row: its "
+                    found["acceleration"] = (int(a), f"the workpiece accelerates at ({acc[0]:.4g} m/s^2, {acc[1]:.4g} m/s^2, "
+                                                     f"{acc[2]:.4g} rad/s^2) to the next row: its "
                                                      f"inertial wrench [{w[0]:.4g} N, {w[1]:.4g} N, {w[2]:.4g} N m] "
                                                      "lies outside the disturbance box the bands withstand")  # fmt: skip
             elif box is None and ax != 0.0 and "acceleration" not in found:
-                found["acceleration"] = (int(a), f"the workpiece accelerates at {ax:.4g} m/s^2 and the task's bands "
+                found["acceleration"] = (int(a), f"the workpiece accelerates at {ax:.4g} (m/s^2 or rad/s^2) and the task's bands "
                                                  "withstand no disturbance")  # fmt: skip
         out += [(row, kind, msg) for kind, (row, msg) in found.items()]
     return out

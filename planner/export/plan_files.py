@@ -84,6 +84,23 @@ def column_meanings(names, kinds=None) -> dict:
     return out
 
 
+def phase_contacts(ph) -> dict:
+    """``contacts``: the names the mode letters of the phase's first row follow, in order; ``contact_sets``: each run
+    of rows (first and last row index within the phase) with one contact list and mode (a pivot's first row judges
+    the transition with the contact that lifts, the later rows without it)."""
+    from qsplan.hands.formations import formation
+
+    names = ph.contacts if ph.contacts is not None else (formation(ph.formation).contact_names,) * ph.t.size
+    modes = ph.modes()
+    runs = []
+    for k, (c, m) in enumerate(zip(names, modes)):
+        if runs and runs[-1]["contacts"] == list(c) and runs[-1]["mode"] == m:
+            runs[-1]["rows"][1] = k
+        else:
+            runs.append({"rows": [k, k], "contacts": list(c), "mode": m})
+    return {"contacts": list(names[0]), "contact_sets": runs}
+
+
 def plan_metadata(plan) -> dict:
     """What a controller engineer needs to trust the plan (all SI).
 
@@ -102,13 +119,14 @@ def plan_metadata(plan) -> dict:
         d = {"index": i, "name": ph.name, "t_start_s": float(ph.t[0]), "t_end_s": float(ph.t[-1]), "rows": int(ph.t.size)}
         if isinstance(ph, ContactSegmentPlan):
             k = int(np.argmin(ph.width))
-            d.update(kind="contact", mode=ph.mode, effort_joint=ph.effort_joint, competitors_precluded=list(ph.competitors),
+            d.update(kind="contact", mode=ph.modes()[0], effort_joint=ph.effort_joint, competitors_precluded=list(ph.competitors),
                      workpiece_speed_m_s=ph.speed, ompl_states=int(ph.x_path.size),
                      narrowest_band={"t_s": float(ph.t[k]), "width_N_m": _num(ph.width[k])},
                      command={"margin_N_m": _num(np.min(ph.margin)), "half_narrowest_band_N_m": _num(0.5 * ph.width[k]),
                               "max_N_m": _num(np.max(ph.command)), "lower_edge_max_N_m": _num(np.max(ph.lower))})  # fmt: skip
             # the effort's unit: N m, or N for a prismatic joint (then its numbers under *_N_m are in N)
             d["effort_unit"] = _joint_units(task.hand)[ph.effort_joint]["tau"]
+            d.update(phase_kind=ph.kind, formation=ph.formation, **phase_contacts(ph))
         else:
             d.update(kind="regrasp", x_workpiece_m=float(np.ravel(ph.x)[0]))
         if plan.timing:

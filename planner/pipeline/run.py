@@ -219,7 +219,7 @@ def _scene(plan, stage) -> str:
     from qsplan.planner.replay.mujoco_scene import write_scene
 
     first = plan.phases[0]  # the plan's first row: the keyframe
-    start = (plan.task.pose(np.ravel(first.x)[0]), np.asarray(first.q[0], dtype=float))
+    start = (first.poses(plan.task.hand.rest_height)[0], np.asarray(first.q[0], dtype=float))
     write_scene(plan.task, stage / "scene.xml", start=start, force=True)
     return "scene.xml"
 

@@ -243,7 +243,7 @@ class _Rejected(Exception):
         self.what, self.failure = what, failure
 
 
-def plan_automatic(task, options=None, progress=None, planner: str = "widest", tables=None) -> Plan:
+def plan_automatic(task, options=None, progress=None, planner: str = "widest", tables=None, timed: bool = True) -> Plan:
     """Plan an automatic task (one with a ``goal``): see the module docstring.
 
     Parameters
@@ -257,6 +257,9 @@ def plan_automatic(task, options=None, progress=None, planner: str = "widest", t
         The sequence search (:data:`qsplan.planner.search.ompl_search.SEQUENCE_PLANNERS`).
     tables : BandTables, optional
         Precomputed tables (benchmarks reuse them across planners).
+    timed : bool
+        Time-scale the plan (:func:`qsplan.planner.plan.timing.time_scale`); False: the quasistatic phases, for a
+        route that continues them (:mod:`qsplan.planner.plan.reorient`).
 
     Returns
     -------
@@ -336,6 +339,8 @@ def plan_automatic(task, options=None, progress=None, planner: str = "widest", t
     # precluded, per configuration, torque-controlled finger and direction), then the dense sweeps and OMPL's checks
     plan = Plan(task, tuple(phases), time.perf_counter() - t_start, counters[0] + tables.band_states,
                 counters[1] + tables.seconds, options, tuple(seq) + (meta,))  # fmt: skip
+    if not timed:
+        return plan
     plan = time_scale(plan)
     plan.check()
     if not any(isinstance(p, ContactSegmentPlan) for p in plan.phases):

@@ -58,6 +58,19 @@ class ContactSegmentPlan:
     speed_scale : ndarray, shape (n,), or None
         The time scaling at each row (:mod:`qsplan.planner.plan.timing`): the fraction of the quasistatic speed
         commanded, 0 at rest (the first and last rows), 1 cruising; None before the time scaling.
+    kind : str
+        ``"slide"`` (the workpiece slides on its palm edge, the paper's Fig. 9), ``"hold"`` (nothing moves while the
+        effort joint's torque ramps: a certified hold) or ``"pivot"`` (the workpiece turns on a palm vertex), the
+        phase kinds of :mod:`qsplan.planner.plan.reorient`.
+    pose : ndarray, shape (n, 3), or None
+        The workpiece's pose ``(x, y, theta)`` at each row (m, m, rad); None: on its palm edge at ``x``.
+    row_modes : tuple of str, or None
+        Each row's contact mode, one letter per contact the row is judged with (:attr:`contacts`); None: ``mode``
+        at every row.
+    formation : str
+        The registered formation (:mod:`qsplan.hands.formations`) naming the phase's contacts.
+    contacts : tuple of tuple of str, or None
+        Per row, the names of the contacts its mode's letters follow, in order; None: the formation's.
     """
 
     name: str
@@ -76,11 +89,27 @@ class ContactSegmentPlan:
     speed: float
     planning: object
     speed_scale: np.ndarray | None = None
+    kind: str = "slide"
+    pose: np.ndarray | None = None
+    row_modes: tuple | None = None
+    formation: str = "palm_edge"
+    contacts: tuple | None = None
     in_contact = True  # the workpiece held in a contact mode (a class constant, not a field)
 
     @property
     def width(self) -> np.ndarray:
         return self.upper - self.lower
+
+    def poses(self, rest_height: float) -> np.ndarray:
+        """The workpiece's pose at every row (m, m, rad), shape (n, 3): :attr:`pose`, or ``(x, rest_height, 0)``."""
+        if self.pose is not None:
+            return np.asarray(self.pose, dtype=float)
+        x = np.broadcast_to(np.asarray(self.x, dtype=float), (self.t.size,))
+        return np.column_stack([x, np.full(x.size, float(rest_height)), np.zeros(x.size)])
+
+    def modes(self) -> tuple:
+        """Each row's mode letters (:attr:`row_modes`, or :attr:`mode` at every row)."""
+        return tuple(self.row_modes) if self.row_modes is not None else (self.mode,) * self.t.size
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -110,6 +139,10 @@ class RegraspPlan:
     planning: tuple
     speed_scale: np.ndarray | None = None
     in_contact = False  # the fingers move in free space (a class constant, not a field)
+
+    def poses(self, rest_height: float) -> np.ndarray:
+        """The workpiece's pose at every row (m, m, rad), shape (n, 3): resting on its palm edge at ``x``."""
+        return np.tile([float(self.x), float(rest_height), 0.0], (self.t.size, 1))
 
 
 @dataclass(frozen=True, slots=True, eq=False)

@@ -267,6 +267,12 @@ def plan_task(task: Task, options: PlannerOptions | None = None, progress=None, 
     from qsplan.planner.plan.failure import palm_report
 
     check_goal_served(task)  # a goal in another formation (theta, another palm feature): refused by name first
+    from qsplan.planner.task.goal import reorients
+
+    if reorients(task):  # the route through the flush instant, a hold and the pivot
+        from qsplan.planner.plan.reorient import plan_reorientation
+
+        return plan_reorientation(task, options, progress, sequence_planner)
     beyond = palm_report(task)  # from the task's geometry alone, before any table or grid is built
     if beyond is not None:
         raise PlanFailure(beyond)

@@ -15,7 +15,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-__all__ = ["RegraspStep", "SearchSummary", "SlideStep", "search_summary", "step_dicts"]
+__all__ = ["HoldStep", "PivotStep", "RegraspStep", "SearchSummary", "SlideStep", "search_summary", "step_dicts"]
 
 
 def _finite(v) -> float | None:
@@ -74,6 +74,46 @@ class RegraspStep:
     def as_dict(self) -> dict:
         return {"kind": self.kind, "x_from_m": self.x, "x_to_m": self.x, "grasp_from": self.grasp_from,
                 "grasp_to": self.grasp_to, "x": self.x, "from": self.grasp_from, "to": self.grasp_to}  # fmt: skip
+
+
+@dataclass(frozen=True, slots=True)
+class HoldStep:
+    """A certified hold of the route (:mod:`qsplan.planner.plan.reorient`): nothing moves at workpiece ``x`` (m) and
+    angle ``theta`` (rad) while ``effort_joint``'s torque ramps ``torque_from`` -> ``torque_to`` inside the proved
+    interval ``[proved_lower, proved_upper]`` (N m; inf: unbounded)."""
+
+    x: float
+    theta: float
+    effort_joint: str
+    torque_from: float
+    torque_to: float
+    proved_lower: float
+    proved_upper: float
+    kind = "hold"
+
+    def as_dict(self) -> dict:
+        return {"kind": self.kind, "x_from_m": self.x, "x_to_m": self.x, "theta_rad": self.theta,
+                "effort_joint": self.effort_joint, "torque_from": self.torque_from, "torque_to": self.torque_to,
+                "proved_interval": [_finite(self.proved_lower), _finite(self.proved_upper)]}  # fmt: skip
+
+
+@dataclass(frozen=True, slots=True)
+class PivotStep:
+    """A pivot of the route: the workpiece turns on its vertex ``vertex`` (as the task writes it) on the palm from
+    ``theta_from`` to ``theta_to`` (rad), ``effort_joint`` torque-controlled, its narrowest band ``narrowest_band``
+    (N m; inf: unbounded)."""
+
+    vertex: int
+    theta_from: float
+    theta_to: float
+    effort_joint: str
+    narrowest_band: float
+    kind = "pivot"
+
+    def as_dict(self) -> dict:
+        return {"kind": self.kind, "vertex": self.vertex, "theta_from_rad": self.theta_from,
+                "theta_to_rad": self.theta_to, "effort_joint": self.effort_joint,
+                "narrowest_band": _finite(self.narrowest_band), "effort_unit": "N m"}  # fmt: skip
 
 
 @dataclass(frozen=True, slots=True)

@@ -128,11 +128,12 @@ def plan_columns(plan) -> tuple:
             cols[f"tau_{name}"] += ph.command.tolist() if mine else nan
             cols[f"tau_{name}_min"] += ph.lower.tolist() if mine else nan
             cols[f"tau_{name}_max"] += ph.upper.tolist() if mine else nan
-        cols["mode"] += [ph.mode if contact else "free"] * n
+        cols["mode"] += list(ph.modes()) if contact else ["free"] * n
         cols["margin"] += ph.margin.tolist() if contact else nan
-        cols["x_workpiece"] += np.broadcast_to(np.asarray(ph.x, float), (n,)).tolist()
-        cols["y_workpiece"] += [y0] * n
-        cols["theta_workpiece"] += [0.0] * n
+        pose = ph.poses(y0)
+        cols["x_workpiece"] += pose[:, 0].tolist()
+        cols["y_workpiece"] += pose[:, 1].tolist()
+        cols["theta_workpiece"] += pose[:, 2].tolist()
         cols["phase"] += [i] * n
         cols["effort_joint"] += [ph.effort_joint if contact else "none"] * n
         for j, name in enumerate(joints):

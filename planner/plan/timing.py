@@ -99,6 +99,10 @@ def _slide(task, ph):
     limits = dyn.joint_accelerations
     names = task.hand.joint_names
     cands = {"workpiece_acceleration": dyn.workpiece_acceleration / abs(ph.speed)}
+    if ph.pose is not None:  # a turning workpiece: its angular acceleration too (Dynamics.angular_acceleration)
+        turn = np.max(np.abs(np.diff(ph.pose[:, 2])) / np.diff(s), initial=0.0)
+        if turn > 0:
+            cands["workpiece_acceleration (turning)"] = dyn.angular_acceleration(task.hand) / turn
     for j in np.flatnonzero(moving):
         cands[f"joint_acceleration.{names[j]}"] = limits[j] / np.max(np.abs(rates[:, j]))
     binding = min(cands, key=cands.get)
@@ -125,7 +129,6 @@ def _rest_bands(task, ph):
     are chosen again by the slide's rule (:func:`qsplan.planner.torque.command.plan_command`).  With one
     velocity-controlled joint the two directions agree (same sign): nothing changes.
     """
-    from qsplan.hands.interface import scene_at
     from qsplan.mechanics.bands.batched_robust import robust_bands
     from qsplan.mechanics.errors import QsplanError
     from qsplan.planner.torque.command import plan_command
@@ -136,7 +139,7 @@ def _rest_bands(task, ph):
     scenes = []
     for k, (a, b) in ((0, (0, 1)), (ph.t.size - 1, (ph.t.size - 2, ph.t.size - 1))):
         chord = (ph.q[b] - ph.q[a]) / (ph.t[b] - ph.t[a])  # the rows' quasistatic times: a velocity at speed scale 1
-        scenes.append((k, scene_at(task.hand, task.pose(ph.x[k]), ph.q[k], effort, np.where(effort, 0.0, chord))))
+        scenes.append((k, _rest_scene(task, ph, k, a if k == b else b, effort, np.where(effort, 0.0, chord))))
     bands = robust_bands([sc for _, sc in scenes], ph.mode, task.mu_range, shared=task.shared_mu,
                          force_margin=task.force_margin, disturbance=task.disturbance)  # fmt: skip
     for (k, _), rb in zip(scenes, bands):
@@ -147,6 +150,23 @@ def _rest_bands(task, ph):
     if np.array_equal(lower, ph.lower) and np.array_equal(upper, ph.upper):
         return ph.lower, ph.upper, ph.command, ph.margin
     return (lower, upper, *plan_command(lower, upper, task.torque_resolution))
+
+
+def _rest_scene(task, ph, k, other, effort, velocity):
+    """The scene of ``ph``'s row ``k`` at rest for the motion to or from row ``other``: the formation's closed form,
+    or where the polygons show another contact set there (a slide's last row at the flush instant), every contact
+    found but those the motion makes only at ``k`` (:func:`qsplan.hands.found_contacts.made_contacts`)."""
+    from qsplan.hands.found_contacts import made_contacts, ordered_contacts, row_contact_scene
+    from qsplan.hands.interface import scene_at
+    from qsplan.mechanics.errors import SceneError
+
+    pose = ph.poses(task.hand.rest_height)
+    try:
+        return scene_at(task.hand, pose[k], ph.q[k], effort, velocity)
+    except SceneError:
+        found = ordered_contacts(task.hand, pose[k], ph.q[k])
+        drop = made_contacts(task.hand, (pose[other], ph.q[other]), (pose[k], ph.q[k]), found) if other < k else None
+        return row_contact_scene(task.hand, pose[k], ph.q[k], effort, velocity, drop=drop)
 
 
 def _leg(task, qa, qb, limits, what):
@@ -196,8 +216,14 @@ def time_scale(plan):
     phases, timing, t0 = [], [], 0.0
     for ph in plan.phases:
         T = float(ph.t[-1] - ph.t[0])
-        if ph.in_contact:
-            lower, upper, command, margin = _rest_bands(task, ph)
+        if ph.in_contact and ph.kind == "hold":  # nothing moves: the rows keep their ramp's times
+            t, v = ph.t - ph.t[0], np.zeros(ph.t.size)
+            new = replace(ph, t=t0 + t, speed_scale=v)
+            pieces, alpha, peak, binding = 0, 0.0, 0.0, "none (a hold: nothing moves)"
+        elif ph.in_contact:
+            # a slide's rows at rest are judged again for the chord that leaves or reaches them; a pivot's already are
+            lower, upper, command, margin = (_rest_bands(task, ph) if ph.kind == "slide"
+                                             else (ph.lower, ph.upper, ph.command, ph.margin))  # fmt: skip
             t, v, qd, alpha, peak, binding = _slide(task, ph)
             new = replace(ph, t=t0 + t, qd=qd, speed_scale=v, lower=lower, upper=upper, command=command, margin=margin)
             pieces = 1

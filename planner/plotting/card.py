@@ -122,7 +122,7 @@ def phase_rows(plan) -> list:
         if not is_contact(ph):
             from qsplan.planner.plotting.hands import fingers_touching
 
-            pose = plan.task.pose(float(np.ravel(ph.x)[0]))
+            pose = ph.poses(plan.task.hand.rest_height)[0]
             off = {s for k in range(ph.t.size) for s, on in fingers_touching(hand, pose, ph.q[k]).items() if not on}
             who = "both fingers" if len(off) == 2 else f"the {next(iter(off))} finger" if off else "the fingers"
             rows.append((str(i), times, f"regrasp: {who}\nopen and close again", "velocity only", "-", "-", "-"))
@@ -138,7 +138,11 @@ def phase_rows(plan) -> list:
         w = float(ph.width[k])
         side = "lower" if np.isinf(ph.lower).all() else "upper"
         narrow = f"{torque_text(w, unit)} at {float(ph.t[k]):.3g} s" if np.isfinite(w) else f"none: {side}\nedge unbounded"
-        rows.append((str(i), times, f"slides {'left' if dx < 0 else 'right'} {abs(dx) * 1000:.3g} mm\nin {mode}",
+        th = np.degrees(ph.poses(hand.rest_height)[[0, -1], 2])  # a pivot turns; a hold moves nothing
+        does = {"hold": f"holds: nothing moves\nin {mode.removeprefix('hold: ')}, torque ramps",
+                "pivot": f"pivots {th[0]:.3g} to {th[1]:.3g} deg\nin {mode.removeprefix('pivot: ')}"}.get(
+            ph.kind, f"slides {'left' if dx < 0 else 'right'} {abs(dx) * 1000:.3g} mm\nin {mode}")  # fmt: skip
+        rows.append((str(i), times, does,
                      f"{joint_title(ph.effort_joint)} {word}", f"{_range(ph.command, unit)}\n{sense}",
                      room, narrow))  # fmt: skip
     return rows

@@ -26,7 +26,7 @@ from qsplan.mechanics.model.geometry import CONTACT_TOL
 from qsplan.planner.plotting.plan_panels import is_contact
 from qsplan.planner.plotting.style import FONT, axes_or_new, body_style, joint_colour
 
-__all__ = ["STATES", "TOUCH_TOL", "Snapshot", "effort_direction", "fingers_touching", "hand_limits", "hand_strip_figure",
+__all__ = ["phase_pose", "STATES", "TOUCH_TOL", "Snapshot", "effort_direction", "fingers_touching", "hand_limits", "hand_strip_figure",
            "plan_snapshots", "plot_hand", "row_state", "snapshot_legend_handles"]
 
 #: Relative length of the drawn contact normals (of the finger length, :func:`qsplan.hands.interface.finger_reach`).
@@ -146,7 +146,8 @@ def plot_hand(hand, pose, q=None, ax=None, alpha=1.0, contacts=True, label_joint
     """
     from matplotlib.patches import Polygon as Patch
 
-    from qsplan.hands.interface import contacts_at, finger_of_joint, finger_reach, hand_body_polygons
+    from qsplan.hands.found_contacts import drawable_contacts
+    from qsplan.hands.interface import finger_of_joint, finger_reach, hand_body_polygons
 
     ax = axes_or_new(ax, size=(3.2, 2.6))
     polys = hand_body_polygons(hand, pose, q)
@@ -168,7 +169,7 @@ def plot_hand(hand, pose, q=None, ax=None, alpha=1.0, contacts=True, label_joint
                         arrowprops={"arrowstyle": "-|>", "color": colour, "lw": 1.6, "shrinkA": 7, "shrinkB": 0})  # fmt: skip
     if contacts:
         scale = _NORMAL * finger_reach(hand)
-        for c in contacts_at(hand, pose, q):
+        for c in drawable_contacts(hand, pose, q):
             ax.plot(*c.point, "o", ms=3.5, color="k", alpha=alpha, zorder=5)
             ax.arrow(*c.point, *(scale * c.normal), width=0.0, head_width=0.2 * scale, color="k", lw=0.8,
                      length_includes_head=True, alpha=alpha, zorder=5)  # fmt: skip
@@ -291,8 +292,13 @@ class Snapshot:
 
 
 def _pose(plan, phase, k):
-    x = np.ravel(phase.x)
-    return plan.task.pose(float(x[min(k, x.size - 1)]))
+    return phase_pose(plan, phase, k)
+
+
+def phase_pose(plan, phase, k) -> np.ndarray:
+    """The workpiece's pose (m, m, rad) at row ``k`` of ``phase`` (its last row beyond it): turned in a pivot."""
+    pose = phase.poses(plan.task.hand.rest_height)
+    return pose[min(k, len(pose) - 1)]
 
 
 def _off(plan, phase, k) -> tuple:

@@ -20,7 +20,7 @@ import numpy as np
 from qsplan.mechanics.errors import SceneError
 from qsplan.mechanics.model.geometry import CONTACT_TOL
 
-from qsplan.planner.plotting.hands import fingers_touching, row_state
+from qsplan.planner.plotting.hands import fingers_touching, phase_pose, row_state
 from qsplan.planner.plotting.plan_panels import (
     draw_band,
     effort_words,
@@ -208,17 +208,18 @@ def sliding_directions(hand, pose0, q0, pose1, q1) -> list:
     list of (point, direction)
         The contact point (m, shape (2,)) and the unit tangent (shape (2,)) the workpiece slides along there, zeros
         where it slips less than :data:`_SLIDE_TOL`.  Raises :class:`~qsplan.mechanics.errors.SceneError` when a
-        finger does not touch (:func:`qsplan.hands.interface.contacts_at`).
+        finger does not touch (:func:`qsplan.hands.found_contacts.drawable_contacts`).
     """
     from shapely.geometry import Point, Polygon
 
-    from qsplan.hands.interface import contacts_at, hand_body_polygons
+    from qsplan.hands.found_contacts import drawable_contacts
+    from qsplan.hands.interface import hand_body_polygons
 
     before, after = hand_body_polygons(hand, pose0, q0), hand_body_polygons(hand, pose1, q1)
     rw, tw = _rigid(before["workpiece"], after["workpiece"])
     links = [n for n in before if n not in ("palm", "workpiece")]
     out = []
-    for c in contacts_at(hand, pose0, q0):
+    for c in drawable_contacts(hand, pose0, q0):
         p = np.asarray(c.point, dtype=float)
         body = p  # on the palm, which does not move
         if c.body >= 0:
@@ -270,8 +271,7 @@ def animation_frames(plan, max_frames: int) -> list:
     out = []
     for i, k, w in _keys(plan, max_frames):
         ph = plan.phases[i]
-        x = np.ravel(ph.x)
-        pose = plan.task.pose(float(x[min(k, x.size - 1)]))
+        pose = phase_pose(plan, ph, k)
         q = np.asarray(ph.q[k], float) if w == 0.0 else (1.0 - w) * ph.q[k] + w * ph.q[k + 1]
         t = _instant(plan, (i, k, w))
         if w == 0.0:
@@ -284,11 +284,11 @@ def animation_frames(plan, max_frames: int) -> list:
         if state in ("sliding", "holding"):
             j = min(k + 1, ph.t.size - 1)
             moving = is_contact(ph) and j != k
-            nxt = (plan.task.pose(float(x[min(j, x.size - 1)])), ph.q[j]) if moving else (pose, q)
+            nxt = (phase_pose(plan, ph, j), ph.q[j]) if moving else (pose, q)
             try:
                 contacts = sliding_directions(hand, pose, q, *nxt)
                 if is_contact(ph) and j == k and k > 0:  # a segment's last row slides as the row before it did
-                    prev = sliding_directions(hand, plan.task.pose(float(x[k - 1])), ph.q[k - 1], pose, q)
+                    prev = sliding_directions(hand, phase_pose(plan, ph, k - 1), ph.q[k - 1], pose, q)
                     contacts = [(p, d) for (p, _), (_, d) in zip(contacts, prev)]
             except SceneError:  # touching, but not in the grasp's contact set (between rows): no contact drawn
                 contacts = []

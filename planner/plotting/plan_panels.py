@@ -92,7 +92,11 @@ def phase_label(phase, hand=None) -> tuple:
         kind = ContactMode(phase.mode).kind
     except (ValueError, TypeError):
         kind = str(phase.mode)
-    return f"{kind} ({phase.mode})", f"{joint_title(phase.effort_joint)} {effort_words(hand, phase.effort_joint)[0]}"
+    first = phase.modes()[0] if hasattr(phase, "modes") else phase.mode
+    lead = f"{ContactMode(first).kind} ({first}) then " if first != phase.mode else ""  # a pivot's transition row
+    what = {"hold": "hold: ", "pivot": "pivot: "}.get(getattr(phase, "kind", "slide"), "")
+    return (f"{what}{lead}{kind} ({phase.mode})",
+            f"{joint_title(phase.effort_joint)} {effort_words(hand, phase.effort_joint)[0]}")
 
 
 def phase_colour(phase, hand=None) -> str:

@@ -32,6 +32,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from qsplan.hands.workpiece import polygon_inertia  # noqa: F401 (named in __all__: its home is the hands layer)
+
 from qsplan.mechanics.errors import QsplanError
 
 __all__ = ["ARMATURE", "CONTACT_SOLIMP", "CONTACT_TIMECONST", "DEPTH", "FOOT_RADIUS", "MIN_MU", "NOMINAL_LINK_MASS",
@@ -85,21 +87,6 @@ def servo_gains(kind: str) -> tuple:
     (N m/rad and N m s/rad for a revolute joint; N/m and N s/m for a prismatic one)."""
     inertia = ARMATURE[kind]
     return inertia * SERVO_OMEGA**2, 2.0 * inertia * SERVO_OMEGA
-
-
-def polygon_inertia(polygon, mass) -> tuple:
-    """``(centroid (2,), inertia about it)`` of a uniform lamina of ``mass`` (kg) over ``polygon`` (k, 2) (m): the
-    polar second moment (kg m^2), by the shoelace sums."""
-    p = np.asarray(polygon, dtype=float)
-    a, b = p, np.roll(p, -1, axis=0)
-    cross = a[:, 0] * b[:, 1] - b[:, 0] * a[:, 1]
-    area = cross.sum() / 2.0
-    c = ((a + b) * cross[:, None]).sum(axis=0) / (6.0 * area)
-    a, b = a - c, b - c
-    cross = a[:, 0] * b[:, 1] - b[:, 0] * a[:, 1]
-    j = (cross * (a[:, 0] ** 2 + a[:, 0] * b[:, 0] + b[:, 0] ** 2 + a[:, 1] ** 2 + a[:, 1] * b[:, 1]
-                  + b[:, 1] ** 2)).sum() / 12.0  # fmt: skip
-    return c, abs(float(mass) * j / area)
 
 
 def contact_pairs(hand) -> dict:

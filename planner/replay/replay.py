@@ -33,6 +33,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from qsplan.mechanics.errors import QsplanError
+from qsplan.planner.replay.phases import replay_segments, rows_pose
 
 __all__ = ["ReplaySystem", "SegmentReplay", "Replay", "replay_plan", "replay_segments",
            "friction_samples", "REPLAY_STEP"]
@@ -106,6 +107,7 @@ class ReplaySystem:
     friction: object
     formation: object
     scenes: dict = field(default_factory=dict, repr=False)
+    found: bool = False  # scenes from the contacts the polygons show (qsplan.planner.replay.phases)
 
     @property
     def contact_names(self) -> tuple:
@@ -134,7 +136,12 @@ class ReplaySystem:
         scene = self.scenes.get(key)
         if scene is None:
             velocity, effort = self.commands(x[-1])
-            scene = scene_at(self.hand, x[:3], x[3:-1], self.effort_controlled, velocity, effort=effort)
+            if self.found:
+                from qsplan.planner.replay.phases import found_scene
+
+                scene = found_scene(self.hand, x, self.effort_controlled, velocity, effort, self.formation.n_contacts)
+            else:
+                scene = scene_at(self.hand, x[:3], x[3:-1], self.effort_controlled, velocity, effort=effort)
             if len(self.scenes) >= MAX_CACHED_SCENES:
                 self.scenes.clear()
             self.scenes[key] = scene
@@ -174,6 +181,7 @@ class SegmentReplay:
     x_error: float
     x_end: float
     motion: object
+    note: str | None = None  # how the phase was replayed, when not simply (qsplan.planner.replay.phases)
 
     @property
     def followed(self) -> bool:
@@ -221,7 +229,8 @@ class Replay:
 
         return {"mu": [float(m) for m in self.mu], "followed": self.followed, "x_error_m": num(self.x_error),
                 "segments": [{"phase": s.phase, "planned_mode": s.planned_mode, "modes": list(s.labels), "stop": s.stop,
-                              "x_error_m": num(s.x_error), "x_end_m": num(s.x_end)} for s in self.segments]}  # fmt: skip
+                              "x_error_m": num(s.x_error), "x_end_m": num(s.x_end), "note": s.note}
+                             for s in self.segments]}  # fmt: skip
 
 
 def _start_modes(system, x0, mu) -> tuple:
@@ -243,44 +252,6 @@ def friction_samples(mu_range, n, seed=1, shared=False, n_contacts: int = 4) -> 
     draws = [np.full(n_contacts, rng.uniform(lo, hi)) if shared else rng.uniform(lo, hi, n_contacts)
              for _ in range(max(n - 2, 0))]  # fmt: skip
     return ([np.full(n_contacts, float(lo)), np.full(n_contacts, float(hi))] + draws)[:n]
-
-
-def replay_segments(columns) -> list:
-    """Split plan columns (:func:`qsplan.planner.export.plan_files.read_plan_csv`) into in-contact segments.
-
-    ``phase`` is the phase's integer index (``0``, ``1``, ...; files before issue 16 wrote ``0.0``,
-    ``1.0``, ...: both read alike).
-
-    Returns
-    -------
-    list of dict
-        Per segment: ``phase``, ``rows`` (indices), ``mode``, ``effort_joint``.
-    """
-    for key in ("t", "phase", "mode", "effort_joint", "x_workpiece"):
-        if key not in columns:
-            raise QsplanError(f"plan: column {key!r} missing; expected the columns of qsplan.planner.export.plan_files")
-    if not any(str(key).startswith("q_") for key in columns):
-        raise QsplanError("plan: no column 'q_<joint>'; expected the columns of qsplan.planner.export.plan_files")
-    try:
-        values = np.asarray(columns["phase"], float)
-    except (TypeError, ValueError):
-        values = np.array([np.nan])
-    if not (np.all(np.isfinite(values)) and np.all(values == np.round(values)) and np.all(values >= 0)):
-        raise QsplanError("plan: column 'phase' holds a value that is not a phase index (0, 1, 2, ...)")
-    phases = values.astype(int)
-    out = []
-    for p in np.unique(phases):
-        rows = np.flatnonzero(phases == p)
-        mode = str(columns["mode"][rows[0]])
-        if mode == "free":
-            continue
-        out.append(dict(phase=int(p), rows=rows, mode=mode, effort_joint=str(columns["effort_joint"][rows[0]])))
-    return out
-
-
-def rows_pose(columns, k) -> np.ndarray:
-    """The planned workpiece pose at row ``k`` (m, m, rad), shape (3,)."""
-    return np.array([columns["x_workpiece"][k], columns["y_workpiece"][k], columns["theta_workpiece"][k]], float)
 
 
 def replay_plan(columns, hand, mu, options=None, scenes=None, formation=None) -> Replay:
@@ -312,6 +283,8 @@ def replay_plan(columns, hand, mu, options=None, scenes=None, formation=None) ->
     from qsplan.mechanics.motion.simulator import simulate
     from qsplan.mechanics.motion.system import make_friction
     from qsplan.planner.plan.timing import quasistatic_rows
+    from qsplan.planner.replay.phases import (HOLD_NOTE, body_friction, formation_of, paper_form_hand, phase_rows,
+                                              transition_modes, uses_found_contacts)  # fmt: skip
 
     hand = as_hand(hand)
     names = hand.joint_names
@@ -333,6 +306,19 @@ def replay_plan(columns, hand, mu, options=None, scenes=None, formation=None) ->
     out, x_prev = [], None
     for seg in replay_segments(columns):
         rows, e = seg["rows"], seg["effort_joint"]
+        if set(seg["mode"]) == {"R"}:  # a hold: nothing moves, the certificate proves it
+            out.append(SegmentReplay(seg["phase"], seg["mode"], (seg["mode"],), None, 0.0,
+                                     float(columns["x_workpiece"][rows[-1]]), None, HOLD_NOTE))  # fmt: skip
+            continue
+        found, first, note, seg_mu, seg_formation = False, None, None, mu, formation
+        if paper_form_hand(hand):  # the contacts a phase makes or leaves at its ends (qsplan.planner.replay.phases)
+            rows, first, mode, note = phase_rows(hand, columns, rows)
+            seg = dict(seg, mode=mode)
+        if uses_found_contacts(hand, columns, rows):
+            found = True
+            seg_formation = formation_of(hand, columns, rows[0], mode)
+            seg_mu = body_friction(seg_formation.contact_names, mu)
+            x_prev = None  # a turning phase starts where its rows say (the hold before it moves nothing)
         if e not in names:
             raise QsplanError(f"plan: effort_joint {e!r} in phase {seg['phase']} is no joint of the hand {names}")
         tau = np.column_stack([np.asarray(columns[f"tau_{n}"], float)[rows] for n in names])
@@ -343,18 +329,27 @@ def replay_plan(columns, hand, mu, options=None, scenes=None, formation=None) ->
         qd_rows = np.column_stack([np.asarray(columns[f"qd_{n}"], float)[rows] for n in names])
         s, velocity = quasistatic_rows(np.asarray(columns["t"], float)[rows], u, q_rows, qd_rows)
         t = float(columns["t"][rows[0]]) + s  # the replay's clock: the plan's start time plus the path parameter
-        system = ReplaySystem(hand, effort, t, velocity, tau, friction, formation, scenes.setdefault(seg["phase"], {}))
+        seg_friction = friction if not found else make_friction(seg_mu, seg_mu)
+        system = ReplaySystem(hand, effort, t, velocity, tau, seg_friction, seg_formation,
+                              scenes.setdefault(seg["phase"], {}), found)  # fmt: skip
         k = rows[0]
         pose = rows_pose(columns, k)
         if x_prev is not None:
             pose = x_prev[:3]  # the regrasp leaves the workpiece where the simulation put it
         q_planned = np.array([columns[f"q_{n}"][k] for n in names], float)
-        q = hand.reclose(pose, q_planned, rows_pose(columns, k))
+        q = q_planned if found else hand.reclose(pose, q_planned, rows_pose(columns, k))
         x0 = np.concatenate([pose, q, [t[0]]])
         if hand.simulation_travel is not None and given is None:
             x_rows = np.asarray(columns["x_workpiece"], float)[rows]
             options = _default_options(_travel_step(t, x_rows, hand.simulation_travel))
-        start = _start_modes(system, x0, mu)
+        if first is not None:  # the transition row with all its contacts: the planned mode alone
+            k0 = seg["rows"][0]
+            start = transition_modes(hand, columns, k0, effort, mu)
+            if start != (first,):
+                why = f"at the transition row the feasible modes are {', '.join(start) or 'none (jam)'}"
+                out.append(SegmentReplay(seg["phase"], first, start, why, np.nan, float(pose[0]), None))
+                break
+        start = _start_modes(system, x0, seg_mu)
         if start != (seg["mode"],):
             why = f"at t = {t[0]:.6g} s the feasible modes are {', '.join(start) or 'none (jam)'}"
             out.append(SegmentReplay(seg["phase"], seg["mode"], start, why, np.nan, float(pose[0]), None))
@@ -374,7 +369,8 @@ def replay_plan(columns, hand, mu, options=None, scenes=None, formation=None) ->
         else:  # stopped at the segment's start
             err, end = np.nan, np.concatenate([pose, q, [t[0]]])
         stop = _stop_message(motion, seg["mode"])
-        out.append(SegmentReplay(seg["phase"], seg["mode"], tuple(motion.labels), stop, err, float(end[0]), motion))
+        out.append(SegmentReplay(seg["phase"], seg["mode"], tuple(motion.labels), stop, err, float(end[0]), motion,
+                                 note))  # fmt: skip
         if not out[-1].followed:
             break  # the rest of the plan starts from a state the plan did not foresee
         x_prev = end

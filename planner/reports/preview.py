@@ -206,12 +206,12 @@ def preview_task(task, progress=None) -> Preview:
     from qsplan.planner.plan.failure import palm_report
     from qsplan.planner.search.tables import SEARCH_MARGIN, band_tables, table_grid
     from qsplan.planner.states.contact import mode_name
-    from qsplan.planner.task.goal import goal_refusal, palm_x_range
+    from qsplan.planner.task.goal import goal_refusal, palm_x_range, reorientation_verdict
 
     t0 = time.perf_counter()
     progress = progress or (lambda line: None)
     hand = task.hand
-    refusal = goal_refusal(task)  # a goal the planner refuses (another orientation, no x): the verdict, as plan says
+    refusal = goal_refusal(task) or reorientation_verdict(task)  # a goal off the palm edge: the verdict says why
     if task.goal is None:
         goal_x = float(task.waypoints[-1])
     else:  # a goal without x (refused) previewed at the start's x

@@ -30,7 +30,8 @@ import numpy as np
 from qsplan.mechanics.errors import QsplanError
 
 __all__ = ["DEFAULT_JOINT_ACCELERATION", "DEFAULT_RELEASE_ACCELERATION", "DEFAULT_WORKPIECE_ACCELERATION", "Dynamics", "box_acceleration",
-           "dynamics_metadata", "inertial_box", "inertial_wrench", "link_mass", "resolve_dynamics", "task_dynamics"]
+           "dynamics_metadata", "inertial_box", "inertial_wrench", "link_mass", "resolve_dynamics", "task_dynamics", "turning_box", "turning_wrench",
+           "workpiece_radius"]
 
 #: The workpiece's largest acceleration by default (m/s^2): it reaches the default 0.01 m/s workpiece speed in
 #: 0.5 s over 2.5 mm (five of the slides' 0.5 mm rows).  Its inertial force on the demo workpiece (0.2 kg) is
@@ -83,6 +84,13 @@ class Dynamics:
     disturbance: object
     source: str
     release_accelerations: np.ndarray
+    turning: bool = False
+
+    def angular_acceleration(self, hand) -> float:
+        """The workpiece's largest angular acceleration (rad/s^2) while it turns: ``workpiece_acceleration`` over its
+        farthest vertex's distance from its centre of mass, so no point of it accelerates faster from the turning
+        alone than the task allows its centre of mass."""
+        return float(self.workpiece_acceleration / workpiece_radius(hand))
 
 
 def _number(v, field, key) -> float:
@@ -101,6 +109,40 @@ def inertial_wrench(mass: float, height: float, ax) -> np.ndarray:
     ax = np.asarray(ax, dtype=float)
     f = -float(mass) * ax
     return np.stack([f, np.zeros_like(f), -float(height) * f], axis=-1)
+
+
+def workpiece_radius(hand) -> float:
+    """The distance (m) from the workpiece's centre of mass to its farthest vertex."""
+    return float(np.max(np.hypot(*np.asarray(hand.workpiece, dtype=float).T)))
+
+
+def turning_wrench(mass: float, inertia: float, com, acceleration, angular) -> np.ndarray:
+    """The workpiece's inertial wrench about the world origin (N, N, N m), shape (..., 3), its centre of mass at
+    ``com`` (..., 2) (m) accelerating at ``acceleration`` (..., 2) (m/s^2) and turning at ``angular`` (...,) (rad/s^2):
+    ``f = -m a``, moment ``c x f - I alpha`` (``inertia`` about the centre of mass, kg m^2).  At ``a = (ax, 0)``,
+    ``alpha = 0`` it is :func:`inertial_wrench`."""
+    com, acc = np.asarray(com, dtype=float), np.asarray(acceleration, dtype=float)
+    f = -float(mass) * acc
+    moment = com[..., 0] * f[..., 1] - com[..., 1] * f[..., 0] - float(inertia) * np.asarray(angular, dtype=float)
+    return np.concatenate([f, moment[..., None]], axis=-1)
+
+
+def turning_box(hand, acceleration: float):
+    """The box (a WrenchBox) holding the inertial wrench of a workpiece that turns and moves anywhere over the palm:
+    ``|fx|, |fy| <= m a``, and a moment within ``m a (X + Y) + I a / R``: ``X`` the palm's half-width (the centre of
+    mass's largest ``|x|``), ``Y = R`` (its largest height with a vertex on the palm), ``R`` its farthest vertex's
+    distance (the angular acceleration's bound, :meth:`Dynamics.angular_acceleration`).  Rounded up to
+    :data:`BOX_GRID`."""
+    from qsplan.hands.interface import manipulator_of
+    from qsplan.mechanics.bands.disturbance import WrenchBox
+    from qsplan.hands.workpiece import polygon_inertia
+
+    m, R = float(hand.workpiece_mass), workpiece_radius(hand)
+    X = float(np.max(np.abs(np.asarray(manipulator_of(hand).base_shape, dtype=float)[:, 0])))
+    _, inertia = polygon_inertia(hand.workpiece, m)
+    f = m * acceleration
+    w = np.ceil(np.array([f, f, f * (X + R) + inertia * acceleration / R]) / BOX_GRID) * BOX_GRID
+    return WrenchBox(tuple(-w), tuple(w))
 
 
 def inertial_box(mass: float, height: float, acceleration: float):
@@ -127,7 +169,7 @@ def box_acceleration(box, mass: float, height: float) -> float:
 
 
 def resolve_dynamics(hand, box, workpiece_acceleration=None, joint_acceleration=None, accelerations=None,
-                     release_acceleration=None) -> Dynamics:
+                     release_acceleration=None, turning: bool = False) -> Dynamics:
     """A task's :class:`Dynamics` from its ``[limits]`` and ``[controller] disturbance`` (``box``: a WrenchBox or None).
 
     Raises
@@ -160,6 +202,8 @@ def resolve_dynamics(hand, box, workpiece_acceleration=None, joint_acceleration=
     rel = np.minimum(rel, acc)
     rel.setflags(write=False)
     m, y = float(hand.workpiece_mass), float(hand.rest_height)
+    if box is None and turning:  # a goal that turns the workpiece: its inertial load in every direction
+        return Dynamics(a_wp, acc, turning_box(hand, a_wp), "inertia", rel, True)
     if box is None:
         return Dynamics(a_wp, acc, inertial_box(m, y, a_wp), "inertia", rel)
     room = box_acceleration(box, m, y)
@@ -167,7 +211,14 @@ def resolve_dynamics(hand, box, workpiece_acceleration=None, joint_acceleration=
         raise QsplanError("controller.disturbance: the box holds no inertial load of the workpiece; every phase starts "
                           "and ends at rest, so it must hold force x from -F to F (N), force y 0 and the moment "
                           f"-{y:.4g} m x force x (N m) for some F > 0")  # fmt: skip
-    return Dynamics(min(a_wp, room), acc, box, "task", rel)
+    if turning:  # the box must hold the turning load at the (cut) acceleration: the turning box's corners inside it
+        need = turning_box(hand, 1.0)
+        per = np.asarray(need.hi, float)
+        room = min(room, float(np.min(np.minimum(-np.asarray(box.lo, float), np.asarray(box.hi, float)) / per)))
+        if not room > 0:
+            raise QsplanError("controller.disturbance: the box holds no inertial load of a turning workpiece (the goal "
+                              "turns it): it must hold force x and y and a moment on both sides of 0")  # fmt: skip
+    return Dynamics(min(a_wp, room), acc, box, "task", rel, turning)
 
 
 def task_dynamics(task) -> Dynamics:

@@ -39,7 +39,7 @@ from qsplan.mechanics.errors import NoAnswerError, QsplanError
 from qsplan.planner.task.fields import task_number
 
 __all__ = ["Goal", "FEATURE_KINDS", "GOAL_KEYS", "THETA_TOL", "GoalNotServedError", "check_goal_served", "feature_text",
-           "goal_refusal", "parse_feature", "make_goal", "make_start_features", "palm_x_range", "task_positions"]
+           "goal_refusal", "parse_feature", "make_goal", "reorientation_verdict", "reorients", "make_start_features", "palm_x_range", "task_positions"]
 
 #: The feature kinds of a goal: the fingertip on an edge, the inner long edge on a vertex.
 FEATURE_KINDS = ("edge", "vertex")
@@ -155,33 +155,51 @@ class GoalNotServedError(NoAnswerError):
         self.field = field
 
 
-#: What the mechanics already computes toward a reorienting goal (said in every refusal of one).
-_REORIENTATION = ("the mechanics of the demo's flush instant and its pivot on vertex 1 exist (docs/reorientation.md), "
-                  "a route through them does not")  # fmt: skip
+#: Where a goal that turns the workpiece goes (said in the refusals of the goals the planner cannot place).
+_REORIENTATION = ("a goal that turns the workpiece (theta, or palm naming another feature) is planned through the "
+                  "flush instant, a hold and a pivot (docs/reorientation.md)")  # fmt: skip
+
+
+def reorients(task) -> bool:
+    """Whether ``task``'s goal asks another orientation than the start's: ``theta`` beyond :data:`THETA_TOL` of 0, or
+    ``palm`` naming another feature than the resting edge (the route of :mod:`qsplan.planner.plan.reorient`)."""
+    goal = task.goal
+    if goal is None:
+        return False
+    resting = int(task.hand.user_edges[0])
+    return bool((goal.theta is not None and abs(goal.theta) > THETA_TOL)
+                or (goal.palm is not None and goal.palm != ("edge", resting)))  # fmt: skip
 
 
 def goal_refusal(task) -> GoalNotServedError | None:
-    """Why the planner refuses ``task``'s goal (a :class:`GoalNotServedError`, not raised), or None: it serves it.
+    """Why the planner refuses ``task``'s goal before planning (a :class:`GoalNotServedError`, not raised), or None.
 
-    The planner serves the palm-edge formation only (the resting edge on the palm, theta = 0), placed by its x: a
-    ``theta`` beyond :data:`THETA_TOL` of 0, a ``palm`` other than the resting edge, or a goal without ``x`` is
-    refused, in that order.
+    A goal that turns the workpiece (:func:`reorients`) goes to the reorientation route, which refuses what it
+    cannot serve by name (:mod:`qsplan.planner.plan.reorient`); a goal that keeps the start's orientation is placed
+    by its x, so one without ``x`` is refused here.
     """
     goal = task.goal
-    if goal is None:
+    if goal is None or reorients(task):  # the reorientation route decides (qsplan.planner.plan.reorient)
         return None
     resting = int(task.hand.user_edges[0])  # the edge the workpiece rests on, as the task's polygon numbers it
-    serves = f"the planner serves the palm_edge formation: edge {resting} on the palm, theta = 0"
-    if goal.theta is not None and abs(goal.theta) > THETA_TOL:
-        return GoalNotServedError("goal.theta", f"goal.theta: reorienting the workpiece (theta = {goal.theta:g} rad) "
-                                                f"is not planned yet ({serves}); {_REORIENTATION}")  # fmt: skip
-    if goal.palm is not None and goal.palm != ("edge", resting):
-        return GoalNotServedError("goal.palm", f"goal.palm: {goal.palm[0]} {goal.palm[1]} on the palm is not planned "
-                                               f"yet ({serves}); {_REORIENTATION}")  # fmt: skip
     if goal.x is None:
-        return GoalNotServedError("goal.x", f"goal.x: missing: the goal keeps the start's orientation ({serves}), "
-                                            f"and the planner places it by the workpiece's x (m)")  # fmt: skip
+        return GoalNotServedError("goal.x", f"goal.x: missing: the goal keeps the start's orientation (the palm_edge "
+                                            f"formation: edge {resting} on the palm, theta = 0), and the planner "
+                                            "places it by the workpiece's x (m); "
+                                            f"{_REORIENTATION}")  # fmt: skip
     return None
+
+
+def reorientation_verdict(task) -> GoalNotServedError | None:
+    """What ``qsplan check`` says of a goal that turns the workpiece (:func:`reorients`), or None: its preview covers
+    the palm-edge formation only; ``qsplan plan`` plans such a goal through the flush instant, a hold and the pivot
+    (:mod:`qsplan.planner.plan.reorient`), or refuses it by name."""
+    if not reorients(task):
+        return None
+    field = "goal.theta" if task.goal.theta is not None else "goal.palm"
+    return GoalNotServedError(field, f"{field}: the goal turns the workpiece ({task.goal.describe()}): the check "
+                                     "previews the palm-edge formation only; qsplan plan plans the turn (the slide to "
+                                     "the flush instant, a certified hold, the pivot) or refuses it by name")  # fmt: skip
 
 
 def check_goal_served(task) -> None:
@@ -235,7 +253,7 @@ def task_positions(task) -> list:
     for i, x in enumerate(task.waypoints):
         where = "the goal" if i == last else f"the end of segment {i + 1}"
         out.append((where, f"motion.waypoints[{i}]", float(x)))
-    if task.goal is not None:
+    if task.goal is not None and task.goal.x is not None:  # a reorienting goal may give no x
         out.append(("the goal", "goal.x", float(task.goal.x)))
     return out
 

@@ -38,8 +38,11 @@ def _depth(region) -> float:
         if part.area <= 0:
             continue
         hull = np.asarray(part.convex_hull.exterior.coords)[:-1]
-        # brute force over directions every 0.25 degree: independent of the planner's rotating calipers
-        angles = np.radians(np.arange(0.0, 180.0, 0.25))
+        # brute force over directions every 0.25 degree (independent of the planner's rotating calipers), and across
+        # each hull edge: a sliver along a flush contact (a finger edge on a workpiece edge) is ~1e-17 m thin across
+        # its own edge but reads 0.1 m x sin(0.125 deg) = 2e-4 m across the nearest sampled direction
+        edges = np.roll(hull, -1, axis=0) - hull
+        angles = np.concatenate([np.radians(np.arange(0.0, 180.0, 0.25)), np.arctan2(edges[:, 0], -edges[:, 1])])
         proj = hull @ np.stack([np.cos(angles), np.sin(angles)])
         best = max(best, float((proj.max(axis=0) - proj.min(axis=0)).min()))
     return best

@@ -1,6 +1,6 @@
 """Goals that say orientation (issue 23, item 4): ``[goal] theta`` and ``palm``, their validation, the record round
-trip, and the planner's honest refusal of every goal but the palm-edge formation's (``qsplan plan`` exit 2 in one
-line, ``qsplan check`` with the same refusal as its verdict)."""
+trip, the refusal of a palm-edge goal without x, and the reorientation route's refusal by name of the turning goals
+it cannot serve (``qsplan plan`` exit 2 in one line; ``qsplan check`` says a turn is planned by ``qsplan plan``)."""
 
 from __future__ import annotations
 
@@ -76,17 +76,8 @@ def test_record_round_trip_keeps_theta_and_palm(goal):
     assert again.goal == task.goal and task_record(again)["goal"] == record["goal"]
 
 
-@pytest.mark.parametrize("goal, field", [
-    ({"theta": -0.5}, "goal.theta"),
-    ({"x": -0.04, "theta": -0.5}, "goal.theta"),  # an x does not make the orientation served
-    ({"theta": 2 * THETA_TOL, "x": -0.04}, "goal.theta"),
-    ({"theta": 0.3, "palm": "vertex:1"}, "goal.theta"),  # theta first
-    ({"palm": "vertex:1", "x": -0.04}, "goal.palm"),
-    ({"palm": "edge:1", "x": -0.04}, "goal.palm"),
-    ({"palm": "edge:0"}, "goal.x"),  # the resting edge, but nowhere to place it
-    ({"theta": 0.0}, "goal.x"),
-])  # fmt: skip
-def test_goals_off_the_palm_edge_formation_are_refused(goal, field):
+@pytest.mark.parametrize("goal, field", [({"palm": "edge:0"}, "goal.x"), ({"theta": 0.0}, "goal.x")])
+def test_goals_of_the_palm_edge_formation_without_x_are_refused(goal, field):
     task = demo_with(goal)
     refusal = goal_refusal(task)
     assert isinstance(refusal, GoalNotServedError) and isinstance(refusal, NoAnswerError)
@@ -97,6 +88,33 @@ def test_goals_off_the_palm_edge_formation_are_refused(goal, field):
         check_goal_served(task)
 
 
+@pytest.mark.parametrize("goal, field, why", [
+    ({"x": -0.04, "theta": -0.5}, "goal.x", "the pivot decides x"),
+    ({"theta": 2 * THETA_TOL, "x": -0.04}, "goal.x", "the pivot decides x"),
+    ({"theta": 0.3, "palm": "vertex:1"}, "goal.theta", "counter-clockwise"),
+    ({"theta": 0.3}, "goal.theta", "counter-clockwise"),
+    ({"theta": -0.3, "palm": "vertex:2"}, "goal.palm", "pivots on vertex 1"),
+    ({"palm": "vertex:1"}, "goal.theta", "give the angle too"),
+    ({"palm": "vertex:1", "x": -0.04}, "goal.x", "the pivot decides x"),
+    ({"palm": "edge:2"}, "goal.palm", "edge 1 is"),
+    ({"palm": "edge:1", "x": -0.04}, "goal.x", "the pivot decides x"),
+])  # fmt: skip
+def test_turning_goals_the_route_cannot_serve_are_refused_by_name(goal, field, why, monkeypatch):
+    from qsplan.planner.plan import autoplan
+    from qsplan.planner.plan.scripted import plan_task
+    from qsplan.planner.task.goal import reorients
+
+    def never(*args, **kwargs):
+        raise AssertionError("the planner ran on a goal it refuses")
+
+    monkeypatch.setattr(autoplan, "plan_automatic", never)
+    task = demo_with(goal)
+    assert reorients(task) and goal_refusal(task) is None  # the reorientation route decides
+    with pytest.raises(GoalNotServedError, match=f"^{field}: .*{why}") as info:
+        plan_task(task)
+    assert info.value.field == field and not isinstance(info.value, ValueError)
+
+
 @pytest.mark.parametrize("goal", [{"x": -0.04, "theta": 0.0}, {"x": -0.04, "theta": -THETA_TOL / 2},
                                   {"x": -0.04, "palm": "edge:0"},
                                   {"x": -0.04, "palm": "edge:0", "theta": 0.0}])  # fmt: skip
@@ -105,12 +123,15 @@ def test_the_palm_edge_formation_at_an_x_is_served(goal):
 
 
 def test_palm_names_the_resting_edge_as_the_polygon_is_written():
+    from qsplan.planner.task.goal import reorients
+
     assert goal_refusal(demo_with({"x": -0.04, "palm": "edge:3"}, ROTATED)) is None
-    refusal = goal_refusal(demo_with({"x": -0.04, "palm": "edge:0"}, ROTATED))
-    assert refusal.field == "goal.palm" and "edge 3 on the palm" in str(refusal)
+    assert not reorients(demo_with({"x": -0.04, "palm": "edge:3"}, ROTATED))
+    assert reorients(demo_with({"x": -0.04, "palm": "edge:0"}, ROTATED))  # edge 0 as written: the bottom-right one
 
 
-@pytest.mark.parametrize("name", sorted(n for n, p in task_paths().items() if "[goal]" in p.read_text()))
+@pytest.mark.parametrize("name", sorted(n for n, p in task_paths().items()
+                                         if "x" in tomllib.loads(p.read_text()).get("goal", {})))
 def test_existing_goals_are_unchanged(name):
     table = tomllib.loads(task_paths()[name].read_text())["goal"]
     goal = load_task(task_paths()[name]).goal
@@ -125,37 +146,35 @@ def test_existing_goals_are_unchanged(name):
     assert goal.theta is None and goal.palm is None and goal_refusal(load_task(task_paths()[name])) is None
 
 
-def test_plan_refuses_the_issues_example_in_one_line(tmp_path, capsys, monkeypatch):
+def test_plan_refuses_a_counter_clockwise_turn_in_one_line(tmp_path, capsys, monkeypatch):
     from qsplan.planner.plan import autoplan
 
     def never(*args, **kwargs):
         raise AssertionError("the planner ran on a goal it refuses")
 
     monkeypatch.setattr(autoplan, "plan_automatic", never)
+    path = tilt_file(tmp_path)
+    path.write_text(path.read_text().replace("theta = -0.5", "theta = 0.5"))
     out = tmp_path / "out"
-    code = main(["plan", str(tilt_file(tmp_path)), "--out", str(out), "--no-plots", "--verify", "0", "--quiet"])
+    code = main(["plan", str(path), "--out", str(out), "--no-plots", "--verify", "0", "--quiet"])
     stdout, err = capsys.readouterr()
     assert code == 2 and stdout == "" and len(err.splitlines()) == 1 and "Traceback" not in err
-    assert err.startswith("qsplan: error: goal.theta: reorienting the workpiece (theta = -0.5 rad) is not planned yet")
-    assert "docs/reorientation.md" in err
+    assert err.startswith("qsplan: error: goal.theta: turning the workpiece counter-clockwise (theta = 0.5 rad) is "
+                          "not planned")  # fmt: skip
     assert not (out / "plan.csv").exists() and not (out / "plan.json").exists()
 
 
-def test_plan_task_raises_the_refusal(tmp_path):
-    from qsplan.planner.plan.scripted import plan_task
+def test_check_reports_a_turning_goal_as_its_verdict(tmp_path, capsys):
+    from qsplan.planner.task.goal import reorientation_verdict
 
-    with pytest.raises(GoalNotServedError, match=r"^goal\.theta: reorienting"):
-        plan_task(load_task(tilt_file(tmp_path)))
-
-
-def test_check_reports_the_refusal_as_its_verdict(tmp_path, capsys):
     task = load_task(tilt_file(tmp_path))
-    refusal = str(goal_refusal(task))
+    verdict = str(reorientation_verdict(task))
+    assert goal_refusal(task) is None and "qsplan plan plans the turn" in verdict
     code = main(["check", str(tilt_file(tmp_path)), "--json", "--out", str(tmp_path / "check")])
     stdout, err = capsys.readouterr()
     doc = json.loads(stdout)
-    assert code == 0 and err == "" and doc["verdict"] == refusal and not doc["ok"] and doc["route"] == []
-    assert doc["start"]["ok"] and not doc["goal"]["ok"] and refusal in doc["goal"]["message"]
+    assert code == 0 and err == "" and doc["verdict"] == verdict and not doc["ok"] and doc["route"] == []
+    assert doc["start"]["ok"] and not doc["goal"]["ok"] and verdict in doc["goal"]["message"]
     assert (tmp_path / "check" / "check.png").is_file() and (tmp_path / "check" / "check.json").is_file()
     code = main(["check", str(tilt_file(tmp_path))])
-    assert code == 0 and capsys.readouterr().out.splitlines()[-1] == f"verdict: {refusal}"
+    assert code == 0 and capsys.readouterr().out.splitlines()[-1] == f"verdict: {verdict}"

@@ -37,17 +37,24 @@ def planned(name):
 
 
 def every_finger_touches(plan, pose, q) -> bool:
-    """The contact search finds the grasp's contact set (palm, palm, a left-finger link, a right-finger link)."""
+    """The contact search finds the grasp's contact set (palm, palm, a left-finger link, a right-finger link); a
+    paper-form hand's in any formation: the palm and both fingers touch (qsplan.hands.found_contacts)."""
+    from qsplan.hands.contact_sets import finger_link
+    from qsplan.hands.found_contacts import ordered_contacts
+
+    hand = plan.task.hand
+    if getattr(hand, "paper", None) is not None:
+        bodies = {c.body for c in ordered_contacts(hand, pose, q)}
+        return {-1, finger_link(hand, "left"), finger_link(hand, "right")} <= bodies
     try:
-        return len(contacts_at(plan.task.hand, pose, q)) == 4
+        return len(contacts_at(hand, pose, q)) == 4
     except SceneError:
         return False
 
 
 def row_config(plan, i, k):
     ph = plan.phases[i]
-    x = np.ravel(ph.x)
-    return plan.task.pose(float(x[min(k, x.size - 1)])), ph.q[k]
+    return ph.poses(plan.task.hand.rest_height)[min(k, ph.t.size - 1)], ph.q[k]
 
 
 @pytest.mark.parametrize("name", TASKS)
@@ -64,7 +71,9 @@ def test_snapshot_labels_match_the_rows(name):
             assert s.state in STATES
             touching = every_finger_touches(plan, pose, q)
             assert s.touching == touching, (name, s.t)
-            if isinstance(ph, ContactSegmentPlan):
+            if isinstance(ph, ContactSegmentPlan) and ph.kind == "hold":  # nothing moves, the torque ramps
+                assert s.state == "holding" and np.ptp(ph.x) == 0 and s.effort == ph.command[s.row]
+            elif isinstance(ph, ContactSegmentPlan):
                 assert s.state == "sliding" and np.ptp(ph.x) > 0 and s.effort == ph.command[s.row]
             elif touching:
                 assert s.state == "holding" and s.row in (0, ph.t.size - 1)  # released from, or closed onto, a grasp

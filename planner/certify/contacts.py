@@ -1,0 +1,109 @@
+"""The certifier's contacts of a row in any formation, found in the polygons (issue 23).
+
+A row's ``mode`` has one letter per contact the row is judged with, in the canonical order of
+:mod:`qsplan.hands.found_contacts` (the palm's contacts left to right, then each finger's from its base outward).
+Which contacts those are is decided here from the row's geometry alone:
+
+* a moving row, or a row at rest that starts its phase: every contact the polygon search finds (a contact that opens
+  toward the next row is judged as breaking, ``B``);
+* a row at rest that ends its phase: the same, without the contacts its motion makes only there (open at the previous
+  row: :func:`qsplan.hands.found_contacts.made_contacts`), e.g. the slide's last row at the flush instant;
+* a **hold row** (every letter ``R``, at rest, its phase not moving): every contact found; nothing moves, and the hold
+  proof (:mod:`qsplan.mechanics.bands.hold`), not the mode check, decides it.
+
+Hands of the paper's form (one link per finger) are judged so; a chain hand's rows keep the four contacts of the
+palm edge (:func:`qsplan.planner.certify.rows.contact_checks`).  Units SI.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+__all__ = ["general_form", "hold_row", "judged_contacts", "judged_contact_checks", "judged_scene"]
+
+
+def general_form(task) -> bool:
+    """Whether ``task``'s hand is judged by found contacts (the paper's form: two single-link fingers)."""
+    from qsplan.hands.reorient import paper_form
+    from qsplan.mechanics.errors import QsplanError
+
+    try:
+        paper_form(task.hand)
+    except QsplanError:
+        return False
+    return True
+
+
+def _same_phase(cols, a, b) -> bool:
+    ph = cols.get("phase")
+    return ph is None or ph[a] == ph[b]
+
+
+def _configuration(task, cols, k):
+    from qsplan.hands.interface import joint_names
+    from qsplan.planner.certify.rows import row_pose, row_q
+
+    return row_pose(cols, k), row_q(cols, k, joint_names(task.hand))
+
+
+def hold_row(cols, k) -> bool:
+    """Row ``k`` claims a hold: every letter ``R``, at rest (``speed_scale`` 0, no velocity command but 0)."""
+    mode = str(cols["mode"][k])
+    if not mode or set(mode) != {"R"} or "speed_scale" not in cols or cols["speed_scale"][k] != 0.0:
+        return False
+    return all(not np.isfinite(cols[c][k]) or cols[c][k] == 0.0 for c in cols if c.startswith("qd_"))
+
+
+def judged_contacts(task, cols, k):
+    """``(found contacts, drop mask)`` of row ``k`` (the module docstring): the canonical contacts and which of them
+    the row's motion makes only there (not judged)."""
+    from qsplan.hands.found_contacts import made_contacts, ordered_contacts
+
+    pose, q = _configuration(task, cols, k)
+    found = ordered_contacts(task.hand, pose, q)
+    n = cols["t"].size
+    ends = (k + 1 == n or not _same_phase(cols, k, k + 1)) and k > 0 and _same_phase(cols, k - 1, k)
+    resting = "speed_scale" in cols and cols["speed_scale"][k] == 0.0
+    if ends and resting and not hold_row(cols, k):
+        return found, made_contacts(task.hand, _configuration(task, cols, k - 1), (pose, q), found)
+    return found, np.zeros(len(found), dtype=bool)
+
+
+def judged_contact_checks(task, cols, k, judged) -> list:
+    """The row's mode has one letter of R, S, B per judged contact; a hold row's phase does not move."""
+    from qsplan.hands.found_contacts import contact_names
+    from qsplan.planner.certify.rows import JUMP_TOL, row_pose, row_q
+
+    found, drop = judged
+    mode = str(cols["mode"][k])
+    pose, _ = _configuration(task, cols, k)
+    names = [n for n, d in zip(contact_names(task.hand, pose, found), drop) if not d]
+    out = []
+    if len(mode) != len(names) or set(mode) - set("RSB"):
+        out.append(("contact", f"mode {mode!r}: expected one letter of R, S, B per contact the row touches "
+                               f"({len(names)}: {', '.join(names) or 'none'})"))  # fmt: skip
+    if hold_row(cols, k):
+        from qsplan.hands.interface import joint_names
+
+        for j in (k - 1, k + 1):
+            if 0 <= j < cols["t"].size and _same_phase(cols, j, k):
+                moved = max(float(np.max(np.abs(row_pose(cols, j) - row_pose(cols, k)))),
+                            float(np.max(np.abs(row_q(cols, j, joint_names(task.hand)) - row_q(cols, k, joint_names(task.hand))))))  # fmt: skip
+                if moved > JUMP_TOL:
+                    out.append(("mode", f"mode {mode} claims a hold (nothing moves) but the phase moves "
+                                        f"{moved:.3g} to an adjacent row"))  # fmt: skip
+                    break
+    return out
+
+
+def judged_scene(task, cols, k, judged, effort, qd, tau):
+    """The row's scene with its judged contacts (:func:`qsplan.hands.point_scene.points_scene`)."""
+    from qsplan.hands.found_contacts import contact_names
+    from qsplan.hands.point_scene import points_scene
+
+    found, drop = judged
+    pose, q = _configuration(task, cols, k)
+    names = contact_names(task.hand, pose, found)
+    keep = [i for i in range(len(found)) if not drop[i]]
+    return points_scene(task.hand, pose, q, [found[i].point for i in keep], [found[i].normal for i in keep],
+                        [found[i].body for i in keep], [names[i] for i in keep], effort, qd, effort=tau)  # fmt: skip

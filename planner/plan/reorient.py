@@ -1,0 +1,368 @@
+"""Reorienting the workpiece: the palm-edge slide to the flush instant, a certified hold, the pivot (issue 23).
+
+A goal that asks another orientation (``[goal] theta``, or ``palm`` naming what rests on the palm) is planned along
+the route the paper's own plan takes (Section 5.2: its first segment ends "when the left finger achieves
+edge-to-edge contact with the workpiece (along the longest edge)"), over three formations joined in contact:
+
+1. **slide** (formation ``palm_edge``, 4S): the automatic planner's route from the start to the **flush instant**
+   (:func:`qsplan.hands.reorient.flush_instant`), where the left finger lies along the workpiece's left edge.  The
+   band tables end :data:`FLUSH_APPROACH` short of it (there the polygons still show four contacts); the slide's
+   last row is the flush instant itself, judged for the motion that reaches it (the contact it makes there is open
+   along that motion, :func:`qsplan.hands.found_contacts.made_contacts`);
+2. **hold** (formation ``flush_to_pivot_v1``, five contacts, mode ``RRRRR``: nothing moves): the left finger held,
+   the right finger's torque ramps from the slide's last command to the pivot's first at :data:`HOLD_TORQUE_RATE`.
+   Its band is the torque interval over which the hold is *proved* (:func:`qsplan.mechanics.bands.hold.
+   hold_torque_interval`: a frictionless equilibrium with every contact loaded by at least the task's force margin,
+   at every vertex of the disturbance box; affine in the torque, so the ramp's ends prove it all);
+3. **pivot** (formation ``pivot_v1``, 4S): the workpiece turns clockwise on vertex 1, the left finger flush (two
+   contacts) driven along the closed-form manifold (:func:`qsplan.hands.reorient.pivot_configurations`), the right
+   finger torque-controlled.  Its first row is the transition: five contacts, mode ``BSSSS`` (vertex 0 lifts), its
+   band the exact transition band, every competitor precluded.  It ends at the goal's angle, at rest.
+
+Every band is :func:`qsplan.mechanics.robust_band`'s (exact, or conservative and labelled; the disturbance box of a
+turning workpiece, :func:`qsplan.planner.task.dynamics.turning_box`); every row at rest also gets its hold interval.
+A goal this route cannot reach (the hand not of the paper's form, a counter-clockwise turn, an event of the pivot
+before the goal: a contact changing, a joint limit, the band below the torque resolution) is refused by name with
+the angle where it ends.  Units SI (m, rad, s, N m).
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import replace
+
+import numpy as np
+from qsplan.mechanics.errors import QsplanError
+from qsplan.planner.plan.results import ContactSegmentPlan, Plan, PlanFailure
+from qsplan.planner.plan.steps import HoldStep, PivotStep
+from qsplan.planner.task.goal import Goal, GoalNotServedError
+
+__all__ = ["FLUSH_APPROACH", "HOLD_MIN_DURATION", "HOLD_ROWS", "HOLD_TORQUE_RATE", "PIVOT_STEP", "hold_phase", "pivot_phase",
+           "plan_reorientation", "pivot_target"]
+
+#: How far (m) short of the flush instant the slide's band tables end: five times the contact tolerance (1 um), so
+#: the polygons show the four contacts of the palm edge there (the left finger's second contact 5 um open); the
+#: slide then reaches the flush instant itself in its last row.
+FLUSH_APPROACH = 5e-6
+
+#: The rate (N m/s) at which a hold ramps the torque-controlled finger's torque: the demo's step of ~3.7 N m takes
+#: about 1.9 s, slow beside a servo's torque loop (ms) so the finger's compliance follows it without a kick.
+HOLD_TORQUE_RATE = 2.0
+
+#: Rows of a hold (the ramp's ends decide its proof; the rows between are for plots and a controller's table).
+HOLD_ROWS = 11
+
+#: The shortest hold (s), when its ramp is short or nothing ramps: its rows' times must grow, and a controller
+#: switching which joint it drives by torque gets a tenth of a second at rest to settle.
+HOLD_MIN_DURATION = 0.1
+
+#: The pivot's rows are at most this far apart in the workpiece's angle (rad): 0.25 deg, 0.4 mm at the farthest
+#: vertex of the demo's workpiece, like the slides' 0.5 mm rows.
+PIVOT_STEP = np.radians(0.25)
+
+#: Largest change of a pivot's torque command between two rows, as a fraction of its largest command: the
+#: transition's band starts at ~4 N m and the 4S bands fall to a tenth of it within a few degrees; hugging the lower
+#: edge would step 0.45 N m in the first 0.25 deg.  5 % keeps every step under a tenth of the command.
+COMMAND_STEP = 0.05
+
+#: The workpiece's internal vertex the route pivots on: the bottom edge's right end (:mod:`qsplan.hands.workpiece`).
+PIVOT = 1
+
+
+def _refuse(field, why):
+    return GoalNotServedError(field, f"{field}: {why}")
+
+
+def pivot_target(task) -> float:
+    """The goal's angle (rad): ``goal.theta``, or for ``palm = "edge:K"`` the angle at which that edge lands on the
+    palm while the workpiece pivots on vertex 1 (the bottom edge's right end).
+
+    Raises
+    ------
+    GoalNotServedError
+        A counter-clockwise turn, a palm feature the pivot on vertex 1 cannot put there, or a goal ``x``.
+    """
+    goal, hand = task.goal, task.hand
+    pivot = int(hand.user_vertices[PIVOT])  # as the task writes it
+    if goal.x is not None:
+        raise _refuse("goal.x", "a goal that turns the workpiece is placed by its orientation: the pivot decides x "
+                                "(give theta or palm, without x)")  # fmt: skip
+    if goal.theta is not None:
+        theta = float(goal.theta)
+        if not theta < 0:
+            raise _refuse("goal.theta", f"turning the workpiece counter-clockwise (theta = {theta:g} rad) is not "
+                                        "planned: the route turns it clockwise onto its bottom-right vertex (vertex "
+                                        f"{pivot}); pivoting on its bottom-left vertex has no band")  # fmt: skip
+        if goal.palm is not None and goal.palm != ("vertex", pivot):
+            raise _refuse("goal.palm", f"{goal.palm[0]} {goal.palm[1]} on the palm at theta = {theta:g} rad: the route "
+                                       f"pivots on vertex {pivot}")  # fmt: skip
+        return theta
+    kind, k = goal.palm
+    if kind == "vertex":
+        raise _refuse("goal.theta", f"vertex {k} on the palm: give the angle too (theta, rad): the workpiece turns on "
+                                    "it through many")  # fmt: skip
+    landing = int(hand.user_edges[PIVOT])  # the edge from the pivot vertex on: the one it can land on
+    if k != landing:
+        raise _refuse("goal.palm", f"edge {k} on the palm: the route pivots on vertex {pivot}, and edge {landing} is "
+                                   "the one it can land on")  # fmt: skip
+    V = np.asarray(hand.workpiece, dtype=float)
+    d = V[PIVOT + 1] - V[PIVOT]
+    return float(-np.arctan2(d[1], d[0]))  # the turn that lays edge PIVOT -> PIVOT + 1 flat on the palm
+
+
+def hold_phase(task, name, pose, q, effort_joint, tau_from, tau_to, t0) -> ContactSegmentPlan:
+    """A hold at one configuration: ``effort_joint``'s torque ramps from ``tau_from`` to ``tau_to`` (N m) at
+    :data:`HOLD_TORQUE_RATE`, every other joint held; its band the proved hold interval (module docstring).
+    ``tau_from`` None: the joint is taken over at rest (the phase before had another effort joint) and starts one
+    torque resolution inside the proved interval.
+
+    Raises
+    ------
+    PlanFailure
+        No hold is proved there, or the ramp leaves its interval (the report names the torques).
+    """
+    from qsplan.hands.found_contacts import row_contact_scene
+    from qsplan.hands.reorient import TRANSITION_FORMATION
+    from qsplan.mechanics.bands.hold import hold_torque_interval, prove_hold
+    from qsplan.planner.plan.failure import configuration_report
+
+    names = task.hand.joint_names
+    effort = np.array(names) == effort_joint
+    scene = row_contact_scene(task.hand, pose, q, effort, np.zeros(len(names)))
+    lo, hi = hold_torque_interval(scene, task.disturbance, margin=task.force_margin.normal)
+    if tau_from is None:  # the effort joint taken over at rest: from a resolution inside the proved interval
+        tau_from = float(min(lo + task.torque_resolution, tau_to)) if np.isfinite(lo) else float(tau_to)
+    proofs = [prove_hold(scene, torques=[t], disturbance=task.disturbance) for t in (tau_from, tau_to)]
+    room = 0.5 * task.torque_resolution  # the certifier's least slack to a band's edge (a controller's rounding)
+    inside = bool(lo + room <= min(tau_from, tau_to) and max(tau_from, tau_to) <= hi - room)  # False when empty
+    if not (inside and all(p.proved for p in proofs)):
+        raise PlanFailure(configuration_report(task, name, "the hold", float(pose[0]), q,
+                                               f"no hold is proved from {tau_from:.4g} to {tau_to:.4g} N m (proved "
+                                               f"interval [{lo:.4g}, {hi:.4g}] N m)"))  # fmt: skip
+    n = HOLD_ROWS
+    s = np.linspace(0.0, 1.0, n)
+    command = tau_from + s * (tau_to - tau_from)
+    t = t0 + s * max(abs(tau_to - tau_from) / HOLD_TORQUE_RATE, HOLD_MIN_DURATION)
+    lower, upper = np.full(n, lo), np.full(n, hi)
+    margin = np.minimum(command - lower, upper - command)
+    qd = np.where(effort[None, :], np.nan, 0.0) * np.ones((n, 1))
+    mode = "R" * len(scene.contact_names)
+    return ContactSegmentPlan(name, effort_joint, mode, np.array([pose[0]]), t, np.full(n, pose[0]),
+                              np.tile(q, (n, 1)), qd, lower, upper, command, margin, (), 0.0, None,
+                              np.zeros(n), "hold", np.tile(pose, (n, 1)), None, TRANSITION_FORMATION,
+                              (tuple(scene.contact_names),) * n)  # fmt: skip
+
+
+def _pivot_thetas(theta_goal: float) -> np.ndarray:
+    n = int(np.ceil(abs(theta_goal) / PIVOT_STEP)) + 1
+    return np.linspace(0.0, theta_goal, n)
+
+
+def pivot_phase(task, name, instant, theta_goal, t0, rate=None) -> ContactSegmentPlan:
+    """The pivot from the flush instant (theta 0) to ``theta_goal`` (rad, negative), the right finger
+    torque-controlled, the left finger driven along the manifold; the first row the transition (module docstring).
+
+    Raises
+    ------
+    PlanFailure
+        A row without a band at least the torque resolution wide, the manifold leaving the hand's reach, a joint
+        limit, or the polygons showing another contact set than the formation's (the report names the angle).
+    """
+    from qsplan.hands.formations import formation
+    from qsplan.hands.found_contacts import (
+        made_contacts,
+        ordered_contacts,
+        row_contact_scene,
+    )
+    from qsplan.hands.reorient import (
+        TRANSITION_FORMATION,
+        pivot_configurations,
+        pivot_scene,
+        transition_scene,
+    )
+    from qsplan.mechanics.bands.batched_robust import robust_bands
+    from qsplan.mechanics.bands.hold import hold_torque_interval
+    from qsplan.mechanics.bands.robust import robust_band
+    from qsplan.planner.plan.failure import configuration_report
+    from qsplan.planner.states.contact import configuration_problem
+    from qsplan.planner.torque.command import plan_command
+
+    hand = task.hand
+    theta = _pivot_thetas(theta_goal)
+    c = pivot_configurations(hand, theta, PIVOT, instant.edge, instant.right_vertex)
+
+    def fail(i, why):
+        return PlanFailure(configuration_report(task, name, f"theta = {np.degrees(theta[i]):.4g} deg", float(c.pose[i, 0]),
+                                                None if np.any(np.isnan(c.q[i])) else c.q[i], why))  # fmt: skip
+
+    for i in range(theta.size):
+        if np.any(np.isnan(c.q[i])):
+            raise fail(i, "the right finger cannot reach its vertex")
+        why = configuration_problem(task, c.pose[i], c.q[i])  # a joint limit, two bodies overlapping
+        if why:
+            raise fail(i, why)
+        found = ordered_contacts(hand, c.pose[i], c.q[i])
+        want = formation(TRANSITION_FORMATION if i == 0 else formation_name()).n_contacts
+        if i == theta.size - 1 and i > 0:  # the goal's row may make a contact (an edge landing): not in the motion
+            found = [f for f, m in zip(found, made_contacts(hand, (c.pose[i - 1], c.q[i - 1]), (c.pose[i], c.q[i]),
+                                                             found)) if not m]  # fmt: skip
+        if len(found) != want:
+            raise fail(i, f"the polygons show {len(found)} contacts; the formation has {want}")
+    reversal = _slip_reversal(hand, c, theta, instant)
+    if reversal is not None:
+        i, at, contact = reversal
+        raise fail(i, f"contact {contact} stops sliding at theta = {np.degrees(at):.4g} deg (its sliding direction "
+                      "reverses: it rolls for an instant, and one 4S phase cannot cross it)")  # fmt: skip
+    speeds = np.asarray(task.joint_speeds, float)
+    com_rate = float(np.max(np.hypot(c.dpose[:, 0], c.dpose[:, 1])))
+    limit = min(float(np.min(speeds / np.maximum(np.max(np.abs(c.dq), axis=0), 1e-300))),
+                task.workpiece_speed / com_rate)
+    rate = -limit if rate is None else rate  # clockwise, the fastest the speed limits allow
+    effort = np.array(hand.joint_names) == "right"
+    first = transition_scene(hand, instant, "right", rate)
+    scenes = [pivot_scene(hand, c, i, "right", rate) for i in range(1, theta.size)]
+    kw = dict(shared=task.shared_mu, force_margin=task.force_margin, disturbance=task.disturbance)
+    bands = [robust_band(first, formation(TRANSITION_FORMATION).mode, task.mu_range, **kw)]
+    bands += robust_bands(scenes, formation(formation_name()).mode, task.mu_range, **kw)
+    lower = np.array([b.lower if b.feasible else np.nan for b in bands])
+    upper = np.array([b.upper if b.feasible else np.nan for b in bands])
+    for k in (0, theta.size - 1):  # at rest: the hold must be proved too, with every contact there (as certified)
+        sc = row_contact_scene(hand, c.pose[k], c.q[k], effort, np.zeros(effort.size))
+        held = hold_torque_interval(sc, task.disturbance, margin=task.force_margin.normal)
+        lower[k], upper[k] = max(lower[k], held[0]), min(upper[k], held[1])
+    width = upper - lower
+    bad = np.flatnonzero(~(width >= task.torque_resolution))
+    if bad.size:
+        i = int(bad[0])
+        why = bands[i].reason if not bands[i].feasible else f"the band is {width[i]:.3g} N m wide"
+        raise fail(i, f"no guaranteed band at least the torque resolution ({task.torque_resolution:g} N m) wide: {why}")
+    command, margin = smooth_command(*plan_command(lower, upper, task.torque_resolution), lower, upper)
+    t = t0 + np.abs(theta) / abs(rate)
+    qd = np.column_stack([c.dq[:, 0] * rate, np.full(theta.size, np.nan)])
+    names5 = tuple(first.contact_names)
+    names4 = tuple(scenes[0].contact_names) if scenes else names5
+    comps = tuple(sorted({m for b in bands for m in getattr(b, "competitors", ())}))
+    return ContactSegmentPlan(name, "right", formation(formation_name()).mode, c.pose[[0, -1], 0], t, c.pose[:, 0],
+                              c.q, qd, lower, upper, command, margin, comps, com_rate * abs(rate), None, None, "pivot",
+                              c.pose, (formation(TRANSITION_FORMATION).mode,) + (formation(formation_name()).mode,)
+                              * (theta.size - 1), formation_name(), (names5,) + (names4,) * (theta.size - 1))  # fmt: skip
+
+
+def smooth_command(command, margin, lower, upper):
+    """The slide's command (:func:`qsplan.planner.torque.command.plan_command`: ``margin`` from the nearer edge)
+    with its steps between rows cut to :data:`COMMAND_STEP` of its range: where the band is open above (a pivot's,
+    after the transition's steep lower edge) it comes down gradually instead of hugging the lower edge, never nearer
+    an edge than the slide's rule keeps it.  Returns ``(command, margin)``, the margin to the nearer edge per row."""
+    floor = np.where(np.isfinite(lower), lower + margin, -np.inf)
+    ceil = np.where(np.isfinite(upper), upper - margin, np.inf)
+    step = COMMAND_STEP * (float(np.max(np.abs(command))) + float(np.min(margin)))
+    out = command.copy()
+    for k in range(1, out.size):  # forward: come down (or up) from the previous row by at most a step
+        out[k] = np.clip(out[k], out[k - 1] - step, out[k - 1] + step)
+    for k in range(out.size - 2, -1, -1):  # backward: anticipate a rise of the floor
+        out[k] = max(out[k], out[k + 1] - step)
+    out = np.minimum(np.maximum(out, floor), ceil)  # the rule's margin first: never nearer an edge
+    return out, np.minimum(out - lower, upper - out)
+
+
+def _slip_reversal(hand, c, theta, instant):
+    """``(first row past it, angle (rad), contact name)`` of the first contact whose sliding direction reverses along
+    the pivot (:func:`qsplan.hands.pivot_sweep.slip_speeds`, located by bisection), or None."""
+    from qsplan.hands.formations import formation
+    from qsplan.hands.pivot_sweep import locate_event, slip_speeds
+    from qsplan.hands.reorient import pivot_configurations
+
+    slips = slip_speeds(hand, c)
+    best = None
+    for j in range(slips.shape[1]):
+        sign = np.sign(slips[:, j])
+        flips = np.flatnonzero(sign[1:] * sign[0] <= 0) + 1 if sign[0] != 0 else np.array([], int)
+        if flips.size and (best is None or flips[0] < best[0]):
+            best = (int(flips[0]), j)
+    if best is None:
+        return None
+    i, j = best
+    at = locate_event(lambda t: slip_speeds(hand, pivot_configurations(hand, [t], PIVOT, instant.edge,
+                                                                       instant.right_vertex))[0, j],
+                      float(theta[i - 1]), float(theta[i]))  # fmt: skip
+    return i, at, formation(formation_name()).contact_names[j]
+
+
+def formation_name() -> str:
+    """The registered formation of the pivot (:data:`qsplan.hands.reorient.PIVOT_FORMATION`)."""
+    from qsplan.hands.reorient import PIVOT_FORMATION
+
+    return PIVOT_FORMATION
+
+
+def plan_reorientation(task, options=None, progress=None, planner: str = "widest") -> Plan:
+    """Plan a goal that turns the workpiece: slide to the flush instant, hold, pivot (the module docstring).
+
+    Raises
+    ------
+    GoalNotServedError
+        The route cannot serve the goal (named field and why).
+    PlanFailure
+        A phase of the route has no plan (the report says where and why).
+    """
+    from qsplan.hands.reorient import flush_instant, paper_form
+    from qsplan.planner.plan.autoplan import plan_automatic
+    from qsplan.planner.plan.timing import time_scale
+
+    progress = progress or (lambda line: None)
+    started = time.perf_counter()
+    hand = task.hand
+    try:
+        paper_form(hand)
+    except QsplanError as exc:
+        raise _refuse("goal.theta", f"turning the workpiece is planned for the paper's hand form only ({exc})") from None
+    theta_goal = pivot_target(task)
+    instant = flush_instant(hand)
+    upper_vertex = int(hand.user_vertices[instant.edge])
+    progress(f"reorientation: slide to the flush instant (x = {instant.x:.6g} m, the left finger along edge "
+             f"{int(hand.user_edges[instant.edge])}), hold, pivot on vertex {int(hand.user_vertices[PIVOT])} to "
+             f"theta = {theta_goal:.4g} rad")  # fmt: skip
+    x_near = instant.x + FLUSH_APPROACH * np.sign(task.start_x - instant.x)
+    sub = replace(task, goal=Goal(float(x_near), ("vertex", upper_vertex), None))
+    slide = plan_automatic(sub, options, progress, planner, timed=False)
+    phases = list(slide.phases)
+    last = phases[-1]
+    if not last.in_contact:
+        raise PlanFailure(slide_failure(task, last))
+    dt = FLUSH_APPROACH / abs(last.speed)
+    qd_end = last.qd[-1:]
+    phases[-1] = replace(last, t=np.append(last.t, last.t[-1] + dt), x=np.append(last.x, instant.x),
+                         q=np.vstack([last.q, instant.q]), qd=np.vstack([last.qd, qd_end]),
+                         lower=np.append(last.lower, last.lower[-1]), upper=np.append(last.upper, last.upper[-1]),
+                         command=np.append(last.command, last.command[-1]),
+                         margin=np.append(last.margin, last.margin[-1]))  # fmt: skip
+    # the slide timed first: the hold starts from its last command as the time scaling chose it
+    timed = time_scale(Plan(task, tuple(phases), 0.0, 0, 0.0, slide.options))
+    end = timed.phases[-1]
+    pivot = pivot_phase(task, f"pivot on vertex {int(hand.user_vertices[PIVOT])} to theta = {theta_goal:.4g} rad",
+                        instant, theta_goal, 0.0)  # fmt: skip
+    start = float(end.command[-1]) if end.effort_joint == "right" else None  # else handed over at rest
+    hold = hold_phase(task, "hold at the flush instant", instant.pose, instant.q, "right", start,
+                      float(pivot.command[0]), 0.0)  # fmt: skip
+    pivot = replace(pivot, t=pivot.t + float(hold.t[-1]))
+    turned = time_scale(Plan(task, (hold, pivot), 0.0, 0, 0.0, slide.options))
+    shift = float(end.t[-1])
+    later = tuple(replace(ph, t=ph.t + shift) for ph in turned.phases)
+    steps = tuple(st for st in slide.sequence if st.kind != "search") + (
+        HoldStep(float(instant.x), 0.0, "right", float(hold.command[0]), float(pivot.command[0]),
+                 float(hold.lower[0]), float(hold.upper[0])),
+        PivotStep(int(hand.user_vertices[PIVOT]), 0.0, theta_goal, "right", float(np.min(pivot.width))),
+    ) + tuple(st for st in slide.sequence if st.kind == "search")  # fmt: skip
+    plan = Plan(task, timed.phases + later, time.perf_counter() - started, slide.validity_checks + pivot.t.size,
+                slide.ompl_seconds, slide.options, steps, timed.timing + turned.timing)  # fmt: skip
+    plan.check()
+    progress(f"reorientation planned: {len(plan.phases)} phases, {plan.duration:.4g} s")
+    return plan
+
+
+def slide_failure(task, phase):
+    """The report when the route to the flush instant does not end in contact (a regrasp last)."""
+    from qsplan.planner.plan.failure import configuration_report
+
+    return configuration_report(task, phase.name, "the flush instant", float(phase.x[-1]), phase.q[-1],
+                                "the route to the flush instant ends with a regrasp, not in contact")  # fmt: skip

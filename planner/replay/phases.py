@@ -1,0 +1,170 @@
+"""The replay of phases in any formation: holds, the contact a slide makes at its end, pivots (issue 23).
+
+:func:`qsplan.planner.replay.replay.replay_plan` re-simulates each in-contact phase with the finite-motion simulator.
+A plan that turns the workpiece (:mod:`qsplan.planner.plan.reorient`) has phases the palm edge's closed form does not
+describe; this module says how each is replayed, from the rows and the task alone:
+
+* a **hold** (every letter ``R``): nothing moves and nothing is simulated: the certificate proves it
+  (:mod:`qsplan.mechanics.bands.hold`); the replay records it as followed, with that note;
+* a phase whose **last row makes a contact** (the slide's end at the flush instant: the polygons show one more
+  contact there than at the row before): simulated to the row before, where the formation still holds;
+* a phase whose **first row has more contacts** than the rest (the pivot's transition row, ``BSSSS``): the all-modes
+  solver at that row with all its contacts must find the planned mode alone (the replay's start check), then the
+  phase is simulated from its second row with the contacts of the rest;
+* scenes of a turning phase come from the contacts the polygons show (:func:`qsplan.hands.found_contacts.
+  row_contact_scene`), their count checked against the phase's.
+
+Friction: the replay's vector gives one coefficient per body of the palm-edge formation (``palm:0``, ``palm:1``,
+``left``, ``right``); a contact of another formation takes its body's (:func:`body_friction`).  Units SI.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from qsplan.mechanics.errors import QsplanError
+
+__all__ = ["HOLD_NOTE", "body_friction", "formation_of", "found_scene", "paper_form_hand", "phase_rows", "replay_segments",
+           "rows_pose", "transition_modes", "uses_found_contacts"]
+
+#: What a hold's replay records: it is not simulated; the certificate proves it.
+HOLD_NOTE = "a hold: nothing moves; proved by the certificate (frictionless equilibrium, every contact loaded)"
+
+
+def paper_form_hand(hand) -> bool:
+    """Whether ``hand`` is of the paper's form (two single-link fingers): its phases may change formation."""
+    from qsplan.hands.reorient import paper_form
+
+    try:
+        paper_form(hand)
+    except QsplanError:
+        return False
+    return True
+
+
+def uses_found_contacts(hand, columns, rows) -> bool:
+    """Whether the phase's rows need the found contacts: the workpiece turns (theta not 0), or a row's mode has other
+    than four letters; only for a hand of the paper's form."""
+    if not paper_form_hand(hand):
+        return False
+    theta = np.asarray(columns["theta_workpiece"], float)[rows]
+    return bool(np.any(theta != 0.0) or any(len(str(columns["mode"][k])) != 4 for k in rows))
+
+
+def _count(hand, columns, k):
+    from qsplan.hands.found_contacts import ordered_contacts
+
+    names = hand.joint_names
+    q = np.array([columns[f"q_{n}"][k] for n in names], float)
+    return len(ordered_contacts(hand, rows_pose(columns, k), q))
+
+
+def phase_rows(hand, columns, rows) -> tuple:
+    """``(rows to simulate, first row's mode to check with all its contacts or None, the simulated mode, note)``."""
+    modes = [str(columns["mode"][k]) for k in rows]
+    first = None
+    if len(rows) > 1 and len(modes[0]) != len(modes[1]):  # the transition row: judged with all its contacts
+        first, rows, modes = modes[0], rows[1:], modes[1:]
+    note = None
+    if len(rows) > 2 and _count(hand, columns, rows[-1]) > _count(hand, columns, rows[-2]):
+        rows = rows[:-1]  # the contact made at the last row: open along the motion, not simulated
+        note = "simulated to the row before its last, where it makes a contact"
+    return rows, first, modes[0], note
+
+
+def body_friction(names, mu) -> np.ndarray:
+    """The friction of contacts ``names`` from the replay's vector ``mu`` (palm:0, palm:1, left, right): a palm
+    contact ``palm:K`` takes ``mu[K]`` (K 0 or 1), a finger's contacts that finger's."""
+    out = []
+    for n in names:
+        body, _, rest = n.partition(":")
+        if body == "palm":
+            out.append(mu[int(rest)] if rest in ("0", "1") else mu[0])
+        else:
+            out.append(mu[2] if body == "left" else mu[3])
+    return np.asarray(out, float)
+
+
+def found_scene(hand, x, effort_controlled, velocity, effort, n_contacts):
+    """The scene at replay state ``x`` (pose, joints, clock) from the contacts the polygons show.
+
+    Raises
+    ------
+    QsplanError
+        The polygons show another number of contacts than the phase's (the geometry left its formation).
+    """
+    from qsplan.hands.found_contacts import row_contact_scene
+
+    scene = row_contact_scene(hand, x[:3], x[3:-1], effort_controlled, velocity, effort)
+    if len(scene.contact_names) != n_contacts:
+        raise QsplanError(f"contacts: the phase has {n_contacts}; the polygons show {len(scene.contact_names)} "
+                          f"({', '.join(scene.contact_names)}) at pose {np.round(x[:3], 6).tolist()}")  # fmt: skip
+    return scene
+
+
+def formation_of(hand, columns, k, mode):
+    """A formation of the contacts the polygons show at row ``k`` (their canonical names), ``mode`` its letters: the
+    simulator's contacts of a turning phase."""
+    from qsplan.hands.formations import ContactSlot, Formation
+    from qsplan.hands.found_contacts import contact_names, ordered_contacts
+
+    pose = rows_pose(columns, k)
+    q = np.array([columns[f"q_{n}"][k] for n in hand.joint_names], float)
+    names = contact_names(hand, pose, ordered_contacts(hand, pose, q))
+    slots = tuple(ContactSlot(n, n.partition(":")[0], "any", None, f"{n}, found in the polygons") for n in names)
+    return Formation("found", slots, mode, "last", "the contacts the polygons show")
+
+
+def transition_modes(hand, columns, k, effort_controlled, mu) -> tuple:
+    """Every mode the all-modes solver finds feasible at row ``k`` with all the contacts the polygons show (its
+    velocity-controlled joints along the straight line to the next row; its efforts at their commands), friction
+    :func:`body_friction`."""
+    from dataclasses import replace
+
+    from qsplan.hands.found_contacts import row_contact_scene
+    from qsplan.mechanics.solver.all_modes import solve
+
+    names = hand.joint_names
+    q0 = np.array([columns[f"q_{n}"][k] for n in names], float)
+    q1 = np.array([columns[f"q_{n}"][k + 1] for n in names], float)
+    tau = np.nan_to_num(np.array([columns[f"tau_{n}"][k] for n in names], float))
+    scene = row_contact_scene(hand, rows_pose(columns, k), q0, effort_controlled, q1 - q0, tau)
+    scene = replace(scene, mu=body_friction(scene.contact_names, mu))
+    return tuple(solve(scene, residuals=False).feasible_modes)
+
+
+def replay_segments(columns) -> list:
+    """Split plan columns (:func:`qsplan.planner.export.plan_files.read_plan_csv`) into in-contact segments.
+
+    ``phase`` is the phase's integer index (``0``, ``1``, ...; files before issue 16 wrote ``0.0``,
+    ``1.0``, ...: both read alike).
+
+    Returns
+    -------
+    list of dict
+        Per segment: ``phase``, ``rows`` (indices), ``mode``, ``effort_joint``.
+    """
+    for key in ("t", "phase", "mode", "effort_joint", "x_workpiece"):
+        if key not in columns:
+            raise QsplanError(f"plan: column {key!r} missing; expected the columns of qsplan.planner.export.plan_files")
+    if not any(str(key).startswith("q_") for key in columns):
+        raise QsplanError("plan: no column 'q_<joint>'; expected the columns of qsplan.planner.export.plan_files")
+    try:
+        values = np.asarray(columns["phase"], float)
+    except (TypeError, ValueError):
+        values = np.array([np.nan])
+    if not (np.all(np.isfinite(values)) and np.all(values == np.round(values)) and np.all(values >= 0)):
+        raise QsplanError("plan: column 'phase' holds a value that is not a phase index (0, 1, 2, ...)")
+    phases = values.astype(int)
+    out = []
+    for p in np.unique(phases):
+        rows = np.flatnonzero(phases == p)
+        mode = str(columns["mode"][rows[0]])
+        if mode == "free":
+            continue
+        out.append(dict(phase=int(p), rows=rows, mode=mode, effort_joint=str(columns["effort_joint"][rows[0]])))
+    return out
+
+
+def rows_pose(columns, k) -> np.ndarray:
+    """The planned workpiece pose at row ``k`` (m, m, rad), shape (3,)."""
+    return np.array([columns["x_workpiece"][k], columns["y_workpiece"][k], columns["theta_workpiece"][k]], float)
