@@ -7,8 +7,8 @@ edge-to-edge contact with the workpiece (along the longest edge)"), over three f
 1. **slide** (formation ``palm_edge``, 4S): the automatic planner's route from the start to the **flush instant**
    (:func:`qsplan.hands.reorient.flush_instant`), where the left finger lies along the workpiece's left edge.  The
    band tables end :data:`FLUSH_APPROACH` short of it (there the polygons still show four contacts); the slide's
-   last row is the flush instant itself, judged for the motion that reaches it (the contact it makes there is open
-   along that motion, :func:`qsplan.hands.found_contacts.made_contacts`);
+   last row is then moved onto the flush instant itself, judged at rest for the motion that reaches it (the
+   contact it makes there is open along that motion, :func:`qsplan.hands.found_contacts.made_contacts`);
 2. **hold** (formation ``flush_to_pivot_v1``, five contacts, mode ``RRRRR``: nothing moves): the left finger held,
    the right finger's torque ramps from the slide's last command to the pivot's first at :data:`HOLD_TORQUE_RATE`.
    Its band is the torque interval over which the hold is *proved* (:func:`qsplan.mechanics.bands.hold.
@@ -329,13 +329,12 @@ def plan_reorientation(task, options=None, progress=None, planner: str = "widest
     last = phases[-1]
     if not last.in_contact:
         raise PlanFailure(slide_failure(task, last))
-    dt = FLUSH_APPROACH / abs(last.speed)
-    qd_end = last.qd[-1:]
-    phases[-1] = replace(last, t=np.append(last.t, last.t[-1] + dt), x=np.append(last.x, instant.x),
-                         q=np.vstack([last.q, instant.q]), qd=np.vstack([last.qd, qd_end]),
-                         lower=np.append(last.lower, last.lower[-1]), upper=np.append(last.upper, last.upper[-1]),
-                         command=np.append(last.command, last.command[-1]),
-                         margin=np.append(last.margin, last.margin[-1]))  # fmt: skip
+    # the last row moves onto the flush instant itself (5 um on): a row at rest, its band judged again for the
+    # chord that reaches it by the time scaling (the contact made there left out: qsplan.planner.plan.timing)
+    x, q, t = last.x.copy(), last.q.copy(), last.t.copy()
+    x[-1], q[-1] = instant.x, instant.q
+    t[-1] = t[-2] + abs(x[-1] - x[-2]) / abs(last.speed)
+    phases[-1] = replace(last, x=x, q=q, t=t)
     # the slide timed first: the hold starts from its last command as the time scaling chose it
     timed = time_scale(Plan(task, tuple(phases), 0.0, 0, 0.0, slide.options))
     end = timed.phases[-1]

@@ -29,7 +29,7 @@ import numpy as np
 from qsplan.mechanics.errors import QsplanError
 
 __all__ = ["BROKEN_FORCE", "CONTACTS", "CONTROL_RATE", "PRELOAD_TIME", "SLIP_SPEED", "MujocoReplay", "MujocoRun",
-           "load_mujoco", "replay_mujoco"]
+           "load_mujoco", "pair_letters", "planned_pairs", "replay_mujoco"]
 
 #: Control rate (Hz) at which the exported commands are sampled and sent: a common joint-servo rate.
 CONTROL_RATE = 1000.0
@@ -107,8 +107,29 @@ class MujocoRun:
 
     @property
     def mismatches(self) -> np.ndarray:
-        """In-contact rows whose judged letters differ from the planned mode, shape (m,) bool."""
-        return self.contact_rows & (self.observed != self.planned)
+        """In-contact rows whose judged letters differ from the planned mode, shape (m,) bool.
+
+        Two readings the means cannot make are left to what they can:
+
+        * the first row of a phase leaves rest: its interval's means still count the load a breaking contact had
+          (MuJoCo's contacts are compliant: the pivot's vertex 0 unloads over that interval) and a sliding contact's
+          slip from rest may average under :data:`SLIP_SPEED`; a pair whose letter differs there is kept when the
+          next row of the phase observes the planned letter;
+        * a hold (every planned letter ``R``) claims that nothing moves, not how the load is shared: five contacts
+          hold the workpiece statically indeterminately (the proof shows an equilibrium with every contact loaded;
+          the compliant model may pick one that leaves a contact without force); a pair read ``B`` by its force
+          alone is kept while it slips under :data:`SLIP_SPEED`.
+        """
+        out = self.contact_rows & (self.observed != self.planned)
+        m = out.size
+        for k in np.flatnonzero(out):
+            start = k == 0 or self.phase[k - 1] != self.phase[k]
+            nxt = self.observed[k + 1] if k + 1 < m and self.phase[k + 1] == self.phase[k] else None
+            hold = set(self.planned[k]) == {"R"}
+            out[k] = not all(p == o or (start and nxt is not None and nxt[j] == p)
+                             or (hold and o == "B" and self.slip_speed[k, j] < SLIP_SPEED)
+                             for j, (p, o) in enumerate(zip(self.planned[k], self.observed[k])))  # fmt: skip
+        return out
 
     @property
     def modes_kept(self) -> bool:
@@ -116,9 +137,10 @@ class MujocoRun:
 
     @property
     def contacts_lost(self) -> tuple:
-        """``(t, contact)`` of every in-contact row where a planned contact is judged broken."""
+        """``(t, contact)`` of every in-contact row where a planned contact is judged broken (and the row's letters
+        are not kept: :attr:`mismatches`)."""
         out = []
-        for k in np.flatnonzero(self.contact_rows):
+        for k in np.flatnonzero(self.mismatches):
             out += [(float(self.t[k]), c) for c, p, o in zip(CONTACTS, self.planned[k], self.observed[k])
                     if p != "B" and o == "B"]  # fmt: skip
         return tuple(out)
@@ -208,6 +230,33 @@ def _friction_vectors(task, mu, n_random, seed) -> np.ndarray:
     return m
 
 
+def pair_letters(mode: str, names) -> str:
+    """A row's planned letters over its contacts ``names`` (the canonical order, :mod:`qsplan.hands.found_contacts`)
+    on the scene's four pairs (:data:`CONTACTS`): ``palm:K`` on its foot, a finger's contacts on its links; a pair
+    no planned contact is on is ``B`` (open: a lifted vertex); a finger flush on an edge (two contacts) slides if
+    either does, else rolls."""
+    out = []
+    for pair in CONTACTS:
+        mine = [m for m, n in zip(mode, names) if (n == pair if pair.startswith("palm") else n.split(":")[0] == pair)]
+        out.append("B" if not mine else ("S" if "S" in mine else ("R" if "R" in mine else "B")))
+    return "".join(out)
+
+
+def planned_pairs(cols, meta) -> np.ndarray:
+    """Each row's planned letters on the four pairs (:func:`pair_letters`): a row whose phase names its contacts
+    (``metadata.phases[i].contact_sets``, plans that turn the workpiece) mapped; any other row as written."""
+    planned = np.asarray(cols["mode"]).astype(str).copy()
+    phases = (meta or {}).get("phases") or []
+    phase = np.asarray(cols["phase"]).astype(int)
+    for i, d in enumerate(phases):
+        rows = np.flatnonzero(phase == i)
+        for run in d.get("contact_sets") or []:
+            for k in rows[run["rows"][0]:run["rows"][1] + 1]:
+                if planned[k] != "free":
+                    planned[k] = pair_letters(planned[k], run["contacts"])
+    return planned
+
+
 def replay_mujoco(plan_dir, task=None, mu=None, n_random: int = 2, seed: int = 0) -> MujocoReplay:
     """Execute an exported plan in MuJoCo (the rules: :mod:`qsplan.planner.replay.mujoco_replay`).
 
@@ -250,7 +299,7 @@ def replay_mujoco(plan_dir, task=None, mu=None, n_random: int = 2, seed: int = 0
     t = np.asarray(cols["t"], float)
     samples = sample_plan(cols, tick_times(float(t.max()), CONTROL_RATE))
     sim = MujocoSim(mujoco, task, samples, cols, PRELOAD_TIME)
-    planned = np.asarray(cols["mode"]).astype(str)
+    planned = planned_pairs(cols, meta)
     pose = np.column_stack([np.asarray(cols[k], float) for k in ("x_workpiece", "y_workpiece", "theta_workpiece")])
     runs = []
     for m in vectors:
