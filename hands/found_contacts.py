@@ -21,6 +21,7 @@ Units SI (m, rad).
 from __future__ import annotations
 
 import numpy as np
+
 from qsplan.mechanics.errors import QsplanError
 from qsplan.mechanics.model.geometry import CONTACT_TOL
 

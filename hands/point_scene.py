@@ -9,6 +9,7 @@ manipulator link carrying each, eq. 1) into a :class:`qsplan.mechanics.Scene` (e
 from __future__ import annotations
 
 import numpy as np
+
 from qsplan.mechanics.errors import QsplanError
 
 __all__ = ["points_scene"]

@@ -32,13 +32,16 @@ import time
 from dataclasses import replace
 
 import numpy as np
+
+from qsplan.hands.reorient import PIVOT_FORMATION, TRANSITION_FORMATION
 from qsplan.mechanics.errors import QsplanError
+
 from qsplan.planner.plan.results import ContactSegmentPlan, Plan, PlanFailure
 from qsplan.planner.plan.steps import HoldStep, PivotStep
 from qsplan.planner.task.goal import Goal, GoalNotServedError
 
-__all__ = ["FLUSH_APPROACH", "HOLD_MIN_DURATION", "HOLD_ROWS", "HOLD_TORQUE_RATE", "PIVOT_STEP", "hold_phase", "pivot_phase",
-           "plan_reorientation", "pivot_target"]
+__all__ = ["COMMAND_STEP", "FLUSH_APPROACH", "HOLD_MIN_DURATION", "HOLD_ROWS", "HOLD_TORQUE_RATE", "PIVOT", "PIVOT_STEP",
+           "hold_phase", "pivot_phase", "pivot_target", "plan_reorientation", "smooth_command"]
 
 #: How far (m) short of the flush instant the slide's band tables end: five times the contact tolerance (1 um), so
 #: the polygons show the four contacts of the palm edge there (the left finger's second contact 5 um open); the
@@ -122,7 +125,6 @@ def hold_phase(task, name, pose, q, effort_joint, tau_from, tau_to, t0) -> Conta
         No hold is proved there, or the ramp leaves its interval (the report names the torques).
     """
     from qsplan.hands.found_contacts import row_contact_scene
-    from qsplan.hands.reorient import TRANSITION_FORMATION
     from qsplan.mechanics.bands.hold import hold_torque_interval, prove_hold
     from qsplan.planner.plan.failure import configuration_report
 
@@ -154,11 +156,12 @@ def hold_phase(task, name, pose, q, effort_joint, tau_from, tau_to, t0) -> Conta
 
 
 def _pivot_thetas(theta_goal: float) -> np.ndarray:
+    """The pivot's rows' angles (rad): from 0 to ``theta_goal``, at most :data:`PIVOT_STEP` apart."""
     n = int(np.ceil(abs(theta_goal) / PIVOT_STEP)) + 1
     return np.linspace(0.0, theta_goal, n)
 
 
-def pivot_phase(task, name, instant, theta_goal, t0, rate=None) -> ContactSegmentPlan:
+def pivot_phase(task, name, instant, theta_goal, t0) -> ContactSegmentPlan:
     """The pivot from the flush instant (theta 0) to ``theta_goal`` (rad, negative), the right finger
     torque-controlled, the left finger driven along the manifold; the first row the transition (module docstring).
 
@@ -169,17 +172,8 @@ def pivot_phase(task, name, instant, theta_goal, t0, rate=None) -> ContactSegmen
         limit, or the polygons showing another contact set than the formation's (the report names the angle).
     """
     from qsplan.hands.formations import formation
-    from qsplan.hands.found_contacts import (
-        made_contacts,
-        ordered_contacts,
-        row_contact_scene,
-    )
-    from qsplan.hands.reorient import (
-        TRANSITION_FORMATION,
-        pivot_configurations,
-        pivot_scene,
-        transition_scene,
-    )
+    from qsplan.hands.found_contacts import made_contacts, ordered_contacts, row_contact_scene
+    from qsplan.hands.reorient import pivot_configurations, pivot_scene, transition_scene
     from qsplan.mechanics.bands.batched_robust import robust_bands
     from qsplan.mechanics.bands.hold import hold_torque_interval
     from qsplan.mechanics.bands.robust import robust_band
@@ -202,7 +196,7 @@ def pivot_phase(task, name, instant, theta_goal, t0, rate=None) -> ContactSegmen
         if why:
             raise fail(i, why)
         found = ordered_contacts(hand, c.pose[i], c.q[i])
-        want = formation(TRANSITION_FORMATION if i == 0 else formation_name()).n_contacts
+        want = formation(TRANSITION_FORMATION if i == 0 else PIVOT_FORMATION).n_contacts
         if i == theta.size - 1 and i > 0:  # the goal's row may make a contact (an edge landing): not in the motion
             found = [f for f, m in zip(found, made_contacts(hand, (c.pose[i - 1], c.q[i - 1]), (c.pose[i], c.q[i]),
                                                              found)) if not m]  # fmt: skip
@@ -217,13 +211,13 @@ def pivot_phase(task, name, instant, theta_goal, t0, rate=None) -> ContactSegmen
     com_rate = float(np.max(np.hypot(c.dpose[:, 0], c.dpose[:, 1])))
     limit = min(float(np.min(speeds / np.maximum(np.max(np.abs(c.dq), axis=0), 1e-300))),
                 task.workpiece_speed / com_rate)
-    rate = -limit if rate is None else rate  # clockwise, the fastest the speed limits allow
+    rate = -limit  # clockwise, the fastest the speed limits allow (rad/s)
     effort = np.array(hand.joint_names) == "right"
     first = transition_scene(hand, instant, "right", rate)
     scenes = [pivot_scene(hand, c, i, "right", rate) for i in range(1, theta.size)]
     kw = dict(shared=task.shared_mu, force_margin=task.force_margin, disturbance=task.disturbance)
     bands = [robust_band(first, formation(TRANSITION_FORMATION).mode, task.mu_range, **kw)]
-    bands += robust_bands(scenes, formation(formation_name()).mode, task.mu_range, **kw)
+    bands += robust_bands(scenes, formation(PIVOT_FORMATION).mode, task.mu_range, **kw)
     lower = np.array([b.lower if b.feasible else np.nan for b in bands])
     upper = np.array([b.upper if b.feasible else np.nan for b in bands])
     for k in (0, theta.size - 1):  # at rest: the hold must be proved too, with every contact there (as certified)
@@ -242,10 +236,10 @@ def pivot_phase(task, name, instant, theta_goal, t0, rate=None) -> ContactSegmen
     names5 = tuple(first.contact_names)
     names4 = tuple(scenes[0].contact_names) if scenes else names5
     comps = tuple(sorted({m for b in bands for m in getattr(b, "competitors", ())}))
-    return ContactSegmentPlan(name, "right", formation(formation_name()).mode, c.pose[[0, -1], 0], t, c.pose[:, 0],
+    return ContactSegmentPlan(name, "right", formation(PIVOT_FORMATION).mode, c.pose[[0, -1], 0], t, c.pose[:, 0],
                               c.q, qd, lower, upper, command, margin, comps, com_rate * abs(rate), None, None, "pivot",
-                              c.pose, (formation(TRANSITION_FORMATION).mode,) + (formation(formation_name()).mode,)
-                              * (theta.size - 1), formation_name(), (names5,) + (names4,) * (theta.size - 1))  # fmt: skip
+                              c.pose, (formation(TRANSITION_FORMATION).mode,) + (formation(PIVOT_FORMATION).mode,)
+                              * (theta.size - 1), PIVOT_FORMATION, (names5,) + (names4,) * (theta.size - 1))  # fmt: skip
 
 
 def smooth_command(command, margin, lower, upper):
@@ -276,7 +270,8 @@ def _slip_reversal(hand, c, theta, instant):
     best = None
     for j in range(slips.shape[1]):
         sign = np.sign(slips[:, j])
-        flips = np.flatnonzero(sign[1:] * sign[0] <= 0) + 1 if sign[0] != 0 else np.array([], int)
+        first = np.flatnonzero(sign)  # the direction it starts sliding in (a zero first sample: the next)
+        flips = (np.flatnonzero(sign[first[0] + 1:] != sign[first[0]]) + first[0] + 1) if first.size else first
         if flips.size and (best is None or flips[0] < best[0]):
             best = (int(flips[0]), j)
     if best is None:
@@ -285,14 +280,7 @@ def _slip_reversal(hand, c, theta, instant):
     at = locate_event(lambda t: slip_speeds(hand, pivot_configurations(hand, [t], PIVOT, instant.edge,
                                                                        instant.right_vertex))[0, j],
                       float(theta[i - 1]), float(theta[i]))  # fmt: skip
-    return i, at, formation(formation_name()).contact_names[j]
-
-
-def formation_name() -> str:
-    """The registered formation of the pivot (:data:`qsplan.hands.reorient.PIVOT_FORMATION`)."""
-    from qsplan.hands.reorient import PIVOT_FORMATION
-
-    return PIVOT_FORMATION
+    return i, at, formation(PIVOT_FORMATION).contact_names[j]
 
 
 def plan_reorientation(task, options=None, progress=None, planner: str = "widest") -> Plan:

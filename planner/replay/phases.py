@@ -21,6 +21,7 @@ Friction: the replay's vector gives one coefficient per body of the palm-edge fo
 from __future__ import annotations
 
 import numpy as np
+
 from qsplan.mechanics.errors import QsplanError
 
 __all__ = ["HOLD_NOTE", "body_friction", "formation_of", "found_scene", "paper_form_hand", "phase_rows", "replay_segments",

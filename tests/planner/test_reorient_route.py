@@ -8,6 +8,7 @@ import json
 
 import numpy as np
 import pytest
+
 from qsplan.hands.found_contacts import ordered_contacts, row_contact_scene
 from qsplan.hands.reorient import flush_instant
 from qsplan.mechanics import solve_many
