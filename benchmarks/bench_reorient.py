@@ -93,12 +93,17 @@ def sweep_table(sweep, every):
               f"{np.degrees(c.q[i, 1]):>7.2f} {feature:>14} | {r.lower[i]:>9.5f} {r.upper[i]:>9.5f} {r.width[i]:>8.5f} | "
               f"{l_.lower[i]:>9.5f} {l_.upper[i]:>9.5f} {l_.width[i]:>8.5f} "
               f"{'ok' if sweep.agrees[i] else 'differs'}")  # fmt: skip
+    print_events(sweep)
+    print(f"exact bands: right {bands['right'].exact.all()}, left {bands['left'].exact.all()}; polygon search agrees at "
+          f"{sweep.agrees.sum()} of {len(c.theta)} samples (not at theta = 0, where v0 still touches the palm)")  # fmt: skip
+
+
+def print_events(sweep):
+    """The sweep's events, in the order they occur (bench_reorient_edge.py prints its own with this)."""
     print("\nevents (bisection to 1e-6 rad)")
     for e in sweep.events:
         ends = "  (ends the formation)" if e.ends else ""
         print(f"  {np.degrees(e.theta):>10.4f} deg  {e.name:<18} {e.description}{ends}")
-    print(f"exact bands: right {bands['right'].exact.all()}, left {bands['left'].exact.all()}; polygon search agrees at "
-          f"{sweep.agrees.sum()} of {len(c.theta)} samples (not at theta = 0, where v0 still touches the palm)")  # fmt: skip
 
 
 def figure(task, instant, sweep, path):

@@ -149,10 +149,9 @@ def pivot_table(task, sweep, boxed, every):
           f"right {np.degrees(c.q[:, 1].min()):.2f} to {np.degrees(c.q[:, 1].max()):.2f}; limits "
           f"{np.degrees(task.joint_limits).round(2).tolist()}; polygon search agrees at {sweep.agrees.sum()} of "
           f"{len(c.theta)} samples (not at theta = 0, where v0 still touches the palm)")  # fmt: skip
-    print("\nevents (bisection to 1e-6 rad)")
-    for e in sweep.events:
-        ends = "  (ends the formation)" if e.ends else ""
-        print(f"  {np.degrees(e.theta):>10.4f} deg  {e.name:<18} {e.description}{ends}")
+    from bench_reorient import print_events  # the sibling script's table of events
+
+    print_events(sweep)
 
 
 def clearance(task, configurations, label):
