@@ -15,8 +15,9 @@ edge-to-edge contact with the workpiece (along the longest edge)"), over three f
    hold_torque_interval`: a frictionless equilibrium with every contact loaded by at least the task's force margin,
    at every vertex of the disturbance box; affine in the torque, so the ramp's ends prove it all);
 3. **pivot** (formation ``pivot_v1``, 4S): the workpiece turns clockwise on vertex 1, the left finger flush (two
-   contacts) driven along the closed-form manifold (:func:`qsplan.hands.reorient.pivot_configurations`), the right
-   finger torque-controlled.  Its first row is the transition: five contacts, mode ``BSSSS`` (vertex 0 lifts), its
+   contacts), the fingers along the closed-form manifold (:func:`qsplan.hands.reorient.pivot_configurations`), one
+   finger torque-controlled and the other driven: the one whose narrowest band is widest (:func:`widest_pivot`;
+   the right one, the paper's, on a tie).  Its first row is the transition: five contacts, mode ``BSSSS`` (vertex 0 lifts), its
    band the exact transition band, every competitor precluded.  It ends at the goal's angle, at rest.
 
 Every band is :func:`qsplan.mechanics.robust_band`'s (exact, or conservative and labelled; the disturbance box of a
@@ -40,8 +41,9 @@ from qsplan.planner.plan.results import ContactSegmentPlan, Plan, PlanFailure
 from qsplan.planner.plan.steps import HoldStep, PivotStep
 from qsplan.planner.task.goal import Goal, GoalNotServedError
 
-__all__ = ["COMMAND_STEP", "FLUSH_APPROACH", "HOLD_MIN_DURATION", "HOLD_ROWS", "HOLD_TORQUE_RATE", "PIVOT", "PIVOT_STEP",
-           "hold_phase", "pivot_phase", "pivot_target", "plan_reorientation", "smooth_command"]
+__all__ = ["COMMAND_STEP", "FLUSH_APPROACH", "HOLD_MIN_DURATION", "HOLD_ROWS", "HOLD_TORQUE_RATE", "PIVOT", "PIVOT_EFFORT_JOINTS", "PIVOT_STEP",
+           "hold_phase", "pivot_phase", "pivot_target", "plan_reorientation", "smooth_command",
+           "widest_pivot"]
 
 #: How far (m) short of the flush instant the slide's band tables end: five times the contact tolerance (1 um), so
 #: the polygons show the four contacts of the palm edge there (the left finger's second contact 5 um open); the
@@ -67,6 +69,10 @@ PIVOT_STEP = np.radians(0.25)
 #: transition's band starts at ~4 N m and the 4S bands fall to a tenth of it within a few degrees; hugging the lower
 #: edge would step 0.45 N m in the first 0.25 deg.  5 % keeps every step under a tenth of the command.
 COMMAND_STEP = 0.05
+
+#: The fingers the pivot may torque-control, in order of preference on a tie (the paper's Fig. 9: the right one
+#: pushes while the left finger, flush on the workpiece, is driven).
+PIVOT_EFFORT_JOINTS = ("right", "left")
 
 #: The workpiece's internal vertex the route pivots on: the bottom edge's right end (:mod:`qsplan.hands.workpiece`).
 PIVOT = 1
@@ -161,9 +167,9 @@ def _pivot_thetas(theta_goal: float) -> np.ndarray:
     return np.linspace(0.0, theta_goal, n)
 
 
-def pivot_phase(task, name, instant, theta_goal, t0) -> ContactSegmentPlan:
-    """The pivot from the flush instant (theta 0) to ``theta_goal`` (rad, negative), the right finger
-    torque-controlled, the left finger driven along the manifold; the first row the transition (module docstring).
+def pivot_phase(task, name, instant, theta_goal, t0, effort_joint: str = "right") -> ContactSegmentPlan:
+    """The pivot from the flush instant (theta 0) to ``theta_goal`` (rad, negative), ``effort_joint`` (a finger)
+    torque-controlled, the other driven along the manifold; the first row the transition (module docstring).
 
     Raises
     ------
@@ -212,9 +218,9 @@ def pivot_phase(task, name, instant, theta_goal, t0) -> ContactSegmentPlan:
     limit = min(float(np.min(speeds / np.maximum(np.max(np.abs(c.dq), axis=0), 1e-300))),
                 task.workpiece_speed / com_rate)
     rate = -limit  # clockwise, the fastest the speed limits allow (rad/s)
-    effort = np.array(hand.joint_names) == "right"
-    first = transition_scene(hand, instant, "right", rate)
-    scenes = [pivot_scene(hand, c, i, "right", rate) for i in range(1, theta.size)]
+    effort = np.array(hand.joint_names) == effort_joint
+    first = transition_scene(hand, instant, effort_joint, rate)
+    scenes = [pivot_scene(hand, c, i, effort_joint, rate) for i in range(1, theta.size)]
     kw = dict(shared=task.shared_mu, force_margin=task.force_margin, disturbance=task.disturbance)
     bands = [robust_band(first, formation(TRANSITION_FORMATION).mode, task.mu_range, **kw)]
     bands += robust_bands(scenes, formation(PIVOT_FORMATION).mode, task.mu_range, **kw)
@@ -232,11 +238,11 @@ def pivot_phase(task, name, instant, theta_goal, t0) -> ContactSegmentPlan:
         raise fail(i, f"no guaranteed band at least the torque resolution ({task.torque_resolution:g} N m) wide: {why}")
     command, margin = smooth_command(*plan_command(lower, upper, task.torque_resolution), lower, upper)
     t = t0 + np.abs(theta) / abs(rate)
-    qd = np.column_stack([c.dq[:, 0] * rate, np.full(theta.size, np.nan)])
+    qd = np.where(effort[None, :], np.nan, c.dq * rate)  # the velocity-controlled finger along the manifold
     names5 = tuple(first.contact_names)
     names4 = tuple(scenes[0].contact_names) if scenes else names5
     comps = tuple(sorted({m for b in bands for m in getattr(b, "competitors", ())}))
-    return ContactSegmentPlan(name, "right", formation(PIVOT_FORMATION).mode, c.pose[[0, -1], 0], t, c.pose[:, 0],
+    return ContactSegmentPlan(name, effort_joint, formation(PIVOT_FORMATION).mode, c.pose[[0, -1], 0], t, c.pose[:, 0],
                               c.q, qd, lower, upper, command, margin, comps, com_rate * abs(rate), None, None, "pivot",
                               c.pose, (formation(TRANSITION_FORMATION).mode,) + (formation(PIVOT_FORMATION).mode,)
                               * (theta.size - 1), PIVOT_FORMATION, (names5,) + (names4,) * (theta.size - 1))  # fmt: skip
@@ -326,25 +332,46 @@ def plan_reorientation(task, options=None, progress=None, planner: str = "widest
     # the slide timed first: the hold starts from its last command as the time scaling chose it
     timed = time_scale(Plan(task, tuple(phases), 0.0, 0, 0.0, slide.options))
     end = timed.phases[-1]
-    pivot = pivot_phase(task, f"pivot on vertex {int(hand.user_vertices[PIVOT])} to theta = {theta_goal:.4g} rad",
-                        instant, theta_goal, 0.0)  # fmt: skip
-    start = float(end.command[-1]) if end.effort_joint == "right" else None  # else handed over at rest
-    hold = hold_phase(task, "hold at the flush instant", instant.pose, instant.q, "right", start,
+    pivot = widest_pivot(task, f"pivot on vertex {int(hand.user_vertices[PIVOT])} to theta = {theta_goal:.4g} rad",
+                         instant, theta_goal, progress)  # fmt: skip
+    e = pivot.effort_joint
+    start = float(end.command[-1]) if end.effort_joint == e else None  # else handed over at rest
+    hold = hold_phase(task, "hold at the flush instant", instant.pose, instant.q, e, start,
                       float(pivot.command[0]), 0.0)  # fmt: skip
     pivot = replace(pivot, t=pivot.t + float(hold.t[-1]))
     turned = time_scale(Plan(task, (hold, pivot), 0.0, 0, 0.0, slide.options))
     shift = float(end.t[-1])
     later = tuple(replace(ph, t=ph.t + shift) for ph in turned.phases)
     steps = tuple(st for st in slide.sequence if st.kind != "search") + (
-        HoldStep(float(instant.x), 0.0, "right", float(hold.command[0]), float(pivot.command[0]),
+        HoldStep(float(instant.x), 0.0, e, float(hold.command[0]), float(pivot.command[0]),
                  float(hold.lower[0]), float(hold.upper[0])),
-        PivotStep(int(hand.user_vertices[PIVOT]), 0.0, theta_goal, "right", float(np.min(pivot.width))),
+        PivotStep(int(hand.user_vertices[PIVOT]), 0.0, theta_goal, e, float(np.min(pivot.width))),
     ) + tuple(st for st in slide.sequence if st.kind == "search")  # fmt: skip
     plan = Plan(task, timed.phases + later, time.perf_counter() - started, slide.validity_checks + pivot.t.size,
                 slide.ompl_seconds, slide.options, steps, timed.timing + turned.timing)  # fmt: skip
     plan.check()
     progress(f"reorientation planned: {len(plan.phases)} phases, {plan.duration:.4g} s")
     return plan
+
+
+def widest_pivot(task, name, instant, theta_goal, progress) -> ContactSegmentPlan:
+    """The pivot with either finger torque-controlled (:data:`PIVOT_EFFORT_JOINTS`), the one whose narrowest band is
+    widest (the first on a tie; the second is not computed when the first's bands are all unbounded above); the
+    first one's failure when neither has a plan."""
+    found, first_failure = [], None
+    for e in PIVOT_EFFORT_JOINTS:
+        if found and np.isinf(np.min(found[0].width)):
+            break  # unbounded everywhere: nothing is wider
+        try:
+            found.append(pivot_phase(task, name, instant, theta_goal, 0.0, e))
+        except PlanFailure as exc:
+            first_failure = first_failure or exc
+            progress(f"  pivot with the {e} finger torque-controlled: {exc}")
+    if not found:
+        raise first_failure
+    best = max(found, key=lambda p: float(np.min(p.width)))  # max keeps the first of equals
+    progress(f"  pivot: the {best.effort_joint} finger torque-controlled, narrowest band {np.min(best.width):.4g} N m")
+    return best
 
 
 def slide_failure(task, phase):

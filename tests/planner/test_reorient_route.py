@@ -183,3 +183,17 @@ def test_mujoco_keeps_the_turning_plans_modes(run):
         assert r.modes_kept and not r.contacts_lost and r.max_error() < 1e-4
         pivot = r.phase == 2
         assert set(r.planned[pivot][1:]) == {"BSSS"}  # palm:0 open on the pivot, the left finger's two contacts one pair
+
+
+def test_the_pivot_with_the_left_finger_torque_controlled(task):
+    """The other candidate of the widest-first choice: the left finger torque-controlled, the right one driven; its
+    transition band is bounded above (the left finger pushes inward, issue 23: <= -2.72 N m without margin)."""
+    from qsplan.planner.plan.reorient import pivot_phase, widest_pivot
+
+    fi = flush_instant(task.hand)
+    left = pivot_phase(task, "left", fi, -0.2, 0.0, "left")
+    assert left.effort_joint == "left" and np.isnan(left.qd[:, 0]).all() and np.isfinite(left.qd[:, 1]).all()
+    assert np.isinf(left.lower[0]) and left.upper[0] < -2.72 and np.all(left.command < left.upper)
+    assert np.all(left.width >= task.torque_resolution) and left.modes()[0] == "BSSSS"
+    right = widest_pivot(task, "right", fi, -0.2, lambda line: None)
+    assert right.effort_joint == "right" and np.isinf(np.min(right.width))  # unbounded: nothing is wider
