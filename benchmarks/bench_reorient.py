@@ -29,6 +29,7 @@ from qsplan.hands.reorient import TRANSITION_FORMATION, flush_instant, pivot_con
 from qsplan.hands.segments import flush_angle
 from qsplan.mechanics import DEFAULT_TOLERANCES, robust_band, solve_many
 from qsplan.planner.certify.modes import mode_checks
+from qsplan.planner.certify.rows import friction_points
 from qsplan.planner.task.task import demo_task_path, load_task
 
 INSIDE, OUTSIDE, FAR = 1e-6, 1e-3, 100.0  # N m: inside a finite edge, outside it, along an unbounded side
@@ -184,8 +185,7 @@ def main():
           f"q_right = {np.degrees(instant.q[1]):.2f} deg; closed form {closed * 1e3:.2f} ms; brentq on the flush angle "
           f"{root:.9f} m (|diff| {abs(root - instant.x):.1e} m, {reference * 1e3:.2f} ms)")  # fmt: skip
     rng = np.random.default_rng(args.seed)
-    lo, hi = task.mu_range
-    mus = np.vstack([np.array(list(product((lo, hi), repeat=5))), rng.uniform(lo, hi, (args.random, 5))])
+    mus = friction_points(task, args.random, rng, 5)  # the five-contact box's vertices, then seeded draws
     transition_table(task, instant, mus)
     t0 = time.perf_counter()
     sweep = sweep_pivot(hand, task.mu_range, task.force_margin, task.torque_resolution, limits=task.joint_limits,

@@ -47,6 +47,7 @@ from qsplan.hands.reorient import (PIVOT_FORMATION, TRANSITION_FORMATION, flush_
 from qsplan.mechanics import robust_band
 from qsplan.mechanics.bands.hold import hold_torque_interval, prove_hold
 from qsplan.planner.certify.modes import mode_checks
+from qsplan.planner.certify.rows import friction_points
 from qsplan.planner.states.contact import configuration_problem
 from qsplan.planner.task.task import load_task
 
@@ -246,8 +247,7 @@ def main():
           f"({np.degrees(instant.q[0]):.2f}, {np.degrees(instant.q[1]):.2f}) deg, inside the limits {inside}   "
           f"{1e3 * sec:.2f} ms")  # fmt: skip
     rng = np.random.default_rng(args.seed)
-    lo, hi = task.mu_range
-    mus = np.vstack([np.array(list(product((lo, hi), repeat=5))), rng.uniform(lo, hi, (args.random, 5))])
+    mus = friction_points(task, args.random, rng, 5)  # the five-contact box's vertices, then seeded draws
     edges = transition_table(task, instant, mus)
     print("\nholds at the flush instant (five contacts; proofs use no friction)")
     flush = transition_scene(hand, instant, "right")

@@ -25,7 +25,7 @@ import numpy as np
 from qsplan.mechanics.errors import QsplanError
 from qsplan.mechanics.model.geometry import CONTACT_TOL
 
-__all__ = ["contact_names", "drawable_contacts", "made_contacts", "ordered_contacts", "row_contact_scene"]
+__all__ = ["contact_names", "drawable_contacts", "made_contacts", "ordered_contacts", "row_contact_scene", "slot_of"]
 
 
 def ordered_contacts(hand, pose, q, tol: float = CONTACT_TOL) -> list:
@@ -90,22 +90,23 @@ def made_contacts(hand, before, after, contacts) -> np.ndarray:
     return made
 
 
-def row_contact_scene(hand, pose, q, effort_controlled, velocity, effort=None, mu=None, drop=None):
-    """The scene of every contact found at ``pose``, ``q`` in the canonical order (:func:`qsplan.hands.point_scene.points_scene`), without
-    those flagged in ``drop`` (bool, shape (n_found,): contacts :func:`made_contacts` made at this row).
+def row_contact_scene(hand, pose, q, effort_controlled, velocity, effort=None, mu=None, drop=None, found=None):
+    """The scene of every contact found at ``pose``, ``q`` in the canonical order
+    (:func:`qsplan.hands.point_scene.points_scene`), without those flagged in ``drop`` (bool, shape (n_found,):
+    contacts :func:`made_contacts` made at this row); ``found``: :func:`ordered_contacts` there, when already searched.
 
     Raises
     ------
     SceneError
         As :func:`ordered_contacts`; QsplanError when no contact is left.
     """
-    found = ordered_contacts(hand, pose, q)
+    from qsplan.hands.point_scene import points_scene
+
+    found = ordered_contacts(hand, pose, q) if found is None else found
     names = contact_names(hand, pose, found)
     keep = np.ones(len(found), dtype=bool) if drop is None else ~np.asarray(drop, dtype=bool)
     if not keep.any():
         raise QsplanError("contacts: the workpiece touches nothing at this configuration")
-    from qsplan.hands.point_scene import points_scene
-
     found = [c for c, k in zip(found, keep) if k]
     names = [n for n, k in zip(names, keep) if k]
     return points_scene(hand, pose, q, [c.point for c in found], [c.normal for c in found],
@@ -113,13 +114,17 @@ def row_contact_scene(hand, pose, q, effort_controlled, velocity, effort=None, m
 
 
 def drawable_contacts(hand, pose, q) -> list:
-    """The contacts to draw at ``pose``, ``q``: a paper-form hand's as the polygons show them (any formation,
-    :func:`ordered_contacts`), a chain hand's grasp contacts (:func:`qsplan.hands.interface.contacts_at`)."""
+    """The contacts to draw at ``pose``, ``q``: a hand that reorients, as the polygons show them (any formation,
+    :func:`ordered_contacts`); any other, its grasp's (:func:`qsplan.hands.interface.contacts_at`)."""
     from qsplan.hands.interface import contacts_at
-    from qsplan.hands.reorient import paper_form
 
-    try:
-        paper_form(hand)
-    except QsplanError:
-        return contacts_at(hand, pose, q)
-    return ordered_contacts(hand, pose, q)
+    return ordered_contacts(hand, pose, q) if hand.reorients else contacts_at(hand, pose, q)
+
+
+def slot_of(name: str, slots) -> int | None:
+    """Which of ``slots`` (a formation's contact names, e.g. the palm edge's ``palm:0, palm:1, left, right``) the
+    canonical contact ``name`` sits on: a palm contact on the slot of its own name, a finger's (``left:base``,
+    ``left:tip``) on that finger's; None where ``slots`` has none (a palm contact under another vertex)."""
+    body = name.split(":")[0]
+    key = name if body == "palm" else body
+    return list(slots).index(key) if key in slots else None

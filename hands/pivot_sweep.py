@@ -31,7 +31,7 @@ from qsplan.mechanics.errors import QsplanError, SceneError
 from qsplan.mechanics.model.geometry import CONTACT_TOL
 
 __all__ = ["DEFAULT_RESOLUTION", "EVENT_TOL", "SWEEP_END", "SWEEP_STEP", "PivotBands", "PivotEvent", "PivotSweep",
-           "geometric_events", "locate_event", "pivot_band", "polygon_contacts", "same_contacts", "slip_speeds",
+           "geometric_events", "locate_event", "pivot_band", "polygon_contacts", "same_contacts", "slip_events", "slip_speeds",
            "sweep_pivot"]
 
 #: Bracket (rad) to which :func:`locate_event` bisects an event's angle: 5.7e-5 deg, far below the sweep's step.
@@ -201,6 +201,24 @@ def _first_crossing(g) -> int | None:
     return None if after.size == 0 else int(nonzero[0] + after[0])
 
 
+def slip_events(hand, configurations) -> list:
+    """Each contact's first reversal of its sliding direction along ``configurations`` (:func:`slip_speeds`),
+    bisected to :data:`EVENT_TOL`: :class:`PivotEvent` ``slip_<contact>`` (not ending the formation: the 4S phase
+    does), in contact order."""
+    c = configurations
+    args = (c.pivot, c.edge, c.right_vertex)
+    slips = slip_speeds(hand, c)
+    out = []
+    for j, name in enumerate(formation(PIVOT_FORMATION).contact_names):
+        i = _first_crossing(slips[:, j])
+        if i is not None:
+            at = locate_event(lambda t, j=j: slip_speeds(hand, pivot_configurations(hand, [t], *args))[0, j],
+                              c.theta[i - 1], c.theta[i])  # fmt: skip
+            words = f"contact {name} stops sliding (its sliding direction reverses: it rolls for an instant, 4S breaks)"
+            out.append(PivotEvent(f"slip_{name}", at, words, False))
+    return out
+
+
 def locate_event(f, a: float, b: float, tol: float = EVENT_TOL) -> float:
     """Bisection of a sign change of the scalar ``f`` between angles ``a`` (before it) and ``b`` (at or after it)
     to a bracket of ``tol`` (rad); the bracket's midpoint."""
@@ -300,15 +318,7 @@ def sweep_pivot(hand, mu_range, force_margin=None, resolution: float = DEFAULT_R
             agrees[i] = same_contacts(located[-1], polygon_contacts(hand, c.pose[i], c.q[i]))
         except SceneError:
             agrees[i] = False
-    names = formation(PIVOT_FORMATION).contact_names
-    slips = slip_speeds(hand, c)
-    for j, name in enumerate(names):
-        i = _first_crossing(slips[:, j])
-        if i is not None:
-            at = locate_event(lambda t, j=j: slip_speeds(hand, pivot_configurations(hand, [t], *args))[0, j],
-                              c.theta[i - 1], c.theta[i])  # fmt: skip
-            words = f"contact {name} stops sliding (its sliding direction reverses: it rolls for an instant, 4S breaks)"
-            events.append(PivotEvent(f"slip_{name}", at, words, False))
+    events += slip_events(hand, c)
     manifold = time.perf_counter() - started
     bands = {}
     for ej in effort_joints:

@@ -37,7 +37,7 @@ import numpy as np
 from qsplan.mechanics import QsplanError
 
 from qsplan.planner.certify.bands import BAND_RTOL, band_checks, free_row_cells, recomputed_bands
-from qsplan.planner.certify.contacts import general_form, hold_row, judged_contact_checks, judged_contacts
+from qsplan.planner.certify.contacts import hold_row, judged_contact_checks, judged_contacts
 from qsplan.planner.certify.files import META_TOL, agreement_checks, metadata_checks, schema_checks
 from qsplan.planner.certify.inputs import (plan_columns_required, plan_sources, read_plan,
                                            read_plan_file, task_from_metadata)  # fmt: skip
@@ -308,7 +308,7 @@ def certify_plan(plan, task, *, n_random: int = 8, seed: int = 0, force_margin: 
     found_at = [[] for _ in range(n)]
     verdict_info, slip, ends = [], None, {}  # slip: (row, phase, sliding velocities) of the last in-contact row
     scenes = {}  # in-contact rows' scenes: their bands recomputed in one batch per mode
-    general = general_form(task)
+    general = task.hand.reorients  # any formation: the row's contacts found in the polygons
     for k in range(n):
         mode = str(cols["mode"][k])
         found = limit_checks(task, cols, k)

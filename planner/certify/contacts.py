@@ -11,27 +11,15 @@ Which contacts those are is decided here from the row's geometry alone:
 * a **hold row** (every letter ``R``, at rest, its phase not moving): every contact found; nothing moves, and the hold
   proof (:mod:`qsplan.mechanics.bands.hold`), not the mode check, decides it.
 
-Hands of the paper's form (one link per finger) are judged so; a chain hand's rows keep the four contacts of the
-palm edge (:func:`qsplan.planner.certify.rows.contact_checks`).  Units SI.
+A hand that reorients (:attr:`qsplan.hands.protocol.Hand.reorients`) is judged so; any other hand's rows keep the four
+contacts of the palm edge (:func:`qsplan.planner.certify.rows.contact_checks`).  Units SI.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["general_form", "hold_row", "judged_contacts", "judged_contact_checks", "judged_scene"]
-
-
-def general_form(task) -> bool:
-    """Whether ``task``'s hand is judged by found contacts (the paper's form: two single-link fingers)."""
-    from qsplan.hands.reorient import paper_form
-    from qsplan.mechanics.errors import QsplanError
-
-    try:
-        paper_form(task.hand)
-    except QsplanError:
-        return False
-    return True
+__all__ = ["hold_row", "judged_contacts", "judged_contact_checks", "judged_scene"]
 
 
 def _same_phase(cols, a, b) -> bool:
@@ -72,7 +60,7 @@ def judged_contacts(task, cols, k):
 def judged_contact_checks(task, cols, k, judged) -> list:
     """The row's mode has one letter of R, S, B per judged contact; a hold row's phase does not move."""
     from qsplan.hands.found_contacts import contact_names
-    from qsplan.planner.certify.rows import JUMP_TOL, row_pose, row_q
+    from qsplan.planner.certify.rows import JUMP_TOL
 
     found, drop = judged
     mode = str(cols["mode"][k])
@@ -83,12 +71,11 @@ def judged_contact_checks(task, cols, k, judged) -> list:
         out.append(("contact", f"mode {mode!r}: expected one letter of R, S, B per contact the row touches "
                                f"({len(names)}: {', '.join(names) or 'none'})"))  # fmt: skip
     if hold_row(cols, k):
-        from qsplan.hands.interface import joint_names
-
+        pose_k, q_k = _configuration(task, cols, k)
         for j in (k - 1, k + 1):
             if 0 <= j < cols["t"].size and _same_phase(cols, j, k):
-                moved = max(float(np.max(np.abs(row_pose(cols, j) - row_pose(cols, k)))),
-                            float(np.max(np.abs(row_q(cols, j, joint_names(task.hand)) - row_q(cols, k, joint_names(task.hand))))))  # fmt: skip
+                pose_j, q_j = _configuration(task, cols, j)
+                moved = max(float(np.max(np.abs(pose_j - pose_k))), float(np.max(np.abs(q_j - q_k))))
                 if moved > JUMP_TOL:
                     out.append(("mode", f"mode {mode} claims a hold (nothing moves) but the phase moves "
                                         f"{moved:.3g} to an adjacent row"))  # fmt: skip
@@ -97,13 +84,9 @@ def judged_contact_checks(task, cols, k, judged) -> list:
 
 
 def judged_scene(task, cols, k, judged, effort, qd, tau):
-    """The row's scene with its judged contacts (:func:`qsplan.hands.point_scene.points_scene`)."""
-    from qsplan.hands.found_contacts import contact_names
-    from qsplan.hands.point_scene import points_scene
+    """The row's scene with its judged contacts (:func:`qsplan.hands.found_contacts.row_contact_scene`)."""
+    from qsplan.hands.found_contacts import row_contact_scene
 
     found, drop = judged
     pose, q = _configuration(task, cols, k)
-    names = contact_names(task.hand, pose, found)
-    keep = [i for i in range(len(found)) if not drop[i]]
-    return points_scene(task.hand, pose, q, [found[i].point for i in keep], [found[i].normal for i in keep],
-                        [found[i].body for i in keep], [names[i] for i in keep], effort, qd, effort=tau)  # fmt: skip
+    return row_contact_scene(task.hand, pose, q, effort, qd, effort=tau, drop=drop, found=found)

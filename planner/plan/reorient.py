@@ -9,16 +9,18 @@ edge-to-edge contact with the workpiece (along the longest edge)"), over three f
    band tables end :data:`FLUSH_APPROACH` short of it (there the polygons still show four contacts); the slide's
    last row is then moved onto the flush instant itself, judged at rest for the motion that reaches it (the
    contact it makes there is open along that motion, :func:`qsplan.hands.found_contacts.made_contacts`);
-2. **hold** (formation ``flush_to_pivot_v1``, five contacts, mode ``RRRRR``: nothing moves): the left finger held,
-   the right finger's torque ramps from the slide's last command to the pivot's first at :data:`HOLD_TORQUE_RATE`.
+2. **hold** (formation ``flush_to_pivot_v1``, five contacts, every letter ``R``: nothing moves): the other finger
+   held, the pivot's torque-controlled finger's torque ramps from the slide's last command to the pivot's first at
+   :data:`HOLD_TORQUE_RATE`.
    Its band is the torque interval over which the hold is *proved* (:func:`qsplan.mechanics.bands.hold.
    hold_torque_interval`: a frictionless equilibrium with every contact loaded by at least the task's force margin,
    at every vertex of the disturbance box; affine in the torque, so the ramp's ends prove it all);
 3. **pivot** (formation ``pivot_v1``, 4S): the workpiece turns clockwise on vertex 1, the left finger flush (two
    contacts), the fingers along the closed-form manifold (:func:`qsplan.hands.reorient.pivot_configurations`), one
    finger torque-controlled and the other driven: the one whose narrowest band is widest (:func:`widest_pivot`;
-   the right one, the paper's, on a tie).  Its first row is the transition: five contacts, mode ``BSSSS`` (vertex 0 lifts), its
-   band the exact transition band, every competitor precluded.  It ends at the goal's angle, at rest.
+   the right one, the paper's, on a tie).  Its first row is the transition: five contacts, the transition
+   formation's mode (vertex 0 lifts, the rest slide), its band the exact transition band, every competitor
+   precluded.  It ends at the goal's angle, at rest.
 
 Every band is :func:`qsplan.mechanics.robust_band`'s (exact, or conservative and labelled; the disturbance box of a
 turning workpiece, :func:`qsplan.planner.task.dynamics.turning_box`); every row at rest also gets its hold interval.
@@ -35,15 +37,13 @@ from dataclasses import replace
 import numpy as np
 
 from qsplan.hands.reorient import PIVOT_FORMATION, TRANSITION_FORMATION
-from qsplan.mechanics.errors import QsplanError
 
 from qsplan.planner.plan.results import ContactSegmentPlan, Plan, PlanFailure
 from qsplan.planner.plan.steps import HoldStep, PivotStep
 from qsplan.planner.task.goal import Goal, GoalNotServedError
 
-__all__ = ["COMMAND_STEP", "FLUSH_APPROACH", "HOLD_MIN_DURATION", "HOLD_ROWS", "HOLD_TORQUE_RATE", "PIVOT", "PIVOT_EFFORT_JOINTS", "PIVOT_STEP",
-           "hold_phase", "pivot_phase", "pivot_target", "plan_reorientation", "smooth_command",
-           "widest_pivot"]
+__all__ = ["FLUSH_APPROACH", "HOLD_MIN_DURATION", "HOLD_ROWS", "HOLD_TORQUE_RATE", "PIVOT", "PIVOT_EFFORT_JOINTS", "PIVOT_STEP",
+           "hold_phase", "pivot_phase", "pivot_rows", "pivot_target", "plan_reorientation", "widest_pivot"]
 
 #: How far (m) short of the flush instant the slide's band tables end: five times the contact tolerance (1 um), so
 #: the polygons show the four contacts of the palm edge there (the left finger's second contact 5 um open); the
@@ -64,11 +64,6 @@ HOLD_MIN_DURATION = 0.1
 #: The pivot's rows are at most this far apart in the workpiece's angle (rad): 0.25 deg, 0.4 mm at the farthest
 #: vertex of the demo's workpiece, like the slides' 0.5 mm rows.
 PIVOT_STEP = np.radians(0.25)
-
-#: Largest change of a pivot's torque command between two rows, as a fraction of its largest command: the
-#: transition's band starts at ~4 N m and the 4S bands fall to a tenth of it within a few degrees; hugging the lower
-#: edge would step 0.45 N m in the first 0.25 deg.  5 % keeps every step under a tenth of the command.
-COMMAND_STEP = 0.05
 
 #: The fingers the pivot may torque-control, in order of preference on a tie (the paper's Fig. 9: the right one
 #: pushes while the left finger, flush on the workpiece, is driven).
@@ -130,14 +125,11 @@ def hold_phase(task, name, pose, q, effort_joint, tau_from, tau_to, t0) -> Conta
     PlanFailure
         No hold is proved there, or the ramp leaves its interval (the report names the torques).
     """
-    from qsplan.hands.found_contacts import row_contact_scene
-    from qsplan.mechanics.bands.hold import hold_torque_interval, prove_hold
+    from qsplan.mechanics.bands.hold import prove_hold
     from qsplan.planner.plan.failure import configuration_report
 
-    names = task.hand.joint_names
-    effort = np.array(names) == effort_joint
-    scene = row_contact_scene(task.hand, pose, q, effort, np.zeros(len(names)))
-    lo, hi = hold_torque_interval(scene, task.disturbance, margin=task.force_margin.normal)
+    effort = np.array(task.hand.joint_names) == effort_joint
+    scene, (lo, hi) = _held_interval(task, pose, q, effort)
     if tau_from is None:  # the effort joint taken over at rest: from a resolution inside the proved interval
         tau_from = float(min(lo + task.torque_resolution, tau_to)) if np.isfinite(lo) else float(tau_to)
     proofs = [prove_hold(scene, torques=[t], disturbance=task.disturbance) for t in (tau_from, tau_to)]
@@ -167,126 +159,129 @@ def _pivot_thetas(theta_goal: float) -> np.ndarray:
     return np.linspace(0.0, theta_goal, n)
 
 
-def pivot_phase(task, name, instant, theta_goal, t0, effort_joint: str = "right") -> ContactSegmentPlan:
-    """The pivot from the flush instant (theta 0) to ``theta_goal`` (rad, negative), ``effort_joint`` (a finger)
-    torque-controlled, the other driven along the manifold; the first row the transition (module docstring).
+def _held_interval(task, pose, q, effort):
+    """``(scene, (lo, hi))``: every contact the polygons show at ``pose``, ``q``, the ``effort`` joints (bool)
+    torque-controlled and the others held, and the torques at which the hold is proved with every contact loaded by
+    the task's force margin at every vertex of its disturbance box (N m; nan when none)."""
+    from qsplan.hands.found_contacts import row_contact_scene
+    from qsplan.mechanics.bands.hold import hold_torque_interval
+
+    scene = row_contact_scene(task.hand, pose, q, effort, np.zeros(effort.size))
+    return scene, hold_torque_interval(scene, task.disturbance, margin=task.force_margin.normal)
+
+
+def _pivot_failure(task, name, c, i, why) -> PlanFailure:
+    """The report of the pivot's row ``i`` (of configurations ``c``): its angle, pose and joints, and ``why``."""
+    from qsplan.planner.plan.failure import configuration_report
+
+    q = None if np.any(np.isnan(c.q[i])) else c.q[i]
+    where = f"theta = {np.degrees(c.theta[i]):.4g} deg"
+    return PlanFailure(configuration_report(task, name, where, float(c.pose[i, 0]), q, why))
+
+
+def pivot_rows(task, name, instant, theta_goal):
+    """The pivot's configurations from the flush instant to ``theta_goal`` (:func:`qsplan.hands.reorient.
+    pivot_configurations`), checked whatever finger is torque-controlled: every row reachable, inside the limits,
+    no two bodies overlapping, the formation's contacts (the transition's at the first row; at the last, without a
+    contact it makes there: an edge landing), no contact's sliding direction reversing.
 
     Raises
     ------
     PlanFailure
-        A row without a band at least the torque resolution wide, the manifold leaving the hand's reach, a joint
-        limit, or the polygons showing another contact set than the formation's (the report names the angle).
+        Naming the row's angle and the reason.
     """
     from qsplan.hands.formations import formation
-    from qsplan.hands.found_contacts import made_contacts, ordered_contacts, row_contact_scene
-    from qsplan.hands.reorient import pivot_configurations, pivot_scene, transition_scene
-    from qsplan.mechanics.bands.batched_robust import robust_bands
-    from qsplan.mechanics.bands.hold import hold_torque_interval
-    from qsplan.mechanics.bands.robust import robust_band
-    from qsplan.planner.plan.failure import configuration_report
+    from qsplan.hands.found_contacts import made_contacts, ordered_contacts
+    from qsplan.hands.reorient import pivot_configurations
     from qsplan.planner.states.contact import configuration_problem
-    from qsplan.planner.torque.command import plan_command
 
     hand = task.hand
-    theta = _pivot_thetas(theta_goal)
-    c = pivot_configurations(hand, theta, PIVOT, instant.edge, instant.right_vertex)
-
-    def fail(i, why):
-        return PlanFailure(configuration_report(task, name, f"theta = {np.degrees(theta[i]):.4g} deg", float(c.pose[i, 0]),
-                                                None if np.any(np.isnan(c.q[i])) else c.q[i], why))  # fmt: skip
-
-    for i in range(theta.size):
+    c = pivot_configurations(hand, _pivot_thetas(theta_goal), PIVOT, instant.edge, instant.right_vertex)
+    n = c.theta.size
+    for i in range(n):
         if np.any(np.isnan(c.q[i])):
-            raise fail(i, "the right finger cannot reach its vertex")
+            raise _pivot_failure(task, name, c, i, "the right finger cannot reach its vertex")
         why = configuration_problem(task, c.pose[i], c.q[i])  # a joint limit, two bodies overlapping
         if why:
-            raise fail(i, why)
+            raise _pivot_failure(task, name, c, i, why)
         found = ordered_contacts(hand, c.pose[i], c.q[i])
+        if i == n - 1 and i > 0:  # the goal's row may make a contact (an edge landing): not in the motion
+            made = made_contacts(hand, (c.pose[i - 1], c.q[i - 1]), (c.pose[i], c.q[i]), found)
+            found = [f for f, m in zip(found, made) if not m]
         want = formation(TRANSITION_FORMATION if i == 0 else PIVOT_FORMATION).n_contacts
-        if i == theta.size - 1 and i > 0:  # the goal's row may make a contact (an edge landing): not in the motion
-            found = [f for f, m in zip(found, made_contacts(hand, (c.pose[i - 1], c.q[i - 1]), (c.pose[i], c.q[i]),
-                                                             found)) if not m]  # fmt: skip
         if len(found) != want:
-            raise fail(i, f"the polygons show {len(found)} contacts; the formation has {want}")
-    reversal = _slip_reversal(hand, c, theta, instant)
+            raise _pivot_failure(task, name, c, i, f"the polygons show {len(found)} contacts; the formation has {want}")
+    reversal = _slip_reversal(hand, c)
     if reversal is not None:
         i, at, contact = reversal
-        raise fail(i, f"contact {contact} stops sliding at theta = {np.degrees(at):.4g} deg (its sliding direction "
-                      "reverses: it rolls for an instant, and one 4S phase cannot cross it)")  # fmt: skip
-    speeds = np.asarray(task.joint_speeds, float)
+        raise _pivot_failure(task, name, c, i, f"contact {contact} stops sliding at theta = {np.degrees(at):.4g} deg "
+                                               "(its sliding direction reverses: it rolls for an instant, and one 4S "
+                                               "phase cannot cross it)")  # fmt: skip
+    return c
+
+
+def pivot_phase(task, name, instant, theta_goal, t0, effort_joint: str = "right", rows=None) -> ContactSegmentPlan:
+    """The pivot from the flush instant (theta 0) to ``theta_goal`` (rad, negative), ``effort_joint`` (a finger)
+    torque-controlled, the other driven along the manifold; the first row the transition (module docstring).
+    ``rows``: :func:`pivot_rows`, when already checked.
+
+    Raises
+    ------
+    PlanFailure
+        As :func:`pivot_rows`; a row without a band at least the torque resolution wide.
+    """
+    from qsplan.hands.formations import formation
+    from qsplan.hands.reorient import pivot_scene, transition_scene
+    from qsplan.mechanics.bands.batched_robust import robust_bands
+    from qsplan.mechanics.bands.robust import robust_band
+    from qsplan.planner.torque.command import plan_command, smooth_command
+
+    hand = task.hand
+    c = pivot_rows(task, name, instant, theta_goal) if rows is None else rows
+    n = c.theta.size
+    speeds, rates = np.asarray(task.joint_speeds, float), np.max(np.abs(c.dq), axis=0)
     com_rate = float(np.max(np.hypot(c.dpose[:, 0], c.dpose[:, 1])))
-    limit = min(float(np.min(speeds / np.maximum(np.max(np.abs(c.dq), axis=0), 1e-300))),
-                task.workpiece_speed / com_rate)
-    rate = -limit  # clockwise, the fastest the speed limits allow (rad/s)
+    limits = [task.workpiece_speed / com_rate] + [float(speeds[j] / rates[j]) for j in np.flatnonzero(rates)]
+    rate = -min(limits)  # clockwise, the fastest the speed limits allow (rad/s)
     effort = np.array(hand.joint_names) == effort_joint
     first = transition_scene(hand, instant, effort_joint, rate)
-    scenes = [pivot_scene(hand, c, i, effort_joint, rate) for i in range(1, theta.size)]
+    scenes = [pivot_scene(hand, c, i, effort_joint, rate) for i in range(1, n)]
     kw = dict(shared=task.shared_mu, force_margin=task.force_margin, disturbance=task.disturbance)
     bands = [robust_band(first, formation(TRANSITION_FORMATION).mode, task.mu_range, **kw)]
     bands += robust_bands(scenes, formation(PIVOT_FORMATION).mode, task.mu_range, **kw)
     lower = np.array([b.lower if b.feasible else np.nan for b in bands])
     upper = np.array([b.upper if b.feasible else np.nan for b in bands])
-    for k in (0, theta.size - 1):  # at rest: the hold must be proved too, with every contact there (as certified)
-        sc = row_contact_scene(hand, c.pose[k], c.q[k], effort, np.zeros(effort.size))
-        held = hold_torque_interval(sc, task.disturbance, margin=task.force_margin.normal)
+    for k in (0, n - 1):  # at rest: the hold must be proved too, with every contact there (as certified)
+        held = _held_interval(task, c.pose[k], c.q[k], effort)[1]
         lower[k], upper[k] = max(lower[k], held[0]), min(upper[k], held[1])
     width = upper - lower
     bad = np.flatnonzero(~(width >= task.torque_resolution))
     if bad.size:
         i = int(bad[0])
         why = bands[i].reason if not bands[i].feasible else f"the band is {width[i]:.3g} N m wide"
-        raise fail(i, f"no guaranteed band at least the torque resolution ({task.torque_resolution:g} N m) wide: {why}")
+        raise _pivot_failure(task, name, c, i, f"no guaranteed band at least the torque resolution "
+                                               f"({task.torque_resolution:g} N m) wide: {why}")  # fmt: skip
     command, margin = smooth_command(*plan_command(lower, upper, task.torque_resolution), lower, upper)
-    t = t0 + np.abs(theta) / abs(rate)
     qd = np.where(effort[None, :], np.nan, c.dq * rate)  # the velocity-controlled finger along the manifold
-    names5 = tuple(first.contact_names)
-    names4 = tuple(scenes[0].contact_names) if scenes else names5
+    names = (tuple(first.contact_names),) + (tuple(scenes[0].contact_names),) * (n - 1) if scenes else ()
+    modes = (formation(TRANSITION_FORMATION).mode,) + (formation(PIVOT_FORMATION).mode,) * (n - 1)
     comps = tuple(sorted({m for b in bands for m in getattr(b, "competitors", ())}))
-    return ContactSegmentPlan(name, effort_joint, formation(PIVOT_FORMATION).mode, c.pose[[0, -1], 0], t, c.pose[:, 0],
-                              c.q, qd, lower, upper, command, margin, comps, com_rate * abs(rate), None, None, "pivot",
-                              c.pose, (formation(TRANSITION_FORMATION).mode,) + (formation(PIVOT_FORMATION).mode,)
-                              * (theta.size - 1), PIVOT_FORMATION, (names5,) + (names4,) * (theta.size - 1))  # fmt: skip
+    return ContactSegmentPlan(name, effort_joint, formation(PIVOT_FORMATION).mode, c.pose[[0, -1], 0],
+                              t0 + np.abs(c.theta) / abs(rate), c.pose[:, 0], c.q, qd, lower, upper, command, margin,
+                              comps, com_rate * abs(rate), None, None, "pivot", c.pose, modes, PIVOT_FORMATION,
+                              names)  # fmt: skip
 
 
-def smooth_command(command, margin, lower, upper):
-    """The slide's command (:func:`qsplan.planner.torque.command.plan_command`: ``margin`` from the nearer edge)
-    with its steps between rows cut to :data:`COMMAND_STEP` of its range: where the band is open above (a pivot's,
-    after the transition's steep lower edge) it comes down gradually instead of hugging the lower edge, never nearer
-    an edge than the slide's rule keeps it.  Returns ``(command, margin)``, the margin to the nearer edge per row."""
-    floor = np.where(np.isfinite(lower), lower + margin, -np.inf)
-    ceil = np.where(np.isfinite(upper), upper - margin, np.inf)
-    step = COMMAND_STEP * (float(np.max(np.abs(command))) + float(np.min(margin)))
-    out = command.copy()
-    for k in range(1, out.size):  # forward: come down (or up) from the previous row by at most a step
-        out[k] = np.clip(out[k], out[k - 1] - step, out[k - 1] + step)
-    for k in range(out.size - 2, -1, -1):  # backward: anticipate a rise of the floor
-        out[k] = max(out[k], out[k + 1] - step)
-    out = np.minimum(np.maximum(out, floor), ceil)  # the rule's margin first: never nearer an edge
-    return out, np.minimum(out - lower, upper - out)
-
-
-def _slip_reversal(hand, c, theta, instant):
+def _slip_reversal(hand, c):
     """``(first row past it, angle (rad), contact name)`` of the first contact whose sliding direction reverses along
-    the pivot (:func:`qsplan.hands.pivot_sweep.slip_speeds`, located by bisection), or None."""
-    from qsplan.hands.formations import formation
-    from qsplan.hands.pivot_sweep import locate_event, slip_speeds
-    from qsplan.hands.reorient import pivot_configurations
+    the pivot (:func:`qsplan.hands.pivot_sweep.slip_events`), or None."""
+    from qsplan.hands.pivot_sweep import slip_events
 
-    slips = slip_speeds(hand, c)
-    best = None
-    for j in range(slips.shape[1]):
-        sign = np.sign(slips[:, j])
-        first = np.flatnonzero(sign)  # the direction it starts sliding in (a zero first sample: the next)
-        flips = (np.flatnonzero(sign[first[0] + 1:] != sign[first[0]]) + first[0] + 1) if first.size else first
-        if flips.size and (best is None or flips[0] < best[0]):
-            best = (int(flips[0]), j)
-    if best is None:
+    events = slip_events(hand, c)
+    if not events:
         return None
-    i, j = best
-    at = locate_event(lambda t: slip_speeds(hand, pivot_configurations(hand, [t], PIVOT, instant.edge,
-                                                                       instant.right_vertex))[0, j],
-                      float(theta[i - 1]), float(theta[i]))  # fmt: skip
-    return i, at, formation(PIVOT_FORMATION).contact_names[j]
+    first = max(events, key=lambda e: e.theta)  # the angles decrease along the pivot
+    return int(np.flatnonzero(c.theta < first.theta)[0]), first.theta, first.name.removeprefix("slip_")
 
 
 def plan_reorientation(task, options=None, progress=None, planner: str = "widest") -> Plan:
@@ -299,17 +294,16 @@ def plan_reorientation(task, options=None, progress=None, planner: str = "widest
     PlanFailure
         A phase of the route has no plan (the report says where and why).
     """
-    from qsplan.hands.reorient import flush_instant, paper_form
+    from qsplan.hands.reorient import flush_instant
     from qsplan.planner.plan.autoplan import plan_automatic
     from qsplan.planner.plan.timing import time_scale
 
     progress = progress or (lambda line: None)
     started = time.perf_counter()
     hand = task.hand
-    try:
-        paper_form(hand)
-    except QsplanError as exc:
-        raise _refuse("goal.theta", f"turning the workpiece is planned for the paper's hand form only ({exc})") from None
+    if not hand.reorients:
+        raise _refuse("goal.theta", "turning the workpiece is planned for the paper's hand form only (two single-link "
+                                    "revolute fingers, Fig. 9)")  # fmt: skip
     theta_goal = pivot_target(task)
     instant = flush_instant(hand)
     upper_vertex = int(hand.user_vertices[instant.edge])
@@ -358,12 +352,13 @@ def widest_pivot(task, name, instant, theta_goal, progress) -> ContactSegmentPla
     """The pivot with either finger torque-controlled (:data:`PIVOT_EFFORT_JOINTS`), the one whose narrowest band is
     widest (the first on a tie; the second is not computed when the first's bands are all unbounded above); the
     first one's failure when neither has a plan."""
+    rows = pivot_rows(task, name, instant, theta_goal)  # the geometry, whatever finger is torque-controlled
     found, first_failure = [], None
     for e in PIVOT_EFFORT_JOINTS:
         if found and np.isinf(np.min(found[0].width)):
             break  # unbounded everywhere: nothing is wider
         try:
-            found.append(pivot_phase(task, name, instant, theta_goal, 0.0, e))
+            found.append(pivot_phase(task, name, instant, theta_goal, 0.0, e, rows))
         except PlanFailure as exc:
             first_failure = first_failure or exc
             progress(f"  pivot with the {e} finger torque-controlled: {exc}")

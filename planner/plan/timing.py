@@ -166,7 +166,7 @@ def _rest_scene(task, ph, k, other, effort, velocity):
     except SceneError:
         found = ordered_contacts(task.hand, pose[k], ph.q[k])
         drop = made_contacts(task.hand, (pose[other], ph.q[other]), (pose[k], ph.q[k]), found) if other < k else None
-        return row_contact_scene(task.hand, pose[k], ph.q[k], effort, velocity, drop=drop)
+        return row_contact_scene(task.hand, pose[k], ph.q[k], effort, velocity, drop=drop, found=found)
 
 
 def _leg(task, qa, qb, limits, what):

@@ -291,10 +291,6 @@ class Snapshot:
         return not self.off
 
 
-def _pose(plan, phase, k):
-    return phase_pose(plan, phase, k)
-
-
 def phase_pose(plan, phase, k) -> np.ndarray:
     """The workpiece's pose (m, m, rad) at row ``k`` of ``phase`` (its last row beyond it): turned in a pivot."""
     pose = phase.poses(plan.task.hand.rest_height)
@@ -302,7 +298,7 @@ def phase_pose(plan, phase, k) -> np.ndarray:
 
 
 def _off(plan, phase, k) -> tuple:
-    touching = fingers_touching(plan.task.hand, _pose(plan, phase, k), phase.q[k])
+    touching = fingers_touching(plan.task.hand, phase_pose(plan, phase, k), phase.q[k])
     return tuple(side for side, on in touching.items() if not on)
 
 
@@ -376,6 +372,6 @@ def plan_snapshots(plan, per_segment: int = 3, limit: int | None = None) -> list
         state, off = row_state(plan, i, k)
         effort = float(ph.command[k]) if is_contact(ph) else float("nan")
         role = "start" if (i, k) == (0, 0) else "end" if (i, k) == last else ""
-        out.append(Snapshot(float(ph.t[k]), i, k, _pose(plan, ph, k), np.asarray(ph.q[k], float),
+        out.append(Snapshot(float(ph.t[k]), i, k, phase_pose(plan, ph, k), np.asarray(ph.q[k], float),
                             ph.effort_joint if is_contact(ph) else None, effort, state, off, role))  # fmt: skip
     return out

@@ -235,9 +235,12 @@ def pair_letters(mode: str, names) -> str:
     on the scene's four pairs (:data:`CONTACTS`): ``palm:K`` on its foot, a finger's contacts on its links; a pair
     no planned contact is on is ``B`` (open: a lifted vertex); a finger flush on an edge (two contacts) slides if
     either does, else rolls."""
+    from qsplan.hands.found_contacts import slot_of
+
+    slots = [slot_of(n, CONTACTS) for n in names]
     out = []
-    for pair in CONTACTS:
-        mine = [m for m, n in zip(mode, names) if (n == pair if pair.startswith("palm") else n.split(":")[0] == pair)]
+    for i in range(len(CONTACTS)):
+        mine = [m for m, j in zip(mode, slots) if j == i]
         out.append("B" if not mine else ("S" if "S" in mine else ("R" if "R" in mine else "B")))
     return "".join(out)
 

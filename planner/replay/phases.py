@@ -8,7 +8,7 @@ describe; this module says how each is replayed, from the rows and the task alon
   (:mod:`qsplan.mechanics.bands.hold`); the replay records it as followed, with that note;
 * a phase whose **last row makes a contact** (the slide's end at the flush instant: the polygons show one more
   contact there than at the row before): simulated to the row before, where the formation still holds;
-* a phase whose **first row has more contacts** than the rest (the pivot's transition row, ``BSSSS``): the all-modes
+* a phase whose **first row has more contacts** than the rest (the pivot's transition row: vertex 0 lifts): the all-modes
   solver at that row with all its contacts must find the planned mode alone (the replay's start check), then the
   phase is simulated from its second row with the contacts of the rest;
 * scenes of a turning phase come from the contacts the polygons show (:func:`qsplan.hands.found_contacts.
@@ -24,39 +24,34 @@ import numpy as np
 
 from qsplan.mechanics.errors import QsplanError
 
-__all__ = ["HOLD_NOTE", "body_friction", "formation_of", "found_scene", "paper_form_hand", "phase_rows", "replay_segments",
+__all__ = ["HOLD_NOTE", "body_friction", "formation_of", "found_scene", "phase_rows", "replay_segments",
            "rows_pose", "transition_modes", "uses_found_contacts"]
 
 #: What a hold's replay records: it is not simulated; the certificate proves it.
 HOLD_NOTE = "a hold: nothing moves; proved by the certificate (frictionless equilibrium, every contact loaded)"
 
 
-def paper_form_hand(hand) -> bool:
-    """Whether ``hand`` is of the paper's form (two single-link fingers): its phases may change formation."""
-    from qsplan.hands.reorient import paper_form
-
-    try:
-        paper_form(hand)
-    except QsplanError:
-        return False
-    return True
-
-
 def uses_found_contacts(hand, columns, rows) -> bool:
     """Whether the phase's rows need the found contacts: the workpiece turns (theta not 0), or a row's mode has other
-    than four letters; only for a hand of the paper's form."""
-    if not paper_form_hand(hand):
+    than four letters; only for a hand that reorients (:attr:`qsplan.hands.protocol.Hand.reorients`)."""
+    if not hand.reorients:
         return False
     theta = np.asarray(columns["theta_workpiece"], float)[rows]
     return bool(np.any(theta != 0.0) or any(len(str(columns["mode"][k])) != 4 for k in rows))
 
 
-def _count(hand, columns, k):
-    from qsplan.hands.found_contacts import ordered_contacts
+def _configuration(hand, columns, k) -> tuple:
+    """``(pose, q)`` of row ``k`` (m, m, rad; rad or m)."""
+    return rows_pose(columns, k), np.array([columns[f"q_{n}"][k] for n in hand.joint_names], float)
 
-    names = hand.joint_names
-    q = np.array([columns[f"q_{n}"][k] for n in names], float)
-    return len(ordered_contacts(hand, rows_pose(columns, k), q))
+
+def _makes_contact(hand, columns, a, b) -> bool:
+    """Whether the motion from row ``a`` to row ``b`` makes a contact only at ``b``
+    (:func:`qsplan.hands.found_contacts.made_contacts`)."""
+    from qsplan.hands.found_contacts import made_contacts, ordered_contacts
+
+    after = _configuration(hand, columns, b)
+    return bool(made_contacts(hand, _configuration(hand, columns, a), after, ordered_contacts(hand, *after)).any())
 
 
 def phase_rows(hand, columns, rows) -> tuple:
@@ -66,23 +61,21 @@ def phase_rows(hand, columns, rows) -> tuple:
     if len(rows) > 1 and len(modes[0]) != len(modes[1]):  # the transition row: judged with all its contacts
         first, rows, modes = modes[0], rows[1:], modes[1:]
     note = None
-    if len(rows) > 2 and _count(hand, columns, rows[-1]) > _count(hand, columns, rows[-2]):
+    if len(rows) > 2 and _makes_contact(hand, columns, rows[-2], rows[-1]):
         rows = rows[:-1]  # the contact made at the last row: open along the motion, not simulated
         note = "simulated to the row before its last, where it makes a contact"
     return rows, first, modes[0], note
 
 
 def body_friction(names, mu) -> np.ndarray:
-    """The friction of contacts ``names`` from the replay's vector ``mu`` (palm:0, palm:1, left, right): a palm
-    contact ``palm:K`` takes ``mu[K]`` (K 0 or 1), a finger's contacts that finger's."""
-    out = []
-    for n in names:
-        body, _, rest = n.partition(":")
-        if body == "palm":
-            out.append(mu[int(rest)] if rest in ("0", "1") else mu[0])
-        else:
-            out.append(mu[2] if body == "left" else mu[3])
-    return np.asarray(out, float)
+    """The friction of contacts ``names`` from the replay's vector ``mu`` (the palm edge's palm:0, palm:1, left,
+    right): each contact its slot's (:func:`qsplan.hands.found_contacts.slot_of`: a finger's contacts that finger's),
+    a palm contact under another vertex palm:0's."""
+    from qsplan.hands.formations import formation
+    from qsplan.hands.found_contacts import slot_of
+
+    slots = formation("palm_edge").contact_names
+    return np.asarray([mu[j] if (j := slot_of(n, slots)) is not None else mu[0] for n in names], float)
 
 
 def found_scene(hand, x, effort_controlled, velocity, effort, n_contacts):
@@ -108,8 +101,7 @@ def formation_of(hand, columns, k, mode):
     from qsplan.hands.formations import ContactSlot, Formation
     from qsplan.hands.found_contacts import contact_names, ordered_contacts
 
-    pose = rows_pose(columns, k)
-    q = np.array([columns[f"q_{n}"][k] for n in hand.joint_names], float)
+    pose, q = _configuration(hand, columns, k)
     names = contact_names(hand, pose, ordered_contacts(hand, pose, q))
     slots = tuple(ContactSlot(n, n.partition(":")[0], "any", None, f"{n}, found in the polygons") for n in names)
     return Formation("found", slots, mode, "last", "the contacts the polygons show")
@@ -124,11 +116,9 @@ def transition_modes(hand, columns, k, effort_controlled, mu) -> tuple:
     from qsplan.hands.found_contacts import row_contact_scene
     from qsplan.mechanics.solver.all_modes import solve
 
-    names = hand.joint_names
-    q0 = np.array([columns[f"q_{n}"][k] for n in names], float)
-    q1 = np.array([columns[f"q_{n}"][k + 1] for n in names], float)
-    tau = np.nan_to_num(np.array([columns[f"tau_{n}"][k] for n in names], float))
-    scene = row_contact_scene(hand, rows_pose(columns, k), q0, effort_controlled, q1 - q0, tau)
+    (pose, q0), (_, q1) = _configuration(hand, columns, k), _configuration(hand, columns, k + 1)
+    tau = np.nan_to_num(np.array([columns[f"tau_{n}"][k] for n in hand.joint_names], float))
+    scene = row_contact_scene(hand, pose, q0, effort_controlled, q1 - q0, tau)
     scene = replace(scene, mu=body_friction(scene.contact_names, mu))
     return tuple(solve(scene, residuals=False).feasible_modes)
 

@@ -283,8 +283,8 @@ def replay_plan(columns, hand, mu, options=None, scenes=None, formation=None) ->
     from qsplan.mechanics.motion.simulator import simulate
     from qsplan.mechanics.motion.system import make_friction
     from qsplan.planner.plan.timing import quasistatic_rows
-    from qsplan.planner.replay.phases import (HOLD_NOTE, body_friction, formation_of, paper_form_hand, phase_rows,
-                                              transition_modes, uses_found_contacts)  # fmt: skip
+    from qsplan.planner.replay.phases import (HOLD_NOTE, body_friction, formation_of, phase_rows, transition_modes,
+                                              uses_found_contacts)  # fmt: skip
 
     hand = as_hand(hand)
     names = hand.joint_names
@@ -311,7 +311,7 @@ def replay_plan(columns, hand, mu, options=None, scenes=None, formation=None) ->
                                      float(columns["x_workpiece"][rows[-1]]), None, HOLD_NOTE))  # fmt: skip
             continue
         found, first, note, seg_mu, seg_formation = False, None, None, mu, formation
-        if paper_form_hand(hand):  # the contacts a phase makes or leaves at its ends (qsplan.planner.replay.phases)
+        if hand.reorients:  # the contacts a phase makes or leaves at its ends (qsplan.planner.replay.phases)
             rows, first, mode, note = phase_rows(hand, columns, rows)
             seg = dict(seg, mode=mode)
         if uses_found_contacts(hand, columns, rows):

@@ -29,9 +29,9 @@ import numpy as np
 
 from qsplan.mechanics.errors import QsplanError
 
-__all__ = ["DEFAULT_JOINT_ACCELERATION", "DEFAULT_RELEASE_ACCELERATION", "DEFAULT_WORKPIECE_ACCELERATION", "Dynamics", "box_acceleration",
-           "dynamics_metadata", "inertial_box", "inertial_wrench", "link_mass", "resolve_dynamics", "task_dynamics", "turning_box", "turning_wrench",
-           "workpiece_radius"]
+__all__ = ["DEFAULT_JOINT_ACCELERATION", "DEFAULT_RELEASE_ACCELERATION", "DEFAULT_WORKPIECE_ACCELERATION", "Dynamics",
+           "box_acceleration", "dynamics_metadata", "inertial_box", "inertial_wrench", "link_mass", "resolve_dynamics",
+           "task_dynamics", "turning_box", "turning_wrench", "workpiece_radius"]
 
 #: The workpiece's largest acceleration by default (m/s^2): it reaches the default 0.01 m/s workpiece speed in
 #: 0.5 s over 2.5 mm (five of the slides' 0.5 mm rows).  Its inertial force on the demo workpiece (0.2 kg) is
@@ -84,7 +84,6 @@ class Dynamics:
     disturbance: object
     source: str
     release_accelerations: np.ndarray
-    turning: bool = False
 
     def angular_acceleration(self, hand) -> float:
         """The workpiece's largest angular acceleration (rad/s^2) while it turns: ``workpiece_acceleration`` over its
@@ -105,10 +104,10 @@ def _number(v, field, key) -> float:
 
 def inertial_wrench(mass: float, height: float, ax) -> np.ndarray:
     """The workpiece's inertial wrench about the world origin (N, N, N m), shape (..., 3), at acceleration ``ax``
-    along the palm (m/s^2): ``(-m ax, 0, m ax y)`` at its centre of mass at height ``y`` (m)."""
+    along the palm (m/s^2): ``(-m ax, 0, m ax y)`` at its centre of mass at height ``y`` (m); :func:`turning_wrench`
+    of a workpiece that slides without turning."""
     ax = np.asarray(ax, dtype=float)
-    f = -float(mass) * ax
-    return np.stack([f, np.zeros_like(f), -float(height) * f], axis=-1)
+    return turning_wrench(mass, 0.0, (0.0, float(height)), np.stack([ax, np.zeros_like(ax)], axis=-1), 0.0)
 
 
 def workpiece_radius(hand) -> float:
@@ -119,8 +118,7 @@ def workpiece_radius(hand) -> float:
 def turning_wrench(mass: float, inertia: float, com, acceleration, angular) -> np.ndarray:
     """The workpiece's inertial wrench about the world origin (N, N, N m), shape (..., 3), its centre of mass at
     ``com`` (..., 2) (m) accelerating at ``acceleration`` (..., 2) (m/s^2) and turning at ``angular`` (...,) (rad/s^2):
-    ``f = -m a``, moment ``c x f - I alpha`` (``inertia`` about the centre of mass, kg m^2).  At ``a = (ax, 0)``,
-    ``alpha = 0`` it is :func:`inertial_wrench`."""
+    ``f = -m a``, moment ``c x f - I alpha`` (``inertia`` about the centre of mass, kg m^2)."""
     com, acc = np.asarray(com, dtype=float), np.asarray(acceleration, dtype=float)
     f = -float(mass) * acc
     moment = com[..., 0] * f[..., 1] - com[..., 1] * f[..., 0] - float(inertia) * np.asarray(angular, dtype=float)
@@ -134,25 +132,28 @@ def turning_box(hand, acceleration: float):
     distance (the angular acceleration's bound, :meth:`Dynamics.angular_acceleration`).  Rounded up to
     :data:`BOX_GRID`."""
     from qsplan.hands.interface import manipulator_of
-    from qsplan.mechanics.bands.disturbance import WrenchBox
     from qsplan.hands.workpiece import polygon_inertia
+    from qsplan.mechanics.bands.disturbance import WrenchBox
 
     m, R = float(hand.workpiece_mass), workpiece_radius(hand)
     X = float(np.max(np.abs(np.asarray(manipulator_of(hand).base_shape, dtype=float)[:, 0])))
     _, inertia = polygon_inertia(hand.workpiece, m)
     f = m * acceleration
-    w = np.ceil(np.array([f, f, f * (X + R) + inertia * acceleration / R]) / BOX_GRID) * BOX_GRID
+    w = _grid_ceil(np.array([f, f, f * (X + R) + inertia * acceleration / R]))
     return WrenchBox(tuple(-w), tuple(w))
+
+
+def _grid_ceil(w) -> np.ndarray:
+    """``w`` (N, N m) rounded up to :data:`BOX_GRID`: a box's corners still hold the load, and a task read back from a
+    plan's record (its workpiece re-centred, a rounding apart) gets the same box to the last digit."""
+    return np.ceil(np.asarray(w, dtype=float) / BOX_GRID) * BOX_GRID
 
 
 def inertial_box(mass: float, height: float, acceleration: float):
     """The smallest box holding the inertial wrench at every acceleration in ``[-a, a]`` (a WrenchBox)."""
     from qsplan.mechanics.bands.disturbance import WrenchBox
 
-    w = np.abs(inertial_wrench(mass, height, acceleration))
-    # rounded up to BOX_GRID: the box still holds the load, and a task read back from a plan's record (whose
-    # workpiece is re-centred again, its height a rounding apart) gets the same box to the last digit
-    w = np.ceil(w / BOX_GRID) * BOX_GRID
+    w = _grid_ceil(np.abs(inertial_wrench(mass, height, acceleration)))
     return WrenchBox((-w[0], 0.0, -w[2]), (w[0], 0.0, w[2]))
 
 
@@ -203,7 +204,7 @@ def resolve_dynamics(hand, box, workpiece_acceleration=None, joint_acceleration=
     rel.setflags(write=False)
     m, y = float(hand.workpiece_mass), float(hand.rest_height)
     if box is None and turning:  # a goal that turns the workpiece: its inertial load in every direction
-        return Dynamics(a_wp, acc, turning_box(hand, a_wp), "inertia", rel, True)
+        return Dynamics(a_wp, acc, turning_box(hand, a_wp), "inertia", rel)
     if box is None:
         return Dynamics(a_wp, acc, inertial_box(m, y, a_wp), "inertia", rel)
     room = box_acceleration(box, m, y)
@@ -218,7 +219,7 @@ def resolve_dynamics(hand, box, workpiece_acceleration=None, joint_acceleration=
         if not room > 0:
             raise QsplanError("controller.disturbance: the box holds no inertial load of a turning workpiece (the goal "
                               "turns it): it must hold force x and y and a moment on both sides of 0")  # fmt: skip
-    return Dynamics(min(a_wp, room), acc, box, "task", rel, turning)
+    return Dynamics(min(a_wp, room), acc, box, "task", rel)
 
 
 def task_dynamics(task) -> Dynamics:

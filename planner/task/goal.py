@@ -39,7 +39,7 @@ from qsplan.mechanics.errors import NoAnswerError, QsplanError
 from qsplan.planner.task.fields import task_number
 
 __all__ = ["Goal", "FEATURE_KINDS", "GOAL_KEYS", "THETA_TOL", "GoalNotServedError", "check_goal_served", "feature_text",
-           "goal_refusal", "parse_feature", "make_goal", "reorientation_verdict", "reorients", "make_start_features", "palm_x_range", "task_positions"]
+           "goal_refusal", "goal_turns", "parse_feature", "make_goal", "reorientation_verdict", "reorients", "make_start_features", "palm_x_range", "task_positions"]
 
 #: The feature kinds of a goal: the fingertip on an edge, the inner long edge on a vertex.
 FEATURE_KINDS = ("edge", "vertex")
@@ -161,12 +161,16 @@ _REORIENTATION = ("a goal that turns the workpiece (theta, or palm naming anothe
 
 
 def reorients(task) -> bool:
-    """Whether ``task``'s goal asks another orientation than the start's: ``theta`` beyond :data:`THETA_TOL` of 0, or
-    ``palm`` naming another feature than the resting edge (the route of :mod:`qsplan.planner.plan.reorient`)."""
-    goal = task.goal
+    """Whether ``task``'s goal asks another orientation than the start's (:func:`goal_turns`)."""
+    return goal_turns(task.goal, task.hand)
+
+
+def goal_turns(goal, hand) -> bool:
+    """Whether ``goal`` asks another orientation than the start's: ``theta`` beyond :data:`THETA_TOL` of 0, or
+    ``palm`` naming another feature than ``hand``'s resting edge (the route of :mod:`qsplan.planner.plan.reorient`)."""
     if goal is None:
         return False
-    resting = int(task.hand.user_edges[0])
+    resting = int(hand.user_edges[0])
     return bool((goal.theta is not None and abs(goal.theta) > THETA_TOL)
                 or (goal.palm is not None and goal.palm != ("edge", resting)))  # fmt: skip
 

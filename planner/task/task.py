@@ -51,7 +51,6 @@ from __future__ import annotations
 import tomllib
 from dataclasses import dataclass
 from pathlib import Path
-from types import SimpleNamespace
 
 import numpy as np
 
@@ -274,9 +273,9 @@ def make_task(hand, start_x, waypoints=None, mu_range=(0.0, 0.2), torque_resolut
         from qsplan.hands.formations import formation as registered
 
         formation = registered(formation)
-    from qsplan.planner.task.goal import reorients
+    from qsplan.planner.task.goal import goal_turns
 
-    turning = reorients(SimpleNamespace(goal=goal, hand=hand))  # a goal that turns the workpiece: its inertia too
+    turning = goal_turns(goal, hand)  # a goal that turns the workpiece: its inertia in every direction
     dyn = resolve_dynamics(hand, task_disturbance(disturbance), workpiece_acceleration, joint_acceleration,
                            joint_accelerations, release_acceleration, turning)  # fmt: skip
     return Task(name, hand, start_x, wp, (lo, hi), bool(shared_mu), checked["torque_resolution"], limits,

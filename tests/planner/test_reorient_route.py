@@ -13,6 +13,7 @@ from qsplan.hands.found_contacts import ordered_contacts, row_contact_scene
 from qsplan.hands.reorient import flush_instant
 from qsplan.mechanics import solve_many
 from qsplan.mechanics.bands.hold import hold_torque_interval, prove_hold
+from qsplan.planner.certify.rows import friction_points
 from qsplan.planner.plan.results import PlanFailure
 from qsplan.planner.plan.scripted import plan_task
 from qsplan.planner.task.task import load_task, task_paths
@@ -71,12 +72,6 @@ def test_the_hold_band_is_the_proved_interval_and_its_edges_are_sharp(task, plan
     assert prove_hold(scene, torques=[lo - 1e-3], disturbance=task.disturbance).margin < margin
 
 
-def _box_vertices(task, n_c, rng):
-    lo, hi = task.mu_range
-    vertices = np.array(np.meshgrid(*[[lo, hi]] * n_c, indexing="ij")).reshape(n_c, -1).T
-    return np.vstack([vertices, rng.uniform(lo, hi, (N_RANDOM, n_c))])
-
-
 @pytest.mark.parametrize("where", ["lower edge", "command", "far"])
 def test_the_transition_row_has_its_mode_alone_against_the_all_modes_solver(task, plan, where):
     from dataclasses import replace
@@ -87,7 +82,7 @@ def test_the_transition_row_has_its_mode_alone_against_the_all_modes_solver(task
     tau = {"lower edge": pivot.lower[0] + 1e-6, "command": pivot.command[0], "far": pivot.command[0] + 100.0}[where]
     scene = row_contact_scene(task.hand, pose[0], pivot.q[0], [False, True], [chord[0], np.nan], effort=[0.0, tau])
     assert len(scene.contact_names) == 5
-    mus = _box_vertices(task, 5, np.random.default_rng(3))
+    mus = friction_points(task, N_RANDOM, np.random.default_rng(3), 5)  # the box's 32 vertices, then seeded draws
     for w in task.disturbance.vertices():
         sv = solve_many(replace(scene, g_obj=scene.g_obj + w), mus)
         feasible = sv.codes == 0
