@@ -50,8 +50,9 @@ def quiet_dask_logs():
 def check_address(address: str) -> None:
     """Raise a one-line :class:`QsplanError` when ``address`` cannot be a Dask scheduler's address.
 
-    Accepts ``[scheme://]host:port`` with a scheme Dask knows (tcp, tls, ws, wss, ucx, inproc)
-    and, for tcp and tls, a port in 1..65535.
+    Accepts ``[scheme://]host:port`` with a scheme Dask knows (tcp, tls, ws, wss, ucx, inproc),
+    for tcp and tls a port in 1..65535, and for inproc ``inproc://host/pid/n`` (a scheduler in
+    this very process: ``LocalCluster(processes=False).scheduler_address``).
     """
     from distributed.comm.addressing import parse_address, parse_host_port
     from distributed.comm.registry import backends
@@ -64,6 +65,10 @@ def check_address(address: str) -> None:
             host, port = parse_host_port(loc)
             if not host or not 0 < int(port) < 65536:
                 raise ValueError(f"expected host:port with a port in 1..65535; got {loc!r}")
+        if scheme == "inproc":
+            parts = loc.split("/")
+            if len(parts) != 3 or not (parts[0] and parts[1].isdigit() and parts[2].isdigit()):
+                raise ValueError(f"expected inproc://host/pid/n, a scheduler in this process; got {loc!r}")
     except (ValueError, TypeError) as exc:
         raise QsplanError(
             f"scheduler: {address} is not a Dask scheduler address such as tcp://host:8786 ({exc})"
@@ -71,12 +76,14 @@ def check_address(address: str) -> None:
 
 
 def _probe(address: str, timeout: float):
-    """Ask the scheduler at a tcp ``address`` who it is, the whole exchange bounded by ``timeout`` s."""
+    """Ask the scheduler at ``address`` who it is, the whole exchange bounded by ``timeout`` s."""
 
     async def ask():
         from distributed.comm import connect as comm_connect
+        from distributed.security import Security
 
-        comm = await comm_connect(address, timeout=timeout)
+        # the connection arguments a Client would use (TLS from Dask's configuration)
+        comm = await comm_connect(address, timeout=timeout, **Security().get_connection_args("client"))
         try:
             await comm.write({"op": "identity"})
             return await comm.read()
@@ -91,29 +98,50 @@ def _probe(address: str, timeout: float):
         return ex.submit(asyncio.run, bounded()).result()
 
 
+def _client(address: str, timeout: float):
+    """``Client(address)``, closed here when its constructor raises.
+
+    A ``Client`` whose start failed is closed by its ``__del__`` at the next garbage collection, which
+    waits out twice the timeout for a loop that has stopped and then prints a ``TimeoutError``
+    traceback (10 s after ``qsplan: error: ...``).  Allocating it first keeps a handle to close it now.
+    """
+    from distributed import Client
+
+    client = Client.__new__(Client)
+    try:
+        client.__init__(address, timeout=timeout, set_as_default=False)
+    except BaseException:
+        try:
+            client.close(timeout=timeout)
+        except Exception:  # noqa: BLE001 - the constructor's error is the one reported
+            pass
+        raise
+    return client
+
+
 def connect(address: str, timeout: float):
     """A Dask ``Client`` for the scheduler at ``address``, or a one-line error within about ``timeout`` s.
+
+    The scheduler is asked who it is first (every scheme), so that no ``Client`` is built where none
+    answers: ``Client(timeout=...)`` does not bound the handshake.
 
     Raises
     ------
     QsplanError
         A malformed address, or no scheduler answering there within ``timeout`` s.
     """
-    from distributed import Client
-
     check_address(address)
-    if "://" not in address or address.startswith("tcp://"):
-        try:  # before Client: it does not bound the handshake, and a failed one lingers 10 s in __del__
-            _probe(address, timeout)
-        except (OSError, asyncio.TimeoutError, TimeoutError, ValueError, TypeError) as exc:
-            why = str(exc) or type(exc).__name__
-            if isinstance(exc, (asyncio.TimeoutError, TimeoutError)):
-                why = "connected or tried to, but no answer"
-            raise QsplanError(
-                f"scheduler: cannot reach a Dask scheduler at {address} within {timeout:g} s ({why})"
-            ) from None
     try:
-        return Client(address, timeout=timeout, set_as_default=False)
+        _probe(address, timeout)
+    except (OSError, asyncio.TimeoutError, TimeoutError, ValueError, TypeError) as exc:
+        why = str(exc) or type(exc).__name__
+        if isinstance(exc, (asyncio.TimeoutError, TimeoutError)):
+            why = "connected or tried to, but no answer"
+        raise QsplanError(
+            f"scheduler: cannot reach a Dask scheduler at {address} within {timeout:g} s ({why})"
+        ) from None
+    try:
+        return _client(address, timeout)
     except (OSError, TimeoutError, ValueError, TypeError) as exc:
         raise QsplanError(
             f"scheduler: cannot reach a Dask scheduler at {address} within {timeout:g} s ({exc})"

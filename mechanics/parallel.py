@@ -21,6 +21,7 @@ import dataclasses
 import os
 import pickle
 import threading
+from contextlib import contextmanager
 from functools import partial
 
 from qsplan.mechanics.errors import ParallelError, QsplanError
@@ -106,17 +107,70 @@ def chunk_count(n_units: int, min_units: int, *, workers=None, scheduler=None) -
 _MISSING = object()
 
 
-def _one_blas_thread():
-    """Pool initializer: one BLAS thread per worker process.
+def _worker_start():
+    """Pool initializer: Ctrl-C ignored, one BLAS thread per worker process.
+
+    Ctrl-C at a terminal signals the whole foreground process group, the workers too: each would
+    print a ``KeyboardInterrupt`` traceback (37 lines for ``qsplan sweep`` on two workers).  The parent
+    alone answers it (:func:`_stop_pool`, then ``qsplan: interrupted``); a worker is started with
+    SIGINT blocked (:func:`_sigint_held`), ignores it here, then unblocks it (a pending one is dropped).
 
     The workers already fill the cores; a forked worker would otherwise keep the
     parent's BLAS thread pool, and two workers with two BLAS threads each ran the
     n_c = 12..14 mode solves 0.75-0.86x as fast as one process instead of 1.5-1.9x
     (benchmarks/bench_parallel.py).  Dask's workers do the same by default.
     """
+    import signal
+
     from threadpoolctl import threadpool_limits
 
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    if hasattr(signal, "pthread_sigmask"):
+        signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGINT})
     threadpool_limits(limits=1)
+
+
+@contextmanager
+def _sigint_held():
+    """SIGINT blocked in this thread meanwhile, and delivered when the block ends (never lost).
+
+    Worker processes and the executor's thread started meanwhile inherit the block (fork, and the
+    exec of spawn and of the forkserver keep a signal mask), so no Ctrl-C reaches a worker before
+    :func:`_worker_start` ignores it.
+    """
+    import signal
+
+    if not hasattr(signal, "pthread_sigmask"):  # not POSIX: workers get no process-group Ctrl-C
+        yield
+        return
+    old = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
+    try:
+        yield
+    finally:
+        signal.pthread_sigmask(signal.SIG_SETMASK, old)
+
+
+#: Seconds a worker process is given to end after SIGTERM before it is killed (a worker computing
+#: ends at once: nothing of ours handles SIGTERM).
+STOP_SECONDS = 5.0
+
+
+def _stop_pool(ex) -> None:
+    """Cancel the chunks not started and end the worker processes now.
+
+    For a Ctrl-C or a chunk that raised: the remaining results are moot, and the executor's own
+    shutdown (its ``with`` block's end) would run every queued chunk first.  The workers are the
+    executor's ``_processes`` (Python has no public handle on them before 3.14's ``terminate_workers``).
+    """
+    procs = list((getattr(ex, "_processes", None) or {}).values())
+    ex.shutdown(wait=False, cancel_futures=True)
+    for p in procs:
+        p.terminate()
+    for p in procs:
+        p.join(STOP_SECONDS)
+        if p.is_alive():
+            p.kill()
+            p.join()
 
 
 def _pool_context():
@@ -162,27 +216,40 @@ def no_progress_timeout() -> float:
 
 
 def _in_pool(fn, items: list, n: int, progress=None) -> list:
-    """``[fn(item) ...]`` on ``n`` local processes; a pool that breaks is replaced once for the missing items."""
+    """``[fn(item) ...]`` on ``n`` local processes; a pool that breaks is replaced once for the missing items.
+
+    A Ctrl-C (``KeyboardInterrupt`` here; the workers ignore it) or an exception of ``fn`` ends the
+    workers at once (:func:`_stop_pool`) and propagates.
+    """
     from concurrent.futures import ProcessPoolExecutor
     from concurrent.futures.process import BrokenProcessPool
 
     results: list = [_MISSING] * len(items)
     todo = list(range(len(items)))
     for attempt in (1, 2):
+        ex, futures = None, []
         try:
-            with ProcessPoolExecutor(max_workers=min(n, len(todo)), mp_context=_pool_context(),
-                                     initializer=_one_blas_thread) as ex:  # fmt: skip
+            with _sigint_held():  # the workers start inside: none sees a Ctrl-C before it ignores them
+                ex = ProcessPoolExecutor(max_workers=min(n, len(todo)), mp_context=_pool_context(),
+                                         initializer=_worker_start)  # fmt: skip
                 futures = [(i, ex.submit(fn, items[i])) for i in todo]
-                for i, f in futures:  # in order: the first exception of fn propagates, as in a loop
-                    results[i] = f.result()
-                    if progress:
-                        progress(sum(r is not _MISSING for r in results), len(items), "chunks")
-            return results
+            for i, f in futures:  # in order: the first exception of fn propagates, as in a loop
+                results[i] = f.result()
+                if progress:
+                    progress(sum(r is not _MISSING for r in results), len(items), "chunks")
         except BrokenProcessPool:
             for i, f in futures:
                 if f.done() and not f.cancelled() and f.exception() is None:
                     results[i] = f.result()
             todo = [i for i in todo if results[i] is _MISSING]
+            ex.shutdown(wait=True)
+            continue
+        except BaseException:  # KeyboardInterrupt, fn's exception
+            if ex is not None:
+                _stop_pool(ex)
+            raise
+        ex.shutdown(wait=True)
+        return results
     raise ParallelError(
         f"workers: a local worker process died (killed, or out of memory) while running {len(todo)} of "
         f"{len(items)} chunks, and again in a new pool; rerun with workers=1 to compute in this process"
