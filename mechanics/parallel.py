@@ -127,7 +127,31 @@ def _worker_start():
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     if hasattr(signal, "pthread_sigmask"):
         signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGINT})
+    _die_with_parent()
     threadpool_limits(limits=1)
+
+
+#: ``prctl`` option asking the kernel to signal this process when its parent dies (Linux, ``<sys/prctl.h>``).
+_PR_SET_PDEATHSIG = 1
+
+
+def _die_with_parent() -> None:
+    """Linux: this worker gets SIGTERM when the process that started it dies.
+
+    A parent killed (SIGTERM, SIGKILL: not a Ctrl-C, which :func:`_stop_pool` answers) never shuts its pool down, and
+    its workers, blocked reading their next task, would live on forever.  Elsewhere nothing is done (the workers end
+    when their pipe to the parent breaks at their next task)."""
+    import sys
+
+    if not sys.platform.startswith("linux"):
+        return
+    import ctypes
+    import signal
+
+    try:
+        ctypes.CDLL(None, use_errno=True).prctl(_PR_SET_PDEATHSIG, int(signal.SIGTERM), 0, 0, 0)
+    except (OSError, AttributeError):  # no libc prctl: the old behaviour
+        pass
 
 
 @contextmanager

@@ -316,3 +316,24 @@ def test_ctrl_c_in_a_sweep_is_one_line(tmp_path):
     workers = _wait_for_workers(proc)
     err = _interrupt(proc, workers, "terminal")
     assert proc.returncode == 130 and err == "qsplan: interrupted\n", err[-2000:]
+
+
+@pytestmark_linux
+def test_workers_end_when_their_command_is_killed(tmp_path):
+    """A command killed outright (SIGKILL: it cannot shut its pool down) takes its workers with it: each asked the
+    kernel for SIGTERM at its parent's death (``mechanics.parallel``).  Before, they waited for a task forever."""
+    from qsplan.mechanics.model.scene_io_write import scene_to_dict
+
+    scene, _ = planted_scene(np.random.default_rng([1995, 16, 13]), 16, 13, 15)  # ~15 s of work on 2 workers
+    path = tmp_path / "n16.json"
+    path.write_text(json.dumps(scene_to_dict(scene)))
+    argv = [sys.executable, "-m", "qsplan.planner.cli", "modes", str(path), "--search", "all", "--workers", "2"]
+    proc = subprocess.Popen(argv, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, process_group=0)
+    assert "this takes about" in proc.stderr.readline()
+    workers = _wait_for_workers(proc)
+    proc.kill()
+    proc.communicate(timeout=HANG_GUARD)
+    deadline = time.monotonic() + HANG_GUARD
+    while not all(_gone(w) for w in workers) and time.monotonic() < deadline:
+        time.sleep(0.05)
+    assert all(_gone(w) for w in workers), "a worker outlived its killed command"
