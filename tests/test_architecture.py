@@ -9,7 +9,7 @@ An AST walk over the source (no import of the code under test):
   ``__init__`` (lazy public names, which may point anywhere) are the only modules outside the layers;
 * exactly one package imports ``ompl`` (:data:`OMPL_PACKAGE`);
 * no name starting with ``_`` is imported from another module;
-* no module is longer than :data:`MAX_MODULE_LINES`;
+* no module is longer than :data:`MAX_MODULE_LINES` (a hint to look for a second concept, not a target);
 * code, tests, examples and benchmarks import the project only as ``qsplan.*``, and examples and
   benchmarks import no private name;
 * every folder with an ``__init__.py`` is a package that ``pyproject.toml`` installs.
@@ -26,8 +26,10 @@ import pytest
 ROOT = Path(__file__).resolve().parent.parent
 #: The user's top-level folders and the subpackage of ``qsplan`` each installs as.
 FOLDERS = {"mechanics": "qsplan.mechanics", "hands": "qsplan.hands", "planner": "qsplan.planner"}
-#: One concept per module: past this a module is split (STYLE.md, point 10).
-MAX_MODULE_LINES = 400
+#: A module this long almost surely holds more than one concept.  Not a target to cut to: modules are split by
+#: concept, whatever their length (a 400-line cap left ten modules at 388-400 lines, cut to the count); this
+#: bound only flags the module nobody looked at.
+MAX_MODULE_LINES = 800
 #: The layers of the package, lowest first (issue 22's design): the paper's mechanics, hands, then the
 #: planner from the task up to the command line.  A module may import its own layer and lower ones only.
 LAYERS = (
