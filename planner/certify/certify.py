@@ -37,7 +37,8 @@ import numpy as np
 from qsplan.mechanics import QsplanError
 
 from qsplan.planner.certify.bands import BAND_RTOL, band_checks, free_row_cells, recomputed_bands
-from qsplan.planner.certify.contacts import hold_row, judged_contact_checks, judged_contacts
+from qsplan.planner.certify.claims import RowEvidence
+from qsplan.planner.certify.contacts import hold_row, judged_contact_checks, judged_contacts, row_contact_names
 from qsplan.planner.certify.files import META_TOL, agreement_checks, metadata_checks, schema_checks
 from qsplan.planner.certify.inputs import (plan_columns_required, plan_sources, read_plan,
                                            read_plan_file, task_from_metadata)  # fmt: skip
@@ -69,7 +70,9 @@ CHECKS = {
     "input": "every cell readable and where the export puts it: one command per joint, no effort on regrasp rows",
     "files": "plan.csv and plan.json hold the same cells; plan.json follows its schema",
     "metadata": "plan.json's metadata states the task's friction, resolution, force margin, limits and hand, and "
-                "each phase's rows, times, mode, effort joint and narrowest band",
+                "each phase's rows, times, mode, effort joint, narrowest band, contacts and contact sets, competitors, "
+                "commands and time scaling, and each step of the sequence (a hold's proved interval, a pivot's "
+                "vertex), as the rows and the row checks find them; the rest is labelled informational",
     "time": "time starts at 0 and grows inside every phase",
     "phase": "phases numbered 0, 1, ... in row order, one mode and effort joint per phase",
     "start": "the first row is the task's start: workpiece x, the fingers' start features or free joints",
@@ -297,7 +300,7 @@ def certify_plan(plan, task, *, n_random: int = 8, seed: int = 0, force_margin: 
     doc = next((d for _, d in read if d is not None), None)
     if doc is not None:
         whole += schema_checks(doc)
-        whole += metadata_checks(doc.get("metadata"), task, cols)
+        meta_at = len(whole)  # the metadata's claims, checked once the rows have been (they use what those found)
     whole += structure_checks(cols)
     if "phase" in cols:
         whole += timing_checks(task, cols)
@@ -308,6 +311,7 @@ def certify_plan(plan, task, *, n_random: int = 8, seed: int = 0, force_margin: 
     found_at = [[] for _ in range(n)]
     verdict_info, slip, ends = [], None, {}  # slip: (row, phase, sliding velocities) of the last in-contact row
     scenes = {}  # in-contact rows' scenes: their bands recomputed in one batch per mode
+    named = {}  # in-contact rows' contacts, as their mode letters follow them (the metadata's contact sets)
     general = task.hand.reorients  # any formation: the row's contacts found in the polygons
     for k in range(n):
         mode = str(cols["mode"][k])
@@ -340,6 +344,7 @@ def certify_plan(plan, task, *, n_random: int = 8, seed: int = 0, force_margin: 
                 contact = contact_checks(task, cols, k, bodies)
             found += contact
             if not contact:
+                named[k] = row_contact_names(task, cols, k, judged)
                 try:
                     scene = row_scene(task, cols, k, judged)
                 except QsplanError as exc:
@@ -363,11 +368,14 @@ def certify_plan(plan, task, *, n_random: int = 8, seed: int = 0, force_margin: 
         verdict_info.append((mode, pts, excluded))
         if progress is not None and (k + 1) % 50 == 0:
             progress(f"certified {k + 1} of {n} rows")
-    for k, rb in recomputed_bands(task, cols, scenes).items():
+    bands = recomputed_bands(task, cols, scenes)
+    for k, rb in bands.items():
         found_at[k] += band_checks(task, cols, k, rb)
     held, holds = hold_checks(task, cols, scenes)
     for k, kind, msg in held:
         found_at[k].append((kind, msg))
+    if doc is not None:
+        whole[meta_at:meta_at] = metadata_checks(doc.get("metadata"), task, cols, RowEvidence(named, bands))
     if 0 in ends and n - 1 in ends:
         whole += endpoint_checks(task, cols, ends[0], ends[n - 1])
     plan_level = []

@@ -19,7 +19,7 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["hold_row", "judged_contacts", "judged_contact_checks", "judged_scene"]
+__all__ = ["hold_row", "judged_contacts", "judged_contact_checks", "judged_scene", "row_contact_names"]
 
 
 def _same_phase(cols, a, b) -> bool:
@@ -57,15 +57,26 @@ def judged_contacts(task, cols, k):
     return found, np.zeros(len(found), dtype=bool)
 
 
+def row_contact_names(task, cols, k, judged=None) -> tuple:
+    """The names of the contacts row ``k``'s mode letters follow, in order: its judged contacts
+    (:func:`judged_contacts`, without those its motion makes only there; named by
+    :func:`qsplan.hands.found_contacts.contact_names` among themselves: a finger left with one contact is ``left``), or
+    without ``judged`` (a hand that does not reorient) the task's formation's."""
+    from qsplan.hands.found_contacts import contact_names
+
+    if judged is None:
+        return tuple(task.formation.contact_names)
+    found, drop = judged
+    pose, _ = _configuration(task, cols, k)
+    return contact_names(task.hand, pose, [c for c, d in zip(found, drop) if not d])
+
+
 def judged_contact_checks(task, cols, k, judged) -> list:
     """The row's mode has one letter of R, S, B per judged contact; a hold row's phase does not move."""
-    from qsplan.hands.found_contacts import contact_names
     from qsplan.planner.certify.rows import JUMP_TOL
 
-    found, drop = judged
     mode = str(cols["mode"][k])
-    pose, _ = _configuration(task, cols, k)
-    names = [n for n, d in zip(contact_names(task.hand, pose, found), drop) if not d]
+    names = row_contact_names(task, cols, k, judged)
     out = []
     if len(mode) != len(names) or set(mode) - set("RSB"):
         out.append(("contact", f"mode {mode!r}: expected one letter of R, S, B per contact the row touches "

@@ -5,8 +5,9 @@ certifier (:mod:`qsplan.planner.certify.certify`) checks every row of one of the
 holds the very same cells (:func:`agreement_checks`: the same columns, every number bit for bit, JSON ``null``
 where the CSV has ``-inf`` in a ``_min`` column, ``inf`` in a ``_max`` column and ``nan`` elsewhere), that
 ``plan.json`` follows its schema (:func:`schema_checks`), and that every fact its ``metadata`` states is the
-task's or the rows' (:func:`metadata_checks`: friction, resolution, force margin, limits, the hand, each phase's
-rows, times, mode, effort joint and narrowest band, the plan's narrowest band).  Each check returns
+task's or the rows' (:func:`metadata_checks`: friction, resolution, force margin, disturbance, command rule, time
+scaling, limits, the hand, the task's tables and record, the plan's narrowest band; each phase and each step of the
+sequence, :mod:`qsplan.planner.certify.claims`), or labelled informational by the schema.  Each check returns
 ``(row or None, kind, message)`` triples; ``None``: the plan as a whole.  Units SI.
 """
 
@@ -93,36 +94,61 @@ def _plain(value):
     return json.loads(json.dumps(value, allow_nan=False))
 
 
-def _stated(claim, truth, path: str) -> str | None:
-    """Where ``claim`` (what the metadata states) differs from ``truth`` (the task's), or None: every key it states
-    must hold the task's value (a key it leaves out states nothing; plans written before a key existed lack it)."""
+def _show(v) -> str:
+    """A claimed or true value for a message (plain JSON, long ones cut)."""
+    text = json.dumps(v, allow_nan=True)
+    return text if len(text) <= 240 else text[:237] + "..."
+
+
+def _difference(claim, truth, path: str):
+    """``(path, claimed, true)`` where ``claim`` (what the metadata states) first differs from ``truth`` (numbers to
+    :data:`META_TOL`, ``null`` only with ``null``), or None: every key ``claim`` states must hold ``truth``'s value (a
+    key it leaves out states nothing: plans written before a key existed lack it)."""
     if isinstance(claim, dict):
         if not isinstance(truth, dict):
-            return path
+            return path, claim, truth
         for key, value in claim.items():
             if key not in truth:
-                return f"{path}.{key}"
-            where = _stated(value, truth[key], f"{path}.{key}")
-            if where:
-                return where
+                return f"{path}.{key}", value, "(nothing the certifier can check)"
+            found = _difference(value, truth[key], f"{path}.{key}")
+            if found:
+                return found
         return None
     if isinstance(claim, list):
         if not isinstance(truth, list) or len(claim) != len(truth):
-            return path
-        return next((w for i, (a, b) in enumerate(zip(claim, truth)) if (w := _stated(a, b, f"{path}[{i}]"))), None)
-    if isinstance(claim, (int, float)) and not isinstance(claim, bool):
-        return None if _close(claim, truth) and not isinstance(truth, (bool, str)) else path
-    return None if claim == truth else path
+            return path, claim, truth
+        return next((d for i, (a, b) in enumerate(zip(claim, truth)) if (d := _difference(a, b, f"{path}[{i}]"))),
+                    None)  # fmt: skip
+    numeric = isinstance(claim, (int, float)) and not isinstance(claim, bool)
+    if numeric and isinstance(truth, (int, float)) and not isinstance(truth, bool):
+        return None if _close(claim, truth) else (path, claim, truth)
+    return None if (claim == truth and type(claim) is type(truth)) else (path, claim, truth)
 
 
-def metadata_checks(meta, task, cols) -> list:
-    """Every fact ``plan.json``'s metadata states, against the task and the rows."""
+def _differs(found, whose: str = "the task's") -> str:
+    """A message for :func:`_difference`'s answer: ``"metadata.x states 1, not the task's 2"``."""
+    path, claim, truth = found
+    if isinstance(claim, list) and isinstance(truth, list) and len(claim) != len(truth):
+        return f"{path} states {len(claim)} entries {_show(claim)}, not {whose} {len(truth)} {_show(truth)}"
+    return f"{path} states {_show(claim)}, not {whose} {_show(truth)}"
+
+
+def metadata_checks(meta, task, cols, evidence=None) -> list:
+    """Every fact ``plan.json``'s metadata states, against the task, the rows and ``evidence`` (what the row checks
+    found: :class:`qsplan.planner.certify.claims.RowEvidence`; each phase's and step's claims,
+    :mod:`qsplan.planner.certify.claims`).  Not checked, the keys the schema labels informational: ``source``,
+    ``task``, ``planner``, ``narrowest_band.phase``, ``hand.description_source``, ``task_record.name`` and those of
+    :mod:`~qsplan.planner.certify.claims`."""
     from qsplan.hands.interface import hand_metadata
-    from qsplan.planner.export.plan_files import disturbance_metadata, plan_metadata_limits
+    from qsplan.planner.certify.claims import RowEvidence, phase_claims, sequence_claims
+    from qsplan.planner.export.plan_files import (command_metadata, disturbance_metadata, force_margin_metadata,
+                                                  friction_metadata, plan_metadata_limits,
+                                                  time_scaling_metadata)  # fmt: skip
     from qsplan.planner.task.record import task_record, task_tables
 
     if not isinstance(meta, dict):
         return [(None, "metadata", "plan.json has no metadata object")]
+    evidence = RowEvidence() if evidence is None else evidence
     out = []
 
     def claim(ok, message, row=None):
@@ -130,77 +156,38 @@ def metadata_checks(meta, task, cols) -> list:
             out.append((row, "metadata", message))
 
     try:
-        fr = meta["friction"]
-        claim(_close(fr["range"][0], task.mu_range[0]) and _close(fr["range"][1], task.mu_range[1])
-              and ("shared" in fr["model"]) == task.shared_mu,
-              f"friction {fr['range']} ({fr['model']}) is not the task's {list(task.mu_range)} "
-              f"({'shared' if task.shared_mu else 'independent'})")  # fmt: skip
+        lacking = [key for key in ("friction", "torque_resolution_N_m", "force_margin") if key not in meta]
+        if lacking:  # stated by every plan
+            raise KeyError(lacking[0])
         claim(_close(meta["torque_resolution_N_m"], task.torque_resolution),
               f"torque resolution {meta['torque_resolution_N_m']} is not the task's {task.torque_resolution:g}")
-        fm = meta["force_margin"]
-        claim(_close(fm["min_normal_force_N"], task.force_margin.normal)
-              and _close(fm["min_coulomb_slack_N"], task.force_margin.slack),
-              f"force margin {fm['min_normal_force_N']} / {fm['min_coulomb_slack_N']} N is not the task's "
-              f"{task.force_margin.normal:g} / {task.force_margin.slack:g} N")  # fmt: skip
         hand = hand_metadata(task.hand)
         hand.pop("description_source", None)  # where the description was read from: not a fact of the plan
-        for key, truth in (("limits", plan_metadata_limits(task)), ("hand", hand),
+        for key, truth in (("friction", friction_metadata(task)), ("force_margin", force_margin_metadata(task)),
+                           ("command", command_metadata(task)), ("time_scaling", time_scaling_metadata(task)),
+                           ("limits", plan_metadata_limits(task)), ("hand", hand),
                            ("task_tables", task_tables(task)), ("formation", task.formation.as_dict()),
-                           ("task_record", task_record(task))):
+                           ("task_record", task_record(task))):  # fmt: skip
             if key in meta:
                 # not facts of the plan: where a hand description was read from, what the task is called
                 ignored = {"hand": "description_source", "task_record": "name"}.get(key)
                 claimed = {k: v for k, v in meta[key].items() if k != ignored} \
                     if ignored and isinstance(meta[key], dict) else meta[key]
-                where = _stated(claimed, _plain(truth), f"metadata.{key}")
-                claim(where is None, f"{where} is not the task's")
+                found = _difference(claimed, _plain(truth), f"metadata.{key}")
+                claim(found is None, found and _differs(found))
         if "disturbance" in meta or task.disturbance is not None:
-            where = _stated(meta.get("disturbance"), _plain(disturbance_metadata(task)), "metadata.disturbance")
-            claim(where is None and (meta.get("disturbance") is None) == (task.disturbance is None),
-                  f"{where or 'metadata.disturbance'} is not the task's")
-        out += _phase_claims(meta["phases"], cols)
+            found = _difference(meta.get("disturbance"), _plain(disturbance_metadata(task)), "metadata.disturbance")
+            claim(found is None, found and _differs(found))
+        phases = meta["phases"]
+        out += phase_claims(phases, task, cols, evidence)
+        if "sequence" in meta:
+            out += sequence_claims(meta["sequence"], phases, task, cols, evidence)
         contact = np.flatnonzero(cols["mode"] != "free")
         if contact.size:
             t, w = _narrowest(cols, contact)
             nb = meta["narrowest_band"]
             claim(_close(nb["t_s"], t) and _close(nb["width_N_m"], w),
                   f"narrowest band {nb['width_N_m']} at t = {nb['t_s']} s; the rows' is {w} at t = {t:g} s")
-    except (KeyError, TypeError, IndexError, ValueError) as exc:
+    except (KeyError, TypeError, IndexError, ValueError, ZeroDivisionError) as exc:
         out.append((None, "metadata", f"plan.json's metadata lacks or garbles a field ({type(exc).__name__}: {exc})"))
-    return out
-
-
-def _phase_claims(phases, cols) -> list:
-    """Each ``metadata.phases`` entry against its rows (index, rows, times, kind, mode, effort joint, narrowest)."""
-    out = []
-    ph = cols["phase"]
-    if not isinstance(phases, list) or len(phases) != int(np.max(ph)) + 1:
-        return [(None, "metadata", f"{len(phases) if isinstance(phases, list) else 'no'} phases described; the rows "
-                                   f"have {int(np.max(ph)) + 1}")]  # fmt: skip
-    for i, d in enumerate(phases):
-        rows = np.flatnonzero(ph == i)
-        if not rows.size:
-            out.append((None, "metadata", f"phase {i} has no rows"))
-            continue
-        first, mode, effort = int(rows[0]), str(cols["mode"][rows[0]]), str(cols["effort_joint"][rows[0]])
-        kind = "regrasp" if mode == "free" else "contact"
-        problems = []
-        if d.get("index") != i:
-            problems.append(f"index {d.get('index')}")
-        if d.get("rows") != rows.size:
-            problems.append(f"{d.get('rows')} rows (the file has {rows.size})")
-        if not (_close(d.get("t_start_s"), cols["t"][rows[0]]) and _close(d.get("t_end_s"), cols["t"][rows[-1]])):
-            problems.append(f"times {d.get('t_start_s')} to {d.get('t_end_s')} s (the rows': {cols['t'][rows[0]]:g} to "
-                            f"{cols['t'][rows[-1]]:g} s)")  # fmt: skip
-        if d.get("kind") != kind:
-            problems.append(f"kind {d.get('kind')!r} (the rows': {kind})")
-        if kind == "contact":
-            if d.get("mode") != mode or d.get("effort_joint") != effort:
-                problems.append(f"mode {d.get('mode')} / effort joint {d.get('effort_joint')} (the rows': {mode} / {effort})")
-            t, w = _narrowest(cols, rows)
-            nb = d.get("narrowest_band") or {}
-            if not (_close(nb.get("t_s"), t) and _close(nb.get("width_N_m"), w)):
-                problems.append(f"narrowest band {nb.get('width_N_m')} at t = {nb.get('t_s')} s (the rows': {w} at {t:g} s)")
-        if problems:
-            out.append((first, "metadata", f"metadata.phases[{i}] states " + "; ".join(problems)))
     return out

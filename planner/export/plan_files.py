@@ -64,8 +64,10 @@ TIME_SCALING_RULE = ("every phase starts and ends at rest (speed_scale 0, every 
                      "time (constant acceleration) and every joint moves along the straight line between the rows in "
                      "proportion to the path covered; qd at a row is the quasistatic velocity times speed_scale")
 
-__all__ = ["PLAN_COLUMNS", "PLAN_FORMAT", "column_meanings", "export_plan", "plan_columns", "plan_joints",
-           "disturbance_metadata", "plan_metadata", "plan_metadata_limits", "plain_json", "read_plan_csv", "task_tables"]
+__all__ = ["PLAN_COLUMNS", "PLAN_FORMAT", "column_meanings", "command_metadata", "contact_runs", "export_plan",
+           "plan_columns", "plan_joints", "disturbance_metadata", "force_margin_metadata", "friction_metadata",
+           "plan_metadata", "plan_metadata_limits", "plain_json", "read_plan_csv", "task_tables",
+           "time_scaling_metadata"]
 
 PLAN_FORMAT = FORMAT + ".plan"
 
@@ -91,14 +93,19 @@ def phase_contacts(ph) -> dict:
     from qsplan.hands.formations import formation
 
     names = ph.contacts if ph.contacts is not None else (formation(ph.formation).contact_names,) * ph.t.size
-    modes = ph.modes()
+    return {"contacts": list(names[0]), "contact_sets": contact_runs(names, ph.modes())}
+
+
+def contact_runs(names, modes) -> list:
+    """``contact_sets``: each run of rows with one contact list (``names[k]``: the names row ``k``'s mode letters
+    follow) and one mode (``modes[k]``), as ``{"rows": [first, last], "contacts", "mode"}`` (rows counted from 0)."""
     runs = []
     for k, (c, m) in enumerate(zip(names, modes)):
         if runs and runs[-1]["contacts"] == list(c) and runs[-1]["mode"] == m:
             runs[-1]["rows"][1] = k
         else:
             runs.append({"rows": [k, k], "contacts": list(c), "mode": m})
-    return {"contacts": list(names[0]), "contact_sets": runs}
+    return runs
 
 
 def plan_metadata(plan) -> dict:
@@ -108,7 +115,6 @@ def plan_metadata(plan) -> dict:
     :mod:`qsplan.planner.plan.steps`) is written under ``"sequence"`` when the plan has one.
     """
     from qsplan.planner.plan.results import ContactSegmentPlan
-    from qsplan.planner.torque.command import MAX_MARGIN_RESOLUTIONS
 
     from qsplan.hands.interface import hand_metadata
 
@@ -135,22 +141,13 @@ def plan_metadata(plan) -> dict:
     doc = {
         "source": "qsplan: Trinkle & Zeng (1995), Section 5.2, Figs. 9-13; planned with OMPL",
         "task": task.name,
-        "friction": {"range": list(task.mu_range), "model": "one coefficient shared by all contacts" if task.shared_mu
-                     else "each contact's coefficient independently in the range"},
+        "friction": friction_metadata(task),
         "torque_resolution_N_m": task.torque_resolution,
-        "force_margin": dict(task.force_margin.to_dict(),
-                             meaning="inside every band, for every friction in the range, every loaded contact's "
-                                     "normal force and every rolling contact's friction-cone slacks are at least "
-                                     "these (eq. 28 made strict)"),
+        "force_margin": force_margin_metadata(task),
         "disturbance": disturbance_metadata(task),
-        "command": {"rule": "per in-contact segment one margin m kept from both band edges at every row: lower + m "
-                            "where the band is wider than 2 m, the midpoint where it is narrower; m = min(half the "
-                            "segment's narrowest band, max_margin_resolutions x torque_resolution_N_m); each phase "
-                            "records its m (command.margin_N_m)",
-                    "max_margin_resolutions": MAX_MARGIN_RESOLUTIONS, "torque_resolution_N_m": task.torque_resolution,
-                    "velocity_controlled_torque_cells": "nan in CSV, null in JSON"},
+        "command": command_metadata(task),
         "limits": plan_metadata_limits(task),
-        "time_scaling": dict(dynamics_metadata(task), rule=TIME_SCALING_RULE),
+        "time_scaling": time_scaling_metadata(task),
         "task_tables": task_tables(task),
         "task_record": task_record(task),
         "narrowest_band": {"phase": name, "t_s": _num(t), "width_N_m": _num(w)},
@@ -173,6 +170,36 @@ def _joint_units(hand) -> dict:
     from qsplan.hands.interface import JOINT_UNITS, joint_kinds, joint_names
 
     return {n: JOINT_UNITS[k] for n, k in zip(joint_names(hand), joint_kinds(hand))}
+
+
+def friction_metadata(task) -> dict:
+    """``metadata.friction``: the task's friction range and model."""
+    return {"range": list(task.mu_range), "model": "one coefficient shared by all contacts" if task.shared_mu
+            else "each contact's coefficient independently in the range"}  # fmt: skip
+
+
+def force_margin_metadata(task) -> dict:
+    """``metadata.force_margin``: the task's force margin (N) and its meaning."""
+    return dict(task.force_margin.to_dict(),
+                meaning="inside every band, for every friction in the range, every loaded contact's normal force and "
+                        "every rolling contact's friction-cone slacks are at least these (eq. 28 made strict)")  # fmt: skip
+
+
+def command_metadata(task) -> dict:
+    """``metadata.command``: the command rule in words and numbers (:mod:`qsplan.planner.torque.command`)."""
+    from qsplan.planner.torque.command import MAX_MARGIN_RESOLUTIONS
+
+    return {"rule": "per in-contact segment one margin m kept from both band edges at every row: lower + m where the "
+                    "band is wider than 2 m, the midpoint where it is narrower; m = min(half the segment's narrowest "
+                    "band, max_margin_resolutions x torque_resolution_N_m); each phase records its m "
+                    "(command.margin_N_m)",
+            "max_margin_resolutions": MAX_MARGIN_RESOLUTIONS, "torque_resolution_N_m": task.torque_resolution,
+            "velocity_controlled_torque_cells": "nan in CSV, null in JSON"}  # fmt: skip
+
+
+def time_scaling_metadata(task) -> dict:
+    """``metadata.time_scaling``: the task's acceleration limits, the inertial load and the rule the rows are timed by."""
+    return dict(dynamics_metadata(task), rule=TIME_SCALING_RULE)
 
 
 def disturbance_metadata(task) -> dict | None:

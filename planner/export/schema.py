@@ -19,10 +19,16 @@ import math
 import re
 from pathlib import Path
 
-__all__ = ["SCHEMA_FILE", "check_schedule_document", "check_schedule_files", "schedule_schema", "validate"]
+__all__ = ["INFORMATIONAL", "SCHEMA_FILE", "check_schedule_document", "check_schedule_files", "informational_paths",
+           "schedule_schema", "validate"]
 
 #: The schema's file name, beside this module.
 SCHEMA_FILE = "torque_schedule.schema.json"
+
+#: How the schema's ``description`` of a key begins when the key states nothing a controller relies on (bookkeeping:
+#: names, seeds, wall times, search statistics, labels): ``qsplan verify`` does not check it; every other key of a
+#: plan's metadata it checks against the task and the rows (:mod:`qsplan.planner.certify.files`).
+INFORMATIONAL = "Informational:"
 
 _TYPES = {
     "object": lambda v: isinstance(v, dict),
@@ -113,6 +119,50 @@ def validate(instance, schema: dict, root: dict | None = None, path: str = "$") 
         elif passing > 1:
             errors.append(f"{path}: {passing} of the {len(found)} alternatives hold; expected exactly one")
     return errors
+
+
+def _applying(instance, schema: dict, root: dict) -> list:
+    """The schema objects that apply to ``instance``: ``schema``, what its ``$ref`` names, and each ``oneOf``
+    alternative it satisfies, recursively."""
+    out = [schema]
+    if "$ref" in schema:
+        out += _applying(instance, _resolve(schema["$ref"], root), root)
+    for sub in schema.get("oneOf", ()):
+        if not validate(instance, sub, root):
+            out += _applying(instance, sub, root)
+    return out
+
+
+def informational_paths(doc, schema: dict | None = None) -> list:
+    """The paths (``$.metadata.planner``, ``$.metadata.phases[0].name``, ...) of every value of ``doc`` whose schema
+    ``description`` begins with :data:`INFORMATIONAL` (what lies under one is not listed again), in document order."""
+    root = schedule_schema() if schema is None else schema
+    out = []
+
+    def walk(value, schemas, path):
+        if any(str(s.get("description", "")).startswith(INFORMATIONAL) for s in schemas):
+            out.append(path)
+            return
+        if isinstance(value, dict):
+            for key, item in value.items():
+                subs = []
+                for s in schemas:
+                    patterns = s.get("patternProperties", {}).items()
+                    matched = [sub for pattern, sub in patterns if re.search(pattern, key)]
+                    if key in s.get("properties", {}):
+                        matched.append(s["properties"][key])
+                    extra = s.get("additionalProperties")
+                    if not matched and isinstance(extra, dict):
+                        matched.append(extra)
+                    subs += matched
+                walk(item, [a for sub in subs for a in _applying(item, sub, root)], f"{path}.{key}")
+        elif isinstance(value, list):
+            subs = [s["items"] for s in schemas if isinstance(s.get("items"), dict)]
+            for i, item in enumerate(value):
+                walk(item, [a for sub in subs for a in _applying(item, sub, root)], f"{path}[{i}]")
+
+    walk(doc, _applying(doc, root, root), "$")
+    return out
 
 
 def _short(v) -> str:

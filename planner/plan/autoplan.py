@@ -34,7 +34,7 @@ from qsplan.hands.interface import JOINT_UNITS
 from qsplan.mechanics.errors import QsplanError
 
 from qsplan.planner.plan.results import ContactSegmentPlan, Plan, PlanFailure
-from qsplan.planner.plan.steps import RegraspStep, SearchSummary, SlideStep
+from qsplan.planner.plan.steps import RegraspStep, SearchSummary, SlideStep, realised_steps
 from qsplan.planner.plan.timing import time_scale
 from qsplan.planner.search.ompl_search import search_route
 from qsplan.planner.search.tables import band_tables, table_grid
@@ -342,6 +342,7 @@ def plan_automatic(task, options=None, progress=None, planner: str = "widest", t
     if not timed:
         return plan
     plan = time_scale(plan)
+    plan = replace(plan, sequence=realised_steps(plan.sequence, plan.phases))  # the steps as the rows are timed
     plan.check()
     if not any(isinstance(p, ContactSegmentPlan) for p in plan.phases):
         raise QsplanError("goal: reached by regrasps alone; the plan has no in-contact segment to export")

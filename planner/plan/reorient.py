@@ -39,7 +39,7 @@ import numpy as np
 from qsplan.hands.reorient import PIVOT_FORMATION, TRANSITION_FORMATION
 
 from qsplan.planner.plan.results import ContactSegmentPlan, Plan, PlanFailure
-from qsplan.planner.plan.steps import HoldStep, PivotStep
+from qsplan.planner.plan.steps import HoldStep, PivotStep, realised_steps
 from qsplan.planner.task.goal import Goal, GoalNotServedError
 
 __all__ = ["FLUSH_APPROACH", "HOLD_MIN_DURATION", "HOLD_ROWS", "HOLD_TORQUE_RATE", "PIVOT", "PIVOT_EFFORT_JOINTS", "PIVOT_STEP",
@@ -342,7 +342,8 @@ def plan_reorientation(task, options=None, progress=None, planner: str = "widest
         PivotStep(int(hand.user_vertices[PIVOT]), 0.0, theta_goal, e, float(np.min(pivot.width))),
     ) + tuple(st for st in slide.sequence if st.kind == "search")  # fmt: skip
     plan = Plan(task, timed.phases + later, time.perf_counter() - started, slide.validity_checks + pivot.t.size,
-                slide.ompl_seconds, slide.options, steps, timed.timing + turned.timing)  # fmt: skip
+                slide.ompl_seconds, slide.options, realised_steps(steps, timed.phases + later),
+                timed.timing + turned.timing)  # fmt: skip
     plan.check()
     progress(f"reorientation planned: {len(plan.phases)} phases, {plan.duration:.4g} s")
     return plan

@@ -13,9 +13,12 @@ transitions: a new step type with a ``kind`` and ``as_dict``.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
-__all__ = ["HoldStep", "PivotStep", "RegraspStep", "SearchSummary", "SlideStep", "search_summary", "step_dicts"]
+import numpy as np
+
+__all__ = ["HoldStep", "PivotStep", "RegraspStep", "SearchSummary", "SlideStep", "realised_steps", "search_summary",
+           "step_dicts"]
 
 
 def _finite(v) -> float | None:
@@ -161,6 +164,26 @@ class SearchSummary:
 def search_summary(sequence) -> SearchSummary | None:
     """The :class:`SearchSummary` of a plan's ``sequence`` (None for a scripted plan)."""
     return next((s for s in sequence if isinstance(s, SearchSummary)), None)
+
+
+def realised_steps(sequence, phases) -> tuple:
+    """``sequence`` with each slide's ends and narrowest band, and each pivot's narrowest band, as ``phases`` (one per
+    step, in order: the plan's) realise them: the time scaling judges a slide's rows at rest again, and a
+    reorientation moves its slide's last row onto the flush instant, so the search's figures may differ from the
+    rows the plan exports (and ``plan.json`` states; the certifier checks them against the rows)."""
+    if sum(s.kind != "search" for s in sequence) != len(phases):
+        return tuple(sequence)
+    out, i = [], 0
+    for s in sequence:
+        if s.kind != "search":
+            ph, i = phases[i], i + 1
+        if s.kind in ("slide", "pivot"):
+            s = replace(s, narrowest_band=float(np.min(ph.upper - ph.lower)))
+            if s.kind == "slide":
+                x = np.ravel(ph.x)
+                s = replace(s, x_from=float(x[0]), x_to=float(x[-1]))
+        out.append(s)
+    return tuple(out)
 
 
 def step_dicts(sequence) -> list:

@@ -34,7 +34,7 @@ import numpy as np
 
 from qsplan.planner.task.dynamics import task_dynamics
 
-__all__ = ["PhaseTiming", "SCALE_ITERATIONS", "piece_scale", "quasistatic_rows", "time_scale"]
+__all__ = ["PhaseTiming", "SCALE_ITERATIONS", "piece_scale", "quasistatic_rows", "scale_rate", "time_scale"]
 
 #: Rounds of cutting ``α`` and the peak when a slide's curvature makes a joint's command change faster than the
 #: trapezoid alone predicts (each round cuts by the measured excess; the bundled plans need at most one).
@@ -51,9 +51,12 @@ class PhaseTiming:
     pieces : int
         Rest-to-rest pieces (1 for a slide; a regrasp's legs).
     path_acceleration : float
-        The largest ``α`` of its pieces (1/s^2: quasistatic seconds per second squared).
+        The largest change of the speed scale per second between two of its rows (1/s^2: quasistatic seconds per
+        second squared): the largest ``α`` of its pieces wherever a row lies on a ramp (a ramp that ends inside its
+        first interval changes the rows' speed scale slower).  As the rows realise it: ``plan.json`` states it, the
+        certifier checks it against the rows.
     peak_speed_scale : float
-        The largest speed scale reached (1: the quasistatic speed).
+        The largest speed scale at its rows (1: the quasistatic speed; a short slide's triangle stays below).
     duration, quasistatic_duration : float
         Its duration (s) with the stops, and at constant quasistatic speed.
     binding : str
@@ -231,9 +234,18 @@ def time_scale(plan):
             t, q, v, qd, pieces, alpha, peak, binding = _regrasp(task, ph)
             new = replace(ph, t=t0 + t, q=q, qd=qd, speed_scale=v)
         phases.append(new)
-        timing.append(PhaseTiming(ph.name, pieces, float(alpha), float(peak), float(t[-1]), T, binding))
+        # the record states what the rows realise (alpha, peak: the rule's parameters)
+        timing.append(PhaseTiming(ph.name, pieces, scale_rate(t, v), float(np.max(v, initial=0.0)), float(t[-1]), T,
+                                  binding))  # fmt: skip
         t0 = float(new.t[-1])
     return replace(plan, phases=tuple(phases), timing=tuple(timing))
+
+
+def scale_rate(t, u) -> float:
+    """The largest change of the speed scale ``u`` per second between two rows at times ``t`` (s; 1/s^2): by the rule
+    it changes linearly in time between rows (0 for fewer than two rows at distinct times)."""
+    dt, du = np.diff(np.asarray(t, dtype=float)), np.diff(np.asarray(u, dtype=float))
+    return float(np.max(np.abs(du[dt > 0]) / dt[dt > 0], initial=0.0))
 
 
 def quasistatic_rows(t, u, q, qd):
