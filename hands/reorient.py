@@ -34,7 +34,7 @@ from qsplan.mechanics.errors import QsplanError
 from qsplan.mechanics.model.geometry import CONTACT_TOL
 
 __all__ = ["PIVOT_FORMATION", "THETA_RATE", "TRANSITION_FORMATION", "FlushInstant", "PivotConfigurations",
-           "flush_instant", "paper_form", "pivot_configurations", "pivot_contacts", "pivot_scene", "transition_contacts",
+           "flush_instant", "left_sides", "paper_form", "pivot_configurations", "pivot_contacts", "pivot_scene", "transition_contacts",
            "transition_scene"]
 
 #: The workpiece's turning rate (rad/s) the transition and pivot scenes are built for: negative, clockwise (the
@@ -120,10 +120,28 @@ def paper_form(hand):
     return paper
 
 
+def left_sides(hand) -> tuple:
+    """The workpiece edges (internal numbering) the left finger can lie flush along: those running downward
+    counter-clockwise (lower end below upper end, the edge's angle in (0, pi)), longest first (the paper's Section
+    5.2: "along the longest edge"); () when none."""
+    V = paper_form(hand).workpiece
+    d = V - np.roll(V, -1, axis=0)  # upper end (vertex k) minus lower end (vertex k + 1)
+    psi = np.arctan2(d[:, 1], d[:, 0])
+    ks = np.flatnonzero((psi > 0.0) & (psi < np.pi))
+    return tuple(int(k) for k in sorted(ks, key=lambda k: (-np.hypot(*d[k]), k)))
+
+
 def _flush_edge(paper, edge):
-    """``(edge, lower end, upper end, psi)``: the edge the left finger lies along, checked to lean right."""
+    """``(edge, lower end, upper end, psi)``: the edge the left finger lies along (default the longest left side,
+    :func:`left_sides`), checked to lean right."""
     V = paper.workpiece
-    k = paper.longest_edge if edge is None else edge
+    if edge is None:
+        sides = left_sides(paper)
+        if not sides:
+            raise QsplanError("edge: the workpiece has no left side (an edge whose lower end is below its upper end) "
+                              "for the left finger to lie flush along")  # fmt: skip
+        edge = sides[0]
+    k = edge
     if isinstance(k, (bool, np.bool_)) or not isinstance(k, (int, np.integer)) or not 0 <= k < len(V):
         raise QsplanError(f"edge: expected a workpiece edge in [0, {len(V)}); got {edge!r}")
     lo, hi = V[(k + 1) % len(V)], V[k]  # counter-clockwise: a left side runs downward
@@ -157,7 +175,7 @@ def flush_instant(hand, edge=None) -> FlushInstant:
     hand
         A paper-form hand (a :class:`qsplan.hands.described.DescribedHand` of that form, or its record).
     edge : int, optional
-        The workpiece edge (internal numbering); default the longest one.
+        The workpiece edge (internal numbering); default the longest left side (:func:`left_sides`).
 
     Returns
     -------

@@ -105,7 +105,7 @@ def band_checks(task, cols, k, rb) -> list:
     margin = float(cols["margin"][k]) if "margin" in cols else math.nan
     tol = BAND_RTOL * max([abs(v) for v in (tau, lo, hi) if math.isfinite(v)] + [1.0])
     if not (math.isfinite(margin) and abs(margin - slack) <= tol):
-        out.append(("margin", f"margin {margin!r} {unit}; the command {tau:.6g} {unit} is {_fmt(slack)} {unit} from the "
+        out.append(("margin", f"margin {float(margin)!r} {unit}; the command {tau:.6g} {unit} is {_fmt(slack)} {unit} from the "
                               "nearer band edge"))  # fmt: skip
     if slack < 0.5 * task.torque_resolution - tol and lo <= tau <= hi:
         out.append(("margin", f"the command {tau:.6g} {unit} is {slack:.3g} {unit} from its band's edge, less than half "
@@ -121,7 +121,7 @@ def free_row_cells(cols, k, names) -> list:
         out.append(("input", f"a regrasp row with an effort or band for {', '.join(filled)} (every joint is "
                              "velocity-controlled there)"))  # fmt: skip
     if "margin" in cols and not np.isnan(cols["margin"][k]):
-        out.append(("input", f"a regrasp row with a margin {cols['margin'][k]!r}"))
+        out.append(("input", f"a regrasp row with a margin {float(cols['margin'][k])!r}"))
     if str(cols["effort_joint"][k]) != "none":
         out.append(("input", f"a regrasp row names effort_joint {str(cols['effort_joint'][k])!r}; expected none"))
     return out

@@ -42,7 +42,8 @@ from qsplan.planner.certify.contacts import hold_row, judged_contact_checks, jud
 from qsplan.planner.certify.files import META_TOL, agreement_checks, metadata_checks, schema_checks
 from qsplan.planner.certify.inputs import (plan_columns_required, plan_sources, read_plan,
                                            read_plan_file, task_from_metadata)  # fmt: skip
-from qsplan.planner.certify.modes import disturbance_checks, mode_checks, row_scene, slip_reversals, slip_velocities
+from qsplan.planner.certify.modes import (disturbance_checks, mode_checks, mode_misfit, row_scene, slip_reversals,
+                                          slip_velocities)  # fmt: skip
 from qsplan.planner.certify.timing import hold_checks, row_velocity, timing_checks
 from qsplan.planner.certify.route import (ENDPOINT_TOL, FREE_PATH_STEP, endpoint_checks, free_path_checks,
                                           rest_checks, structure_checks)  # fmt: skip
@@ -349,7 +350,11 @@ def certify_plan(plan, task, *, n_random: int = 8, seed: int = 0, force_margin: 
                     scene = row_scene(task, cols, k, judged)
                 except QsplanError as exc:
                     found.append(("contact", f"the row's scene cannot be built: {exc}"))
-                else:
+                    scene = None
+                misfit = None if scene is None or hold_row(cols, k) else mode_misfit(scene, mode)
+                if misfit:  # not a mode of this row's scene: nothing judges it or its band
+                    found.append(("mode", misfit))
+                elif scene is not None:
                     scenes[k] = scene
                     mus = friction_points(task, int(n_random), rng, len(scene.contact_names))
                     pts = len(mus)

@@ -31,6 +31,12 @@ def _fill(name: str) -> float:
     return -math.inf if name.endswith("_min") else (math.inf if name.endswith("_max") else math.nan)
 
 
+def _cell(value) -> str:
+    """A cell as a person reads it: a number's Python repr (``2.0``, ``nan``), a word quoted (``'SSSS'``), never a numpy
+    scalar's repr (``np.float64(2.0)``)."""
+    return repr(str(value)) if isinstance(value, (str, np.str_, bytes)) else repr(float(value))
+
+
 def agreement_checks(a_name, a_cols, b_name, b_cols) -> list:
     """Cells of two plan files that differ (at most one message per column: its first row, and how many differ)."""
     out = []
@@ -53,7 +59,7 @@ def agreement_checks(a_name, a_cols, b_name, b_cols) -> list:
             bad = np.flatnonzero(~((x == y) | (np.isnan(x) & np.isnan(y))))
         if bad.size:
             i = int(bad[0])
-            out.append((i, "files", f"column {name}: {a_name} has {x[i]!r}, {b_name} {y[i]!r}"
+            out.append((i, "files", f"column {name}: {a_name} has {_cell(x[i])}, {b_name} {_cell(y[i])}"
                                     + (f" ({bad.size} rows differ)" if bad.size > 1 else "")))  # fmt: skip
     return out
 

@@ -221,15 +221,16 @@ def task_from_metadata(meta, cols=None):
     Raises
     ------
     QsplanError
-        Naming ``task`` when the metadata holds no task record (a plan written before qsplan recorded its task) or
-        a record that is not a task: then name the task file.
+        Naming ``metadata.task_record`` when the metadata holds no task record (a plan written before qsplan recorded
+        its task) or a record that is not a task: then name the task file.
     """
     from qsplan.planner.task.task import task_from_record
 
     if not (isinstance(meta, dict) and "task_record" in meta):
-        raise QsplanError("task: the plan's metadata does not record the task (no task_record: a plan written before "
-                          "qsplan recorded its task); name the task file")  # fmt: skip
+        raise QsplanError("metadata.task_record: missing: the plan's metadata does not record its task (a plan "
+                          "written before qsplan recorded its task); name the task file")  # fmt: skip
     try:
         return task_from_record(meta["task_record"])
     except QsplanError as exc:
-        raise QsplanError(f"task: the plan's metadata.task_record is not a task ({exc}); name the task file") from None
+        raise QsplanError(f"metadata.task_record: the task the plan records is not a task ({exc}); name the task "
+                          "file") from None

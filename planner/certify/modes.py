@@ -17,7 +17,7 @@ import numpy as np
 
 from qsplan.mechanics import DEFAULT_TOLERANCES, Tolerances, solve_many, solve_many_reference
 
-__all__ = ["MOTION_RTOL", "EXACT_TOLERANCES", "SLIP_SIGN_TOL", "disturbance_checks", "mode_checks", "row_scene", "slip_velocities",
+__all__ = ["MOTION_RTOL", "EXACT_TOLERANCES", "SLIP_SIGN_TOL", "disturbance_checks", "mode_checks", "mode_misfit", "row_scene", "slip_velocities",
            "slip_reversals"]
 
 #: Relative difference tolerated between the workpiece speed the solver computes from
@@ -75,6 +75,20 @@ def row_scene(task, cols, k, judged=None):
     # closed-form grasp the planner uses (qsplan.hands.two_finger_analytic): a certifier shares no
     # shortcut with what it certifies (~2 ms per row); a chain hand's contacts are always found so
     return scene_at(task.hand, row_pose(cols, k), row_q(cols, k, names), effort, qd, effort=tau, method="generic")
+
+
+def mode_misfit(scene, mode: str) -> str | None:
+    """Why the letters ``mode`` are not a mode of ``scene`` (:func:`qsplan.mechanics.modes.kinematics.check_mode_fits`:
+    one letter per contact, and eq. 29's count with the scene's control partition), or None."""
+    from qsplan.mechanics import QsplanError
+    from qsplan.mechanics.modes.kinematics import check_mode_fits
+
+    try:
+        check_mode_fits(scene, mode)
+    except QsplanError as exc:
+        return (f"mode {mode} is not a mode of the row's scene ({scene.n_contacts} contacts "
+                f"{', '.join(scene.contact_names)}): {exc}")  # fmt: skip
+    return None
 
 
 def slip_velocities(task, cols, k, scene):

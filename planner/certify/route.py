@@ -53,7 +53,7 @@ def structure_checks(cols) -> list:
         return out + [(None, "phase", "the plan has no phase column")]
     if not np.all(np.isfinite(ph)) or np.any(ph != np.round(ph)):
         k = int(np.flatnonzero(~np.isfinite(ph) | (ph != np.round(ph)))[0])
-        return out + [(k, "phase", f"phase {ph[k]!r} is not an integer index")]
+        return out + [(k, "phase", f"phase {float(ph[k])!r} is not an integer index")]
     if ph[0] != 0:
         out.append((0, "phase", f"the first row is in phase {int(ph[0])}; expected 0"))
     step = np.diff(ph)

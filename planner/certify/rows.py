@@ -262,7 +262,7 @@ def limit_checks(task, cols, k) -> list:
         out.append(("torque", f"{e} joint {what} {tau:.6g} {unit} outside its band [{lo:.6g}, {hi:.6g}] {unit} "
                               f"({abs(tau - edge):.3g} {unit} past the edge)"))  # fmt: skip
     if not np.isnan(cols[f"qd_{e}"][k]):
-        out.append(("input", f"{e} joint (torque-controlled): a velocity command {cols[f'qd_{e}'][k]!r} beside its "
+        out.append(("input", f"{e} joint (torque-controlled): a velocity command {float(cols[f'qd_{e}'][k])!r} beside its "
                              f"{what}; one command per joint"))  # fmt: skip
     for v in names:
         if v == e:

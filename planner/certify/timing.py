@@ -64,10 +64,12 @@ def row_velocity(cols, k, names):
     """``(joint velocities (n_j,), workpiece x velocity)`` (rad/s or m/s; m/s) the rows give at in-contact row ``k``:
     its commands and the rule's workpiece rate; at rest (``speed_scale`` 0), the straight line to the adjacent row of
     its phase per second (the direction of the motion that leaves or reaches it, see the module docstring).
-    ``None`` for a phase of one row."""
+    ``None`` for a phase of one row, or where no adjacent row of its phase comes later in time (a repeated or
+    reordered time: the ``time`` check names it; no velocity follows from it)."""
     t, ph = cols["t"], cols["phase"]
     n = t.size
-    same = [(a, b) for a, b in ((k, k + 1), (k - 1, k)) if 0 <= a and b < n and ph[a] == ph[k] and ph[b] == ph[k]]
+    same = [(a, b) for a, b in ((k, k + 1), (k - 1, k))
+            if 0 <= a and b < n and ph[a] == ph[k] and ph[b] == ph[k] and t[b] > t[a]]  # fmt: skip
     if not same:
         return None
     a, b = same[0]
@@ -96,7 +98,7 @@ def timing_checks(task, cols) -> list:
     names, units = joint_names(task.hand), joint_units(task.hand)
     u = np.asarray(cols["speed_scale"], float)
     bad = np.flatnonzero(~(np.isfinite(u) & (u >= 0) & (u <= 1)))
-    out = [(int(bad[0]), "timing", f"speed_scale {u[bad[0]]!r} outside [0, 1]")] if bad.size else []
+    out = [(int(bad[0]), "timing", f"speed_scale {float(u[bad[0]])!r} outside [0, 1]")] if bad.size else []
     if bad.size:
         return out
     dyn = task_dynamics(task)
@@ -111,7 +113,7 @@ def timing_checks(task, cols) -> list:
             moving = [n for n in names if np.isfinite(cols[f"qd_{n}"][k]) and cols[f"qd_{n}"][k] != 0.0]
             if u[k] != 0.0 or moving:
                 found.setdefault("timing", (int(k), f"phase {int(cols['phase'][k])} does not "
-                                            f"{'start' if k == rows[0] else 'end'} at rest (speed_scale {u[k]!r}"
+                                            f"{'start' if k == rows[0] else 'end'} at rest (speed_scale {float(u[k])!r}"
                                             + (f"; {', '.join(moving)} commanded to move" if moving else "") + ")"))
         free = str(cols["mode"][rows[0]]) == "free"
         stops = rows[u[rows] == 0.0]  # a regrasp's legs run from rest to rest; its first and last touch the workpiece

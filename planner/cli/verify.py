@@ -59,12 +59,16 @@ def _task(args):
 
         path = task_path(args.task)
         return load_task(path), f"task {path}"
+    from qsplan.mechanics import QsplanError
+
     cols, meta = read_plan(args.plan)
     if meta is None:
-        from qsplan.mechanics import QsplanError
-
-        raise QsplanError("task: the plan has no plan.json metadata recording its task; name the task file")
-    task = task_from_metadata(meta, cols)
+        raise QsplanError(f"{args.plan}: the plan has no plan.json metadata recording its task; name the task file "
+                          "with --task")  # fmt: skip
+    try:
+        task = task_from_metadata(meta, cols)
+    except QsplanError as exc:  # the plan's record, not an option, is at fault
+        raise QsplanError(f"{args.plan}: plan.json's {exc} with --task") from None
     return task, f"task {task.name!r} as recorded in plan.json (palm thickness not recorded: the default)"
 
 

@@ -37,8 +37,10 @@ from qsplan.mechanics.errors import QsplanError
 from qsplan.planner.export.files import (atomic_write, check_out_dir, check_output_path, check_outputs, locked_out_dir,
                                          staging_dir)  # fmt: skip
 from qsplan.planner.export.manifest import MANIFEST, own_outputs, publish_outputs
+from qsplan.planner.plan.failure import GoalReport
 from qsplan.planner.plan.results import Plan, PlanFailure
 from qsplan.planner.plan.scripted import DEFAULT_OPTIONS, plan_task
+from qsplan.planner.task.goal import GoalNotServedError
 
 __all__ = ["ANIMATION_FILES", "FAILURE_FILES", "PLAN_FILES", "PLAN_PLOTS", "CertificationReport", "PlanRun", "plan_outputs", "run_plan"]
 
@@ -51,6 +53,10 @@ FAILURE_FILES = ("failure.json", "failure.png")
 
 #: The plan itself: published last, so that where it is, its certificate and every other output of its run are.
 PLAN_DATA = ("plan.csv", "plan.json")
+
+
+#: ``planner_status`` of a plan refused by its certificate: planned and exported, then refused.
+CERTIFICATE_REFUSED = "ran: planned and exported; the independent certificate refused the plan"
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -71,7 +77,8 @@ class CertificationReport:
                 + (f"; first: {first}" if first else ""))  # fmt: skip
 
     def as_dict(self) -> dict:
-        return {"kind": "certification", "message": self.message, "certificate": self.certificate.to_dict()}
+        return {"kind": "certification", "planner_status": CERTIFICATE_REFUSED, "message": self.message,
+                "certificate": self.certificate.to_dict()}  # fmt: skip
 
 #: The animation it writes with the plots (:func:`qsplan.planner.plotting.animation.plan_animation`): a GIF and a
 #: self-contained HTML page with a slider.
@@ -184,15 +191,9 @@ def run_plan(task, out_dir, *, seed: int = 1, planner: str = "RRTConnect", time_
                  f"torque resolution {task.torque_resolution:g} N m")  # fmt: skip
         try:
             plan = plan_task(task, options, progress, sequence_planner=sequence_planner)
-        except PlanFailure as exc:
-            atomic_write(stage / "failure.json", json.dumps(exc.report.as_dict(), indent=1))
-            names = ["failure.json"]
-            if plots:  # the failed configuration drawn: the blocking bodies, where the band closes
-                from qsplan.planner.plotting.failure import failure_figure
-
-                failure_figure(task, exc.report, stage / "failure.png")
-                names.append("failure.png")
-            raise PlanFailure(exc.report, report_path=publish(names)[0]) from None
+        except (PlanFailure, GoalNotServedError) as exc:  # every failure writes its report (and draws it)
+            report = exc.report if isinstance(exc, PlanFailure) else GoalReport.from_error(exc)
+            raise PlanFailure(report, report_path=publish(_failure_files(task, report, stage, plots))[0]) from None
         from qsplan.planner.export.plan_files import export_plan
 
         staged = [p.name for p in export_plan(plan, stage, force=True)]
@@ -200,8 +201,8 @@ def run_plan(task, out_dir, *, seed: int = 1, planner: str = "RRTConnect", time_
         staged.append("certificate.json")
         if not certificate.ok:  # never published where it looks like a plan
             report = CertificationReport(certificate)
-            atomic_write(stage / "failure.json", json.dumps(report.as_dict(), indent=1))
-            raise PlanFailure(report, report_path=publish(["certificate.json", "failure.json"])[1])
+            names = ["certificate.json", *_failure_files(task, report, stage, plots)]
+            raise PlanFailure(report, report_path=publish(names)[1])
         replays = _verify(plan, stage / "plan.csv", int(verify), seed, progress)
         if replays:
             atomic_write(stage / "replay.json", json.dumps([r.as_dict() for r in replays], indent=1))
@@ -211,6 +212,18 @@ def run_plan(task, out_dir, *, seed: int = 1, planner: str = "RRTConnect", time_
             staged += _draw(plan, certificate, replays, stage, progress)
         files = publish(staged)
     return PlanRun(plan, out, tuple(str(p) for p in files), tuple(replays), certificate)
+
+
+def _failure_files(task, report, stage, plots: bool) -> list:
+    """Write ``failure.json`` (the report) and, with the plots, ``failure.png`` (the failed configuration drawn:
+    :func:`qsplan.planner.plotting.failure.failure_figure`) into ``stage``; their names, the report first."""
+    atomic_write(stage / "failure.json", json.dumps(report.as_dict(), indent=1))
+    if not plots:
+        return ["failure.json"]
+    from qsplan.planner.plotting.failure import failure_figure
+
+    failure_figure(task, report, stage / "failure.png")
+    return ["failure.json", "failure.png"]
 
 
 def _scene(plan, stage) -> str:

@@ -17,11 +17,25 @@ from itertools import product
 
 import numpy as np
 
-__all__ = ["ClosedPoint", "ConfigurationReport", "FailureReport", "PalmReport", "configuration_report",
+__all__ = ["NOT_RUN_BAND_AT_END", "NOT_RUN_GOAL", "NOT_RUN_INVALID", "SEARCHED_BANDS", "ClosedPoint",
+           "ConfigurationReport", "FailureReport", "GoalReport", "PalmReport", "StepReport", "configuration_report",
            "failure_report", "palm_report"]
 
 #: Configurations sampled along the straight line of a failed segment.
 REPORT_SAMPLES = 21
+
+#: ``planner_status`` of a report refused before any planning: a start or goal configuration not valid.
+NOT_RUN_INVALID = "not run (start or goal invalid)"
+
+#: ``planner_status`` of a segment whose start or goal state already has no band: its sweep is not run.
+NOT_RUN_BAND_AT_END = "not run (no guaranteed band at the segment's start or goal)"
+
+#: ``planner_status`` of the sequence search's band report: the search ran over the band tables, and every route it
+#: found has a band narrower than the torque resolution, or none.
+SEARCHED_BANDS = "ran: the sequence search over the band tables; no route keeps a band at least the resolution wide"
+
+#: ``planner_status`` of a goal the planner does not serve (refused by name before planning).
+NOT_RUN_GOAL = "not run (a goal the planner does not serve)"
 
 
 @dataclass(frozen=True, slots=True)
@@ -142,7 +156,11 @@ class ConfigurationReport:
     overlap_area, overlap_depth : float or None
         Of that overlap (m^2, m).
     planner_status : str
-        OMPL's status ("not run" when refused before planning).
+        What planning had done when it stopped here (:data:`NOT_RUN_INVALID` when the start or goal is refused
+        before planning; OMPL's status for a regrasp; what a turning route had planned before this step).
+    pose : tuple of float or None
+        The workpiece's pose ``(x, y, theta)`` (m, m, rad) where it is not the palm-edge formation's at ``x``
+        (a pivot's row); None: resting on its bottom edge at ``x``.
     """
 
     phase: str
@@ -153,7 +171,8 @@ class ConfigurationReport:
     bodies: tuple = ()
     overlap_area: float | None = None
     overlap_depth: float | None = None
-    planner_status: str = "not run (start or goal invalid)"
+    planner_status: str = NOT_RUN_INVALID
+    pose: tuple | None = None
 
     @property
     def message(self) -> str:
@@ -164,7 +183,8 @@ class ConfigurationReport:
         return {"kind": "invalid configuration", "segment": self.phase, "where": self.where, "x_m": self.x,
                 "q_rad": None if self.q is None else list(self.q), "reason": self.reason, "bodies": list(self.bodies),
                 "overlap_area_m2": self.overlap_area, "overlap_depth_m": self.overlap_depth,
-                "planner_status": self.planner_status, "message": self.message}  # fmt: skip
+                "planner_status": self.planner_status, "pose": None if self.pose is None else list(self.pose),
+                "message": self.message}  # fmt: skip
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -213,6 +233,61 @@ class PalmReport:
                 "message": self.message}  # fmt: skip
 
 
+@dataclass(frozen=True, slots=True, eq=False)
+class GoalReport:
+    """Why a task has no plan, known from its goal before any planning: a valid goal the planner does not serve
+    (:class:`qsplan.planner.task.goal.GoalNotServedError`: its field and message, kept word for word).
+
+    Attributes
+    ----------
+    field : str
+        The goal's field (``goal.theta``, ``goal.palm``, ``goal.x``).
+    reason : str
+        What exists and what is missing (the error's message, which starts with the field).
+    """
+
+    field: str
+    reason: str
+
+    @classmethod
+    def from_error(cls, error) -> "GoalReport":
+        """The report of a :class:`qsplan.planner.task.goal.GoalNotServedError`."""
+        return cls(error.field, str(error))
+
+    @property
+    def message(self) -> str:
+        return self.reason
+
+    def as_dict(self) -> dict:
+        return {"kind": "goal not served", "field": self.field, "reason": self.reason, "planner_status": NOT_RUN_GOAL,
+                "message": self.message}  # fmt: skip
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class StepReport:
+    """A failure inside one step of a route the planner chose (the slide to a turn's flush instant): the step in
+    words, the task that step was planned as (its goal the step's end: what a drawing of ``report`` reads), and the
+    step's own report.
+
+    Attributes
+    ----------
+    step : str
+    task : qsplan.planner.task.task.Task
+    report : FailureReport, ConfigurationReport, PalmReport or NoRouteReport
+    """
+
+    step: str
+    task: object
+    report: object
+
+    @property
+    def message(self) -> str:
+        return f"no plan: {self.step}: {self.report.message.removeprefix('no plan: ')}"
+
+    def as_dict(self) -> dict:
+        return {**self.report.as_dict(), "route_step": self.step, "message": self.message}
+
+
 def palm_report(task) -> PalmReport | None:
     """The first workpiece x of ``task`` (its start, waypoints, goal) beyond the palm (a :class:`PalmReport`), or None.
 
@@ -231,12 +306,15 @@ def palm_report(task) -> PalmReport | None:
     return None
 
 
-def configuration_report(task, phase, where, x, q, reason=None, planner_status=None) -> ConfigurationReport:
+def configuration_report(task, phase, where, x, q, reason=None, planner_status=None, pose=None) -> ConfigurationReport:
     """The report of configuration ``q`` (rad, or None) at workpiece ``x`` (m): ``reason`` if given, else what
-    :func:`qsplan.planner.states.contact.configuration_problem` finds (with the colliding bodies)."""
+    :func:`qsplan.planner.states.contact.configuration_problem` finds (with the colliding bodies); ``pose``
+    ``(x, y, theta)`` where the workpiece does not rest on its bottom edge (:attr:`ConfigurationReport.pose`)."""
     from qsplan.planner.states.contact import limit_problem
 
     kw = {} if planner_status is None else {"planner_status": planner_status}
+    if pose is not None:
+        kw["pose"] = tuple(float(v) for v in pose)
     if q is None:
         return ConfigurationReport(phase, where, float(x), None, reason or "no grasp", **kw)
     q = np.asarray(q, float)
@@ -244,7 +322,7 @@ def configuration_report(task, phase, where, x, q, reason=None, planner_status=N
     if reason is None:
         reason = limit_problem(task, q)
     if reason is None:
-        hit = task.hand.collisions(task.pose(x), q, first=True)
+        hit = task.hand.collisions(task.pose(x) if pose is None else np.asarray(pose, float), q, first=True)
         if hit:
             c = hit[0]
             return ConfigurationReport(phase, where, float(x), qt, c.message, c.bodies, c.area, c.depth, **kw)
@@ -288,10 +366,11 @@ def _check(task, x, effort, direction, competitors, grasp, path):
 
 
 def failure_report(task, name, x0, x1, effort, direction, competitors, result=None, xs=None,
-                   grasp=None, path=None) -> FailureReport:  # fmt: skip
+                   grasp=None, path=None, status=None) -> FailureReport:  # fmt: skip
     """The report for a segment from ``x0`` to ``x1`` (m) with no plan (see the module docstring); ``grasp`` the
     features the fingers touch (default the paper hand's inner edges), ``path`` a described hand's free joints along
-    it (:class:`qsplan.planner.plan.phases.FreePath`; default held)."""
+    it (:class:`qsplan.planner.plan.phases.FreePath`; default held); ``status`` what planning had done (default the
+    sweep's ``result.status``, or :data:`NOT_RUN_BAND_AT_END` without one)."""
     from qsplan.planner.states.contact import mode_name
 
     xs = np.linspace(x0, x1, REPORT_SAMPLES) if xs is None else np.asarray(xs, float)
@@ -315,7 +394,8 @@ def failure_report(task, name, x0, x1, effort, direction, competitors, result=No
                 lo_e, hi_e = _edge_corners(task, narrowest.x, effort, direction, grasp, path)
                 narrowest = replace(narrowest, mu_lower_edge=lo_e, mu_upper_edge=hi_e)
             mu_closes = _mu_closes(task, narrowest.x, effort, direction, competitors, grasp, path)
-    status = "not run (start or goal invalid)" if result is None else result.status
+    if status is None:
+        status = NOT_RUN_BAND_AT_END if result is None else result.status
     return FailureReport(name, float(x0), float(x1), effort, task.torque_resolution, task.mu_range, status,
                          tuple(closed), narrowest, mu_closes, mode_name(task.formation.mode))  # fmt: skip
 

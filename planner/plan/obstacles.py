@@ -22,9 +22,13 @@ from dataclasses import dataclass
 import numpy as np
 
 from qsplan.planner.task.goal import feature_text
-from qsplan.planner.plan.failure import ConfigurationReport, failure_report
+from qsplan.planner.plan.failure import SEARCHED_BANDS, ConfigurationReport, failure_report
 from qsplan.planner.states.contact import mode_name
 from qsplan.planner.search.widest import SearchGraph, slide_widths, widest_route
+
+#: ``planner_status`` of a geometry report: the sequence search ran over the band tables with any band accepted, and
+#: no sequence of slides and regrasps joins the start and the goal.
+SEARCHED_GEOMETRY = "ran: the sequence search over the band tables; no sequence of slides and regrasps joins start and goal"
 
 __all__ = ["open_overlap", "NoRouteReport", "blocking_overlap", "no_route_report", "unreachable_goal_report"]
 
@@ -55,9 +59,16 @@ class NoRouteReport:
         tail = f" {self.band.message}" if self.band is not None else ""
         return f"no plan: {self.summary}.{tail}"
 
+    @property
+    def planner_status(self) -> str:
+        """What ran: the sequence search over the band tables (:data:`SEARCHED_BANDS` when it found routes, all too
+        narrow), or the search that found no route for the geometry."""
+        return SEARCHED_BANDS if self.kind == "band closes" else SEARCHED_GEOMETRY
+
     def as_dict(self) -> dict:
         return {"kind": f"no route ({self.kind})", "summary": self.summary, "details": list(self.details),
-                "band": None if self.band is None else self.band.as_dict(), "message": self.message}  # fmt: skip
+                "band": None if self.band is None else self.band.as_dict(), "planner_status": self.planner_status,
+                "message": self.message}  # fmt: skip
 
 
 def _touching(task, tables, g, i) -> str:
@@ -221,7 +232,7 @@ def no_route_report(task, tables, graph, starts, i_start, goals, forbidden) -> N
         e, d = tables.efforts[narrow.effort], float(np.sign(narrow.to_i - narrow.i))
         x0, x1 = float(tables.x[narrow.i]), float(tables.x[narrow.to_i])
         band = failure_report(task, f"the widest route's narrowest slide (grasp {row.label})", x0, x1, e, d, None,
-                              xs=np.array([x0, x1]), grasp=row.grasp, path=row.path)  # fmt: skip
+                              xs=np.array([x0, x1]), grasp=row.grasp, path=row.path, status=SEARCHED_BANDS)  # fmt: skip
         from qsplan.hands.interface import joint_unit
 
         u = joint_unit(task.hand, e, "tau")  # a jaw's force in N
@@ -241,7 +252,7 @@ def no_route_report(task, tables, graph, starts, i_start, goals, forbidden) -> N
         x0, x1 = float(tables.x[step.i]), float(tables.x[step.to_i])
         reports = [failure_report(task, f"the slide from x = {x0:.4g} to {x1:.4g} m (grasp {row.label}, "
                                   f"{_joint_words(task, e)} torque-controlled)", x0, x1, e, d, None,
-                                  xs=np.array([x0, x1]), grasp=row.grasp, path=row.path)
+                                  xs=np.array([x0, x1]), grasp=row.grasp, path=row.path, status=SEARCHED_BANDS)
                    for e in tables.efforts]  # fmt: skip
         band = max(reports, key=lambda r: -1.0 if r.mu_closes is None else r.mu_closes)
         which = "either finger" if len(tables.efforts) == 2 else "any joint"

@@ -37,6 +37,7 @@ from dataclasses import replace
 import numpy as np
 
 from qsplan.hands.reorient import PIVOT_FORMATION, TRANSITION_FORMATION
+from qsplan.mechanics.errors import QsplanError
 
 from qsplan.planner.plan.results import ContactSegmentPlan, Plan, PlanFailure
 from qsplan.planner.plan.steps import HoldStep, PivotStep, realised_steps
@@ -71,6 +72,9 @@ PIVOT_EFFORT_JOINTS = ("right", "left")
 
 #: The workpiece's internal vertex the route pivots on: the bottom edge's right end (:mod:`qsplan.hands.workpiece`).
 PIVOT = 1
+
+#: ``planner_status`` of a failure of the hold or the pivot: what the route had planned when it stopped.
+AFTER_SLIDE = "ran: the slide to the flush instant planned; the hold and pivot stopped here"
 
 
 def _refuse(field, why):
@@ -138,7 +142,7 @@ def hold_phase(task, name, pose, q, effort_joint, tau_from, tau_to, t0) -> Conta
     if not (inside and all(p.proved for p in proofs)):
         raise PlanFailure(configuration_report(task, name, "the hold", float(pose[0]), q,
                                                f"no hold is proved from {tau_from:.4g} to {tau_to:.4g} N m (proved "
-                                               f"interval [{lo:.4g}, {hi:.4g}] N m)"))  # fmt: skip
+                                               f"interval [{lo:.4g}, {hi:.4g}] N m)", AFTER_SLIDE, pose))  # fmt: skip
     n = HOLD_ROWS
     s = np.linspace(0.0, 1.0, n)
     command = tau_from + s * (tau_to - tau_from)
@@ -176,7 +180,7 @@ def _pivot_failure(task, name, c, i, why) -> PlanFailure:
 
     q = None if np.any(np.isnan(c.q[i])) else c.q[i]
     where = f"theta = {np.degrees(c.theta[i]):.4g} deg"
-    return PlanFailure(configuration_report(task, name, where, float(c.pose[i, 0]), q, why))
+    return PlanFailure(configuration_report(task, name, where, float(c.pose[i, 0]), q, why, AFTER_SLIDE, c.pose[i]))
 
 
 def pivot_rows(task, name, instant, theta_goal):
@@ -198,25 +202,32 @@ def pivot_rows(task, name, instant, theta_goal):
     hand = task.hand
     c = pivot_configurations(hand, _pivot_thetas(theta_goal), PIVOT, instant.edge, instant.right_vertex)
     n = c.theta.size
+    blocked = None  # the first row whose geometry ends the pivot: (row, why)
     for i in range(n):
         if np.any(np.isnan(c.q[i])):
-            raise _pivot_failure(task, name, c, i, "the right finger cannot reach its vertex")
+            blocked = (i, "the right finger cannot reach its vertex")
+            break
         why = configuration_problem(task, c.pose[i], c.q[i])  # a joint limit, two bodies overlapping
         if why:
-            raise _pivot_failure(task, name, c, i, why)
+            blocked = (i, why)
+            break
         found = ordered_contacts(hand, c.pose[i], c.q[i])
         if i == n - 1 and i > 0:  # the goal's row may make a contact (an edge landing): not in the motion
             made = made_contacts(hand, (c.pose[i - 1], c.q[i - 1]), (c.pose[i], c.q[i]), found)
             found = [f for f, m in zip(found, made) if not m]
         want = formation(TRANSITION_FORMATION if i == 0 else PIVOT_FORMATION).n_contacts
         if len(found) != want:
-            raise _pivot_failure(task, name, c, i, f"the polygons show {len(found)} contacts; the formation has {want}")
-    reversal = _slip_reversal(hand, c)
-    if reversal is not None:
+            blocked = (i, f"the polygons show {len(found)} contacts; the formation has {want}")
+            break
+    valid = n if blocked is None else blocked[0]  # the rows before it keep the formation: their slips are defined
+    reversal = _slip_reversal(hand, _first_rows(c, valid)) if valid > 1 else None
+    if reversal is not None:  # it comes first along the pivot (found among the rows before the geometry's end)
         i, at, contact = reversal
         raise _pivot_failure(task, name, c, i, f"contact {contact} stops sliding at theta = {np.degrees(at):.4g} deg "
                                                "(its sliding direction reverses: it rolls for an instant, and one 4S "
                                                "phase cannot cross it)")  # fmt: skip
+    if blocked is not None:
+        raise _pivot_failure(task, name, c, *blocked)
     return c
 
 
@@ -272,6 +283,12 @@ def pivot_phase(task, name, instant, theta_goal, t0, effort_joint: str = "right"
                               names)  # fmt: skip
 
 
+def _first_rows(c, m: int):
+    """The pivot's configurations ``c`` cut to their first ``m`` rows."""
+    cut = {k: getattr(c, k)[:m] for k in ("theta", "pose", "q", "dpose", "dq", "vertices")}
+    return replace(c, **cut)
+
+
 def _slip_reversal(hand, c):
     """``(first row past it, angle (rad), contact name)`` of the first contact whose sliding direction reverses along
     the pivot (:func:`qsplan.hands.pivot_sweep.slip_events`), or None."""
@@ -294,7 +311,7 @@ def plan_reorientation(task, options=None, progress=None, planner: str = "widest
     PlanFailure
         A phase of the route has no plan (the report says where and why).
     """
-    from qsplan.hands.reorient import flush_instant
+    from qsplan.hands.reorient import flush_instant, left_sides
     from qsplan.planner.plan.autoplan import plan_automatic
     from qsplan.planner.plan.timing import time_scale
 
@@ -305,14 +322,35 @@ def plan_reorientation(task, options=None, progress=None, planner: str = "widest
         raise _refuse("goal.theta", "turning the workpiece is planned for the paper's hand form only (two single-link "
                                     "revolute fingers, Fig. 9)")  # fmt: skip
     theta_goal = pivot_target(task)
-    instant = flush_instant(hand)
+    field = "goal.theta" if task.goal.theta is not None else "goal.palm"
+    sides = left_sides(hand)
+    if not sides:
+        raise _refuse(field, "the route lays the left finger flush along a left side of the workpiece (an edge whose "
+                             "lower end is below its upper end), and this workpiece has none")  # fmt: skip
+    misfits = []
+    for k in sides:  # the longest left side the finger fits along
+        try:
+            instant = flush_instant(hand, k)
+            break
+        except QsplanError as exc:  # the edge beyond the finger's reach: no flush instant on it
+            misfits.append(f"edge {int(hand.user_edges[k])}: its ends lie {str(exc).partition(' lies ')[2] or exc}")
+    else:
+        raise _refuse(field, "the route lays the left finger flush along a left side of the workpiece, and none fits "
+                             "along it (" + "; ".join(misfits) + ")")  # fmt: skip
     upper_vertex = int(hand.user_vertices[instant.edge])
     progress(f"reorientation: slide to the flush instant (x = {instant.x:.6g} m, the left finger along edge "
              f"{int(hand.user_edges[instant.edge])}), hold, pivot on vertex {int(hand.user_vertices[PIVOT])} to "
              f"theta = {theta_goal:.4g} rad")  # fmt: skip
     x_near = instant.x + FLUSH_APPROACH * np.sign(task.start_x - instant.x)
     sub = replace(task, goal=Goal(float(x_near), ("vertex", upper_vertex), None))
-    slide = plan_automatic(sub, options, progress, planner, timed=False)
+    try:
+        slide = plan_automatic(sub, options, progress, planner, timed=False)
+    except PlanFailure as exc:  # said as the route's step, drawn with the task it was planned as
+        from qsplan.planner.plan.failure import StepReport
+
+        step = (f"the slide to the flush instant (x = {instant.x:.6g} m, the left finger along edge "
+                f"{int(hand.user_edges[instant.edge])})")  # fmt: skip
+        raise PlanFailure(StepReport(step, sub, exc.report)) from None
     phases = list(slide.phases)
     last = phases[-1]
     if not last.in_contact:
@@ -366,7 +404,9 @@ def widest_pivot(task, name, instant, theta_goal, progress) -> ContactSegmentPla
     if not found:
         raise first_failure
     best = max(found, key=lambda p: float(np.min(p.width)))  # max keeps the first of equals
-    progress(f"  pivot: the {best.effort_joint} finger torque-controlled, narrowest band {np.min(best.width):.4g} N m")
+    w = float(np.min(best.width))
+    width = f"{w:.4g} N m" if np.isfinite(w) else "unbounded above (every band)"
+    progress(f"  pivot: the {best.effort_joint} finger torque-controlled, narrowest band {width}")
     return best
 
 
@@ -375,4 +415,5 @@ def slide_failure(task, phase):
     from qsplan.planner.plan.failure import configuration_report
 
     return configuration_report(task, phase.name, "the flush instant", float(phase.x[-1]), phase.q[-1],
-                                "the route to the flush instant ends with a regrasp, not in contact")  # fmt: skip
+                                "the route to the flush instant ends with a regrasp, not in contact",
+                                "ran: the sequence search to the flush instant")  # fmt: skip

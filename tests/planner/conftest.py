@@ -27,3 +27,23 @@ def small_run(tmp_path_factory):
     path = root / "small.toml"
     path.write_text(SMALL_TASK)
     return run_plan(load_task(path), root / "out", verify=1)
+
+
+@pytest.fixture(scope="session")
+def bundled_plan(tmp_path_factory):
+    """``bundled_plan(name)``: the directory of the bundled task ``name`` planned once per test session through
+    ``qsplan plan`` (``--no-plots --verify 0``): ``plan.csv``, ``plan.json``, ``certificate.json``, ``scene.xml``.
+    Read it, or copy it before changing anything."""
+    from qsplan.planner.cli import main
+
+    root, done = tmp_path_factory.mktemp("bundled"), {}
+
+    def plan(name: str):
+        if name not in done:
+            out = root / name
+            code = main(["plan", name, "--out", str(out), "--no-plots", "--verify", "0", "--quiet"])
+            assert code == 0, f"the bundled task {name} did not plan"
+            done[name] = out
+        return done[name]
+
+    return plan

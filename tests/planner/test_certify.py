@@ -68,9 +68,12 @@ def test_unreadable_plans_are_named(tmp_path, setup, match):
         read_plan(setup(tmp_path))
 
 
-def test_metadata_without_the_task_names_the_option():
-    with pytest.raises(QsplanError, match="^task: "):
+def test_metadata_without_the_task_names_the_record():
+    """The plan's record is at fault, not an option the user gave (``qsplan verify`` without ``--task``)."""
+    with pytest.raises(QsplanError, match="^metadata.task_record: missing: .*name the task file"):
         task_from_metadata({"task": "x"})
+    with pytest.raises(QsplanError, match="^metadata.task_record: the task the plan records is not a task "):
+        task_from_metadata({"task_record": {"version": 1}})
 
 
 @pytest.mark.ompl

@@ -210,15 +210,36 @@ def drop_speed_scale(rows, doc):
         del r["speed_scale"]
 
 
+def repeat_row_at_its_time(rows, doc):
+    """An in-contact row written twice, at one time (a divide by zero in the time scaling's rule, once)."""
+    k = _contact(rows)
+    rows.insert(k, dict(rows[k]))
+
+
+def renumber_every_phase(rows, doc):
+    """Every row's phase one higher: the plan starts in phase 1 (a divide by zero in the timing checks, once)."""
+    for r in rows:
+        r["phase"] = str(int(r["phase"]) + 1)
+
+
+def change_one_mode_letter(rows, doc):
+    """One in-contact row's last letter changed (SSSS -> SSSR): not a mode of the row's scene with its control
+    partition (eq. 29), which the band recomputation once raised on (exit 2, naming no row)."""
+    k = _contact(rows, 5)
+    m = rows[k]["mode"]
+    rows[k]["mode"] = m[:-1] + ("R" if m[-1] != "R" else "S")
+
+
 BOTH = [drop_first_row, drop_second_half, relabel_slide_as_free, raise_during_regrasp, widen_band, narrow_band,
         double_margin, bump_phase, swap_times, shift_torque_out, misstate_phase_rows, misstate_friction,
-        swap_controls, no_stop_at_phase_end, rush_the_plan, drop_speed_scale]  # fmt: skip
+        swap_controls, no_stop_at_phase_end, rush_the_plan, drop_speed_scale, repeat_row_at_its_time,
+        renumber_every_phase, change_one_mode_letter]  # fmt: skip
 
 #: The edits each hand's plan gets: every edit on the paper hand's (certified in ~1 s); on the chain hands' (~3 s
 #: each) those whose checks read the hand (its start and goal, its regrasp, its bands), so the suite stays short.
 EDITS = {"paper": BOTH,
          "two_link": [drop_first_row, drop_second_half, relabel_slide_as_free, raise_during_regrasp, widen_band,
-                      narrow_band, double_margin],
+                      narrow_band, double_margin, renumber_every_phase, change_one_mode_letter],
          "jaw": [drop_first_row, drop_second_half, relabel_slide_as_free, widen_band, narrow_band, swap_controls,
                  no_stop_at_phase_end]}  # fmt: skip
 CASES = [(hand, edit) for hand, edits in EDITS.items() for edit in edits]
@@ -241,6 +262,9 @@ EXPECTED = {
     "shift_torque_out": {"torque"},
     "misstate_phase_rows": {"metadata"},
     "misstate_friction": {"metadata"},
+    "repeat_row_at_its_time": {"time"},
+    "renumber_every_phase": {"phase"},
+    "change_one_mode_letter": {"mode"},
 }
 
 
@@ -302,6 +326,8 @@ def test_tampered_plans_are_refused(plans, tmp_path, hand, edit):
     kinds = _kinds(cert)
     assert kinds & EXPECTED[edit.__name__], (edit.__name__, kinds, cert["violations"][:4])
     assert all(v["message"] for v in cert["violations"]) and not cert["certified"]
+    assert not [v for v in cert["violations"] if "np." in v["message"]], "a numpy repr in a message"
+    assert "Warning" not in err and "Traceback" not in err, err
 
 
 @pytest.mark.parametrize("hand", ["paper", "two_link", "jaw"])
@@ -331,3 +357,33 @@ def test_unreadable_plans_exit_2(plans, tmp_path, damage, match):
     damage(dst)
     code, out, err = _run(["verify", str(dst), "--task", str(task)])
     assert code == 2 and err.startswith("qsplan: error: ") and err.count("\n") == 1 and match in err
+
+
+#: Edits of a turning plan's letters: the transition row's BSSSS (vertex 0 lifts) written as SSSSS, and a pivot row's
+#: SSSS as SSSR: each must be exit 1 naming the row and the mode, not exit 2 naming no row.
+TURN_LETTERS = {"transition_as_all_sliding": lambda m: "S" * len(m) if m.startswith("B") else None,
+                "pivot_row_rolling": lambda m: m[:-1] + "R" if m == "SSSS" else None}  # fmt: skip
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("name", list(TURN_LETTERS))
+def test_turning_plan_with_a_letter_changed_names_the_row(bundled_plan, tmp_path, name):
+    src = bundled_plan("reorient_task")
+    rows, doc = _read(src)
+    pivot = [i for i, r in enumerate(rows) if TURN_LETTERS[name](r["mode"]) is not None and r["phase"] == "2"]
+    k = pivot[0] if name.startswith("transition") else pivot[len(pivot) // 2]
+    rows[k]["mode"] = TURN_LETTERS[name](rows[k]["mode"])
+    code, cert, err = _verify(task_paths()["reorient_task"], _write(tmp_path / "bad", rows, doc))
+    assert code == 1, (code, err)
+    assert any(v["row"] == k and v["kind"] == "mode" for v in cert["violations"]), cert["violations"][:4]
+
+
+def test_verify_without_task_blames_the_plan_record_not_the_option(plans, tmp_path):
+    """A tampered ``metadata.task_record`` read because no ``--task`` was given: the plan's record is named."""
+    _, src = plans["paper"]
+    rows, doc = _read(src)
+    doc["metadata"]["task_record"]["hand"]["workpiece_mass"] = -1
+    bad = _write(tmp_path / "bad", rows, doc)
+    code, out, err = _run(["verify", str(bad)])
+    assert code == 2 and err.count("\n") == 1 and "--task:" not in err
+    assert err.startswith(f"qsplan: error: {bad}: plan.json's metadata.task_record: ") and "with --task" in err
