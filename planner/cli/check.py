@@ -10,6 +10,9 @@ wrong: the overlapping bodies and by how much, the joints beyond their limits an
 that do not close onto the features); for each grasp the hand offers, the workpiece x ranges where it is a
 valid configuration and where a guaranteed band at least the torque resolution wide exists, sliding each way;
 and a verdict line: a banded route from the start to the goal (the planner's own search), or what blocks it.
+A goal that turns the workpiece (``[goal] theta`` or ``palm``) is not previewed: the goal's line says so, and
+the route's first step, the slide to the flush instant, is previewed in its place (its end drawn and judged as
+a goal), or the route's refusal is named.
 ``--json``: one JSON document instead.  With ``--out DIR``: ``check.png`` (the start and the goal, collisions
 in red, and one bar per grasp over x) and ``check.json``; an existing file is replaced only with ``--force``.
 
@@ -47,8 +50,10 @@ def _table(preview) -> str:
     lines = [f"task {preview.task!r} ({preview.hand}): {n} grasp{'s' if n > 1 else ''} judged at {grid['points']} "
              f"workpiece x from {grid['x_from_m']:.4g} to {grid['x_to_m']:.4g} m (step {grid['step_m'] * 1e3:.3g} mm) "
              f"in {preview.seconds:.2f} s",
-             f"banded: {d['banded_means']}",
-             preview.start.message, preview.goal.message, "grasps (x ranges in m):"]  # fmt: skip
+             f"banded: {d['banded_means']}", preview.start.message, preview.goal.message]
+    if preview.slide_end is not None:  # a turning goal: its route's first step, previewed
+        lines.append(preview.slide_end.message)
+    lines.append("grasps (x ranges in m):")
     width = max(len(b.name) for b in preview.grasps)
     for b, g in zip(preview.grasps, d["grasps"]):
         pad = " " * (width + 4)

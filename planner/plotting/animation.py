@@ -6,7 +6,9 @@ where every finger touches, with the way the workpiece slides against the body a
 the torque-controlled link with the way its command pushes it, a gauge of each commanded joint's command inside
 its guaranteed band (band edges beyond the gauge marked as in Fig. 13: filled triangles unbounded, hollow finite),
 and the phase (numbered as ``plan.csv``), its kind and what the hand does
-(:func:`qsplan.planner.plotting.hands.row_state`).  In-contact frames are rows of the plan; a regrasp's frames
+(:func:`qsplan.planner.plotting.hands.row_state`).  Each gauge keeps the plan card's scale of the phase shown (a run
+of phases on one scale, linear or log: :func:`qsplan.planner.plotting.plan_panels.scale_groups`).  In-contact frames
+are rows of the plan; a regrasp's frames
 are its rows and the straight joint motions between them (the rows hold each velocity until the next row).
 
 Kept light for ``qsplan plan`` and ``demo``: at most ``max_frames`` frames on a small figure, drawn with
@@ -28,7 +30,7 @@ import numpy as np
 
 from qsplan.mechanics.errors import QsplanError
 
-from qsplan.planner.plotting.hands import effort_direction, hand_limits
+from qsplan.planner.plotting.hands import effort_direction, hand_limits, state_words
 from qsplan.planner.plotting.plan import animation_frames
 from qsplan.planner.plotting.plan_panels import (
     SLACK,
@@ -36,10 +38,12 @@ from qsplan.planner.plotting.plan_panels import (
     effort_words,
     is_contact,
     joint_title,
+    log_ticks,
     phase_colour,
     phase_label,
+    scale_groups,
     slack,
-    torque_limits,
+    torque_scale,
 )
 from qsplan.planner.plotting.style import COMMAND, FONT, body_style, joint_colour, torque_text
 
@@ -60,6 +64,10 @@ _GIF_COLOURS = 64
 
 #: zlib level of the page's PNG frames: 3 is 40 % faster than Pillow's 6 and as small (flat colours) on these frames.
 _PNG_LEVEL = 3
+
+#: The gauges' column (fraction of the figure's height, from 0.80 down) and the gap between two gauges: a gauge's
+#: tick labels and label below it and the next one's note above it (three 7-pt lines, ~0.13 of the 288-pixel height).
+_GAUGE_SPAN, _GAUGE_GAP = 0.6, 0.15
 
 #: Length of the drawn sliding and effort arrows, relative to the hand's drawing width.
 _ARROW = 0.07
@@ -108,21 +116,25 @@ class _Scene:
 
     def _gauge(self, fig, joint, n) -> dict:
         from matplotlib.patches import Rectangle
-        from matplotlib.ticker import MaxNLocator
 
-        h = min(0.16, 0.46 / max(1, len(self.joints)))
-        ax = fig.add_axes((0.58, 0.80 - (n + 1) * (h + 0.09) + 0.09, 0.39, h))
+        k = max(1, len(self.joints))
+        h = min(0.16, (_GAUGE_SPAN - (k - 1) * _GAUGE_GAP) / k)
+        ax = fig.add_axes((0.58, 0.80 - (n + 1) * h - n * _GAUGE_GAP, 0.39, h))
         segs = [p for p in self.plan.phases if is_contact(p) and p.effort_joint == joint]
-        lim = torque_limits(segs, self.plan.task.torque_resolution)
+        res = self.plan.task.torque_resolution
+        scales = {}  # phase -> (limits, log): each run of phases on one scale (the plan card's panels)
+        for group in scale_groups(segs, res):
+            scale = torque_scale(group, res)
+            scales |= {i: scale for i, p in enumerate(self.plan.phases) if any(p is m for m in group)}
+        lim = scales[min(scales)][0]
         word, unit = effort_words(self.hand, joint)
         colour = joint_colour(self.hand, joint)
         ax.set_xlim(*lim)
         ax.set_ylim(0.0, 1.0)
         ax.set_yticks([])
-        ax.xaxis.set_major_locator(MaxNLocator(5))  # tick labels of small efforts (-0.035) stay apart
         ax.tick_params(labelsize=FONT["tick"] - 1, pad=1)
         ax.set_xlabel(f"{joint_title(joint)} {word} ({unit})", fontsize=FONT["note"], labelpad=1)
-        ax.axvline(0.0, color="0.6", lw=0.5)
+        zero = ax.axvline(0.0, color="0.6", lw=0.5)
         band = ax.add_patch(Rectangle((0.0, 0.2), 0.0, 0.6, fc=colour, alpha=0.3, lw=0))
         (command,) = ax.plot([], [], color=COMMAND, lw=2.2)
         ends = {(side, inf): edge_marker(ax, [], 0.5, side, inf, colour, ms=6)[0] for side in ("upper", "lower")
@@ -130,7 +142,41 @@ class _Scene:
         for (side, _), mark in ends.items():  # the gauge lies on its side: an edge beyond it points out
             mark.set_marker(">" if side == "upper" else "<")
         note = ax.text(0.5, 1.05, "", transform=ax.transAxes, ha="center", va="bottom", fontsize=FONT["note"])
-        return {"joint": joint, "lim": lim, "unit": unit, "band": band, "command": command, "ends": ends, "note": note}
+        gauge = {"joint": joint, "lim": lim, "unit": unit, "band": band, "command": command, "ends": ends, "note": note,
+                 "ax": ax, "zero": zero, "scales": scales, "label": f"{joint_title(joint)} {word} ({unit}"}  # fmt: skip
+        self._set_scale(gauge, scales[min(scales)])
+        return gauge
+
+    @staticmethod
+    def _set_scale(g, scale):
+        """Put gauge ``g`` on ``scale`` (``(limits, log)``, its phases' run's: :func:`torque_scale`)."""
+        from matplotlib.ticker import MaxNLocator
+
+        (lo, hi), log = scale
+        ax = g["ax"]
+        ax.set_xscale("log" if log else "linear")
+        ax.set_xlim(lo, hi)
+        if log:
+            log_ticks(ax.xaxis, lo, hi, most=6)
+        else:
+            ax.xaxis.set_major_locator(MaxNLocator(5))  # tick labels of small efforts (-0.035) stay apart
+        g["zero"].set_visible(not log)
+        ax.set_xlabel(g["label"] + (", log scale)" if log else ")"), fontsize=FONT["note"], labelpad=1)
+        g["lim"] = (lo, hi)
+
+    def scale_key(self, i) -> tuple:
+        """The gauges' scales in phase ``i`` (a gauge whose joint is not torque-controlled there keeps the scale of
+        its last phase before ``i`` that is, else its first)."""
+        out = []
+        for g in self.gauges:
+            known = [j for j in g["scales"] if j <= i]
+            out.append(max(known) if known else min(g["scales"]))
+        return tuple(out)
+
+    def set_scales(self, key):
+        """Put every gauge on the scale of its phase in ``key`` (:meth:`scale_key`)."""
+        for g, j in zip(self.gauges, key):
+            self._set_scale(g, g["scales"][j])
 
     def _timeline(self, fig):
         ax = fig.add_axes((0.58, 0.08, 0.39, 0.05))
@@ -158,7 +204,7 @@ class _Scene:
     def set_phase(self, i, state):
         """Set the texts that hold while phase ``i`` keeps the hand's ``state``."""
         ph = self.plan.phases[i]
-        self.doing.set_text(f"the hand is {state}")
+        self.doing.set_text(f"the hand is {state_words(self.plan, i, state)}")
         mode, control = phase_label(ph, self.hand)
         what = f"{mode}, {control}-controlled" if is_contact(ph) else "regrasp, every joint velocity-controlled"
         n = len(self.plan.phases)
@@ -233,12 +279,16 @@ def _render(plan, frames) -> list:
     fig = Figure(figsize=ANIMATION_SIZE, dpi=ANIMATION_DPI)
     canvas = FigureCanvasAgg(fig)
     scene = _Scene(fig, plan, frames)
-    canvas.draw()
-    base, cached, out = canvas.copy_from_bbox(fig.bbox), {}, []
+    bases, cached, out = {}, {}, []  # a background per set of gauge scales (drawn once each)
     for n, f in enumerate(frames):
+        scales = scene.scale_key(f.phase)
+        if scales not in bases:
+            scene.set_scales(scales)
+            canvas.draw()
+            bases[scales] = canvas.copy_from_bbox(fig.bbox)
         key = (f.phase, f.state)
         if key not in cached:
-            canvas.restore_region(base)
+            canvas.restore_region(bases[scales])
             scene.set_phase(*key)
             for a in scene.per_phase:
                 fig.draw_artist(a)
@@ -290,7 +340,7 @@ def _page(plan, frames, images, fps) -> str:
         Image.fromarray(a).save(buf, format="PNG", compress_level=_PNG_LEVEL)
         pngs.append(base64.b64encode(buf.getvalue()).decode("ascii"))
     h, w = images[0].shape[:2]
-    labels = [f"frame {n + 1} of {len(frames)}: phase {f.phase}, t = {f.t:.2f} s, {f.state}"
+    labels = [f"frame {n + 1} of {len(frames)}: phase {f.phase}, t = {f.t:.2f} s, {state_words(plan, f.phase, f.state)}"
               for n, f in enumerate(frames)]
     title = escape(f"{plan.task.name}: the plan, phase by phase")
     return _PAGE.format(title=title, n=len(frames), last=len(frames) - 1, w=w, h=h, duration=f"{plan.duration:.3g}",

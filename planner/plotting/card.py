@@ -5,12 +5,17 @@ numbers them): what the hand does, the commanded joint, the command's range and 
 slack (the command's margin to the nearer band edge) and the narrowest band, in the joint's unit; the
 one-line verdict (certified row by row, re-simulated at N friction vectors); hand snapshots lettered A,
 B, ..., the plan's start and end always among them, each titled with what the hand does there (sliding,
-holding, open, closing: :func:`qsplan.planner.plotting.hands.row_state`); then on one shared time axis a
-thin mode bar (the letters mark the snapshots' instants), each torque-controlled joint's command inside
-its guaranteed band with the slack and the narrowest point marked, edges beyond the plot marked as in
-Fig. 13 (filled: unbounded, hollow: finite), and each joint's velocity command.  The legend lists what is
-drawn, nothing else.  Text is at least 7.5 pt on the printed page.  Only the plan's public fields are
-read (see :mod:`qsplan.planner.plotting.plan_panels`).
+holding, pivoting on vertex K, open, closing: :func:`qsplan.planner.plotting.hands.state_words`), on one row or
+two, as large as the page allows; then on one shared time axis a thin mode bar (the letters mark the snapshots'
+instants; a slide, a hold and a pivot each in its own shade), each torque-controlled joint's command inside its
+guaranteed band with the slack and the narrowest point marked (their labels where they cover no line:
+:func:`qsplan.planner.plotting.plan_panels.place_labels`), one panel per run of phases on one scale
+(:func:`~qsplan.planner.plotting.plan_panels.scale_groups`; a log scale where the command spans more than a decade),
+edges beyond the plot marked as in Fig. 13 (filled: unbounded, hollow: finite), and each joint's velocity command
+as a controller is sent it (:meth:`qsplan.planner.plan.results.Plan.sample`, the rule of ``qsplan sample``; joints
+never velocity-controlled at once share a panel).  The legend lists what is drawn, nothing else.  Text is at least
+7.5 pt on the printed page.  Only the plan's public fields are read (see
+:mod:`qsplan.planner.plotting.plan_panels`).
 """
 
 from __future__ import annotations
@@ -19,7 +24,8 @@ import textwrap
 
 import numpy as np
 
-from qsplan.planner.plotting.hands import plan_snapshots
+from qsplan.planner.plan.sampling import tick_times
+from qsplan.planner.plotting.hands import plan_snapshots, pivot_vertex, state_words
 from qsplan.planner.plotting.plan_panels import (
     SLACK,
     draw_band,
@@ -28,17 +34,21 @@ from qsplan.planner.plotting.plan_panels import (
     is_contact,
     joint_math,
     joint_title,
+    log_ticks,
     mark_narrowest,
     mark_slack,
     phase_label,
+    place_labels,
     plot_mode_timeline,
+    scale_groups,
     slack,
     timeline_handles,
-    torque_limits,
+    torque_scale,
 )
-from qsplan.planner.plotting.style import A4_PORTRAIT, FONT, NARROWEST, joint_colour, torque_text
+from qsplan.planner.plotting.style import A4_PORTRAIT, FONT, NARROWEST, joint_colour, text_width, torque_text
 
-__all__ = ["CARD_DPI", "LEGEND_LABEL_CHARS", "MAX_SNAPSHOTS", "card_snapshots", "phase_rows", "plan_card", "verdict"]
+__all__ = ["CARD_DPI", "LEGEND_LABEL_CHARS", "MAX_SNAPSHOTS", "MIN_SNAPSHOT_WIDTH", "VELOCITY_RATE", "VELOCITY_TICKS",
+           "card_snapshots", "phase_rows", "plan_card", "verdict"]
 
 #: Resolution (dots per inch) the card is written at: 150 keeps 7.5 pt text sharp on an A4 print.
 CARD_DPI = 150
@@ -52,6 +62,24 @@ LEGEND_LABEL_CHARS = 44
 
 #: Width (points) the header's table may take: the A4 page's 595 pt less its margins.
 _TABLE_WIDTH = 570.0
+
+#: The velocity panels draw what a controller is sent (:meth:`qsplan.planner.plan.results.Plan.sample`, the rule of
+#: ``qsplan sample``): each tick's velocity held until the next, at this rate (Hz, a usual joint controller's) ...
+VELOCITY_RATE = 1000.0
+#: ... or coarser, at most this many ticks over a long plan (a 20 s plan at 1 kHz; ~1 ms of drawing per thousand).
+VELOCITY_TICKS = 20_000
+
+#: Snapshots drawn narrower than this (inches on the page, ~190 px at :data:`CARD_DPI`) in one row go on two rows.
+MIN_SNAPSHOT_WIDTH = 1.25
+
+#: Heights on the page (inches of the body's grid, its ratios, each with its title): the thin mode bar; a torque
+#: panel and a velocity panel as usual and at least (a crowded card shrinks its panels to their least before its
+#: snapshots); a snapshot's title; the width the snapshots' row takes, and a snapshot's at most; the legend's line
+#: and the body's margins (the grid's height is the body's less the legend and the time axis' label).
+_TIMELINE_HEIGHT = 0.45
+_TORQUE_HEIGHT, _VELOCITY_HEIGHT, _TORQUE_MIN, _VELOCITY_MIN = 2.3, 1.05, 1.6, 0.75
+_SNAPSHOT_TITLE, _SNAPSHOT_ROW_WIDTH, _SNAPSHOT_MAX_WIDTH = 0.4, 7.9, 2.0
+_LEGEND_LINE, _BODY_MARGIN = 0.16, 0.6
 
 _OK, _BAD = "#1a7f37", "#b42318"
 _COLUMNS = ("phase", "t (s)", "what the hand does", "commanded", "command, its direction", "slack", "narrowest band")
@@ -139,8 +167,9 @@ def phase_rows(plan) -> list:
         side = "lower" if np.isinf(ph.lower).all() else "upper"
         narrow = f"{torque_text(w, unit)} at {float(ph.t[k]):.3g} s" if np.isfinite(w) else f"none: {side}\nedge unbounded"
         th = np.degrees(ph.poses(hand.rest_height)[[0, -1], 2])  # a pivot turns; a hold moves nothing
+        on = "" if pivot_vertex(plan, i) is None else f" on vertex {pivot_vertex(plan, i)},"
         does = {"hold": f"holds: nothing moves\nin {mode.removeprefix('hold: ')}, torque ramps",
-                "pivot": f"pivots {th[0]:.3g} to {th[1]:.3g} deg\nin {mode.removeprefix('pivot: ')}"}.get(
+                "pivot": f"pivots{on} {th[0]:.3g} to {th[1]:.3g} deg\nin {mode.removeprefix('pivot: ')}"}.get(
             ph.kind, f"slides {'left' if dx < 0 else 'right'} {abs(dx) * 1000:.3g} mm\nin {mode}")  # fmt: skip
         rows.append((str(i), times, does,
                      f"{joint_title(ph.effort_joint)} {word}", f"{_range(ph.command, unit)}\n{sense}",
@@ -152,22 +181,58 @@ def _letters(n):
     return [chr(ord("A") + k) if k < 26 else f"A{k - 25}" for k in range(n)]
 
 
+def _velocity_controlled(plan, joint) -> list:
+    """Per phase, whether ``joint`` is velocity-controlled in it (not its torque-controlled joint)."""
+    return [not (is_contact(ph) and ph.effort_joint == joint) for ph in plan.phases]
+
+
+def _velocity_panels(plan, joints, units) -> list:
+    """The velocity panels: ``joints`` in groups that share one, joints of one unit never velocity-controlled in the
+    same phase (the paper hand's fingers when each is torque-controlled in turn: one panel, a line each)."""
+    groups = []
+    for joint in joints:
+        mine = np.array(_velocity_controlled(plan, joint))
+        for group in groups:
+            if units[group[0]] == units[joint] and not any(np.any(mine & _velocity_controlled(plan, j)) for j in group):
+                group.append(joint)
+                break
+        else:
+            groups.append([joint])
+    return groups
+
+
+def _joints_title(joints) -> str:
+    """Joints in words: ``"left and right finger"``, ``"left_jaw and right_jaw joint"``."""
+    word = "finger" if all(j in ("left", "right") for j in joints) else "joint"
+    return f"{', '.join(joints[:-1])} and {joints[-1]} {word}"
+
+
 def _shade_other_control(ax, plan, joint, torque: bool) -> bool:
-    """Hatch where ``joint`` is under the other kind of control, and say so where there is room; whether any."""
+    """Hatch where ``joint`` (or every joint of a list) is under the other kind of control, and say so where there is
+    room; whether any."""
     t0, t1 = float(plan.phases[0].t[0]), float(plan.duration)
     drawn = False
+    joints = joint if isinstance(joint, (list, tuple)) else [joint]
     for ph in plan.phases:
-        mine = is_contact(ph) and ph.effort_joint == joint
-        if mine == torque:
+        mine = any(is_contact(ph) and ph.effort_joint == j for j in joints)
+        if torque and mine:
+            continue
+        if not torque and not all(is_contact(ph) and ph.effort_joint == j for j in joints):
             continue
         a, b = float(ph.t[0]), float(ph.t[-1])
         ax.axvspan(a, b, fc="none", ec="0.8", hatch="////", lw=0, zorder=0)
         drawn = True
-        if (b - a) > 0.18 * (t1 - t0):
-            ax.text(0.5 * (a + b), 0.5, "velocity-controlled" if torque else "torque-controlled (band above)",
-                    transform=ax.get_xaxis_transform(), ha="center", va="center", fontsize=FONT["note"],
-                    color="0.45", bbox={"fc": "white", "ec": "none", "pad": 1.0})  # fmt: skip
+        _note(ax, a, b, t0, t1, "velocity-controlled" if torque else "torque-controlled (band above)", box=True)
     return drawn
+
+
+def _note(ax, a, b, t0, t1, text, box=False) -> None:
+    """A grey note across a stretch ``a`` to ``b`` (s) of a panel spanning ``t0`` to ``t1``, where it fits (the
+    panel's width before the layout, a little narrower than after)."""
+    room = (b - a) / max(t1 - t0, 1e-12) * ax.get_position().width * ax.get_figure(root=True).get_figwidth() * 72.0
+    if text_width(text, FONT["note"]) + 8.0 < room:
+        ax.text(0.5 * (a + b), 0.5, text, transform=ax.get_xaxis_transform(), ha="center", va="center",
+                fontsize=FONT["note"], color="0.45", bbox={"fc": "white", "ec": "none", "pad": 1.0} if box else None)
 
 
 def _facts(plan) -> str:
@@ -197,15 +262,6 @@ def _facts(plan) -> str:
     return text
 
 
-def _text_width(text, size, bold=False) -> float:
-    """Width (points) of ``text`` drawn at ``size`` points in the default font."""
-    from matplotlib.font_manager import FontProperties
-    from matplotlib.textpath import TextPath
-
-    return float(TextPath((0, 0), text, size=size, prop=FontProperties(weight="bold" if bold else "normal"))
-                 .get_extents().width)  # fmt: skip
-
-
 def _header(head, lines, xs) -> None:
     """The header's ``lines`` (:func:`_header_lines`) top down, in points, so that no two lines meet."""
     y = -4.0
@@ -227,7 +283,7 @@ def _header_lines(plan, verdict_line, ok) -> tuple:
     """``(lines, column x positions)``: each line ``(text or cells, size, colour, bold)``."""
     rows = phase_rows(plan)
     size, gap = FONT["note"], 9.0
-    widths = [max(_text_width(line, size, bold=r is _COLUMNS) for r in rows + [_COLUMNS] for line in r[c].split("\n"))
+    widths = [max(text_width(line, size, bold=r is _COLUMNS) for r in rows + [_COLUMNS] for line in r[c].split("\n"))
               for c in range(len(_COLUMNS))]  # fmt: skip
     xs = list(np.cumsum([0.0] + [w + gap for w in widths[:-1]]))
     lines = [(f"Plan card: {plan.task.name}", FONT["suptitle"] + 1, "k", True)]
@@ -251,13 +307,37 @@ def _offset(sub, points, x_points=0.0):
     return offset_copy(sub.transSubfigure, fig=sub.get_figure(root=True), x=x_points, y=points, units="points")
 
 
-def _snapshot_row(sub, plan, shots, letters) -> set:
-    """The snapshots, each titled with its letter, time, role and what the hand does; what was drawn."""
+def _layout(plan, shots, n_torque, n_velocity, grid_in) -> tuple:
+    """``(snapshot rows, snapshot block height, torque panel height, velocity panel height)`` (inches of the body's
+    grid, ``grid_in`` high; its ratios).
+
+    The snapshots on one row while they are at least :data:`MIN_SNAPSHOT_WIDTH` wide there (else two), as wide as
+    their columns allow up to :data:`_SNAPSHOT_MAX_WIDTH`; the panels share the rest in proportion to their usual
+    heights, never below their least (then the snapshots give way).
+    """
+    from qsplan.planner.plotting.hands import hand_limits
+
+    (x0, x1), (y0, y1) = hand_limits(plan.task.hand, [(s.pose, s.q) for s in shots])
+    aspect = (y1 - y0) / (x1 - x0)
+    rows = 1 if _SNAPSHOT_ROW_WIDTH / len(shots) - 0.2 >= MIN_SNAPSHOT_WIDTH else 2
+    cols = -(-len(shots) // rows)
+    width = min(_SNAPSHOT_ROW_WIDTH / cols - 0.2, _SNAPSHOT_MAX_WIDTH)
+    least = n_torque * _TORQUE_MIN + n_velocity * _VELOCITY_MIN
+    room = grid_in - _TIMELINE_HEIGHT - least  # for the snapshots, the panels at their least
+    snap = min(rows * (width * aspect + _SNAPSHOT_TITLE), max(room, rows * (0.6 * width * aspect + _SNAPSHOT_TITLE)))
+    want = n_torque * _TORQUE_HEIGHT + n_velocity * _VELOCITY_HEIGHT
+    k = (grid_in - _TIMELINE_HEIGHT - snap) / want if want else 1.0
+    return rows, snap, max(_TORQUE_HEIGHT * k, _TORQUE_MIN), max(_VELOCITY_HEIGHT * k, _VELOCITY_MIN)
+
+
+def _snapshot_row(sub, plan, shots, letters, rows) -> set:
+    """The snapshots on ``rows`` rows, each titled with its letter, time, role and what the hand does; what was
+    drawn."""
     from qsplan.planner.plotting.hands import hand_limits, plot_hand
 
     lim = hand_limits(plan.task.hand, [(s.pose, s.q) for s in shots])
-    rows = 1 if len(shots) <= 5 else 2
     cols = -(-len(shots) // rows)
+    column = 72.0 * _SNAPSHOT_ROW_WIDTH / cols - 6.0  # points: a title's room
     axes = sub.subplots(rows, cols, squeeze=False).ravel()
     drawn = set()
     for i, (ax, s, letter) in enumerate(zip(axes, shots, letters)):
@@ -265,20 +345,34 @@ def _snapshot_row(sub, plan, shots, letters) -> set:
                   scale_bar=i == 0, effort_sign=s.effort if s.effort_joint else None)  # fmt: skip
         drawn |= ({"contacts"} if s.touching else set()) | ({"effort"} if s.effort_joint else set())
         role = {"start": ", start", "end": ", end"}.get(s.role, "")
-        state = s.state if len(s.off) != 1 or s.state not in ("open", "closing") else f"{s.off[0]} finger {s.state}"
-        ax.set_title(f"{letter}: t = {s.t:.3g} s{role}\nphase {s.phase}: {state}", fontsize=FONT["note"], pad=2)
+        state = state_words(plan, s.phase, s.state)
+        state = state if len(s.off) != 1 or s.state not in ("open", "closing") else f"{s.off[0]} finger {s.state}"
+        title = f"{letter}: t = {s.t:.3g} s{role}\nphase {s.phase}: {state}"
+        if text_width(title, FONT["note"]) > column:  # too wide for its column: the phase on the first line
+            title = f"{letter}: t = {s.t:.3g} s{role}, phase {s.phase}\n{state}"
+        ax.set_title(title, fontsize=FONT["note"], pad=2)
     for ax in axes[len(shots):]:
         ax.set_visible(False)
     return drawn
 
 
-def _torque_panel(ax, plan, joint, res) -> set:
-    """One joint's commands inside their bands, slack and narrowest marked; what was drawn."""
+def _phases_text(numbers) -> str:
+    """Phase numbers in words: ``"phase 0"``, ``"phases 1-2"``, ``"phases 1, 3"``."""
+    if len(numbers) == 1:
+        return f"phase {numbers[0]}"
+    run = list(range(numbers[0], numbers[-1] + 1)) == list(numbers)
+    return f"phases {numbers[0]}-{numbers[-1]}" if run else "phases " + ", ".join(str(n) for n in numbers)
+
+
+def _torque_panel(ax, plan, joint, segs, res, parts: int) -> set:
+    """One joint's commands inside their bands on one scale (``segs``, one of :func:`scale_groups`' runs; ``parts``
+    runs in all), slack and narrowest marked; what was drawn."""
     hand = plan.task.hand
-    segs = [p for p in plan.phases if is_contact(p) and p.effort_joint == joint]
-    ylim = torque_limits(segs, res)
+    ylim, log = torque_scale(segs, res)
     word, unit = effort_words(hand, joint)
     drawn = set()
+    if log:
+        ax.set_yscale("log")
     for seg in segs:
         drawn |= draw_band(ax, seg.t, seg.lower, seg.upper, seg.command, joint_colour(hand, joint), ylim, label=False)
         k = int(np.argmin(seg.width))
@@ -288,13 +382,30 @@ def _torque_panel(ax, plan, joint, res) -> set:
             drawn.add("slack")
     if _shade_other_control(ax, plan, joint, torque=True):
         drawn.add("hatch")
+    if parts > 1:  # this joint's phases drawn on another scale: said where there is room
+        t0, t1 = float(plan.phases[0].t[0]), float(plan.duration)
+        for ph in plan.phases:
+            if is_contact(ph) and ph.effort_joint == joint and not any(ph is m for m in segs):
+                _note(ax, float(ph.t[0]), float(ph.t[-1]), t0, t1, "in its own panel (another scale)")
     ax.set_ylim(*ylim)
-    ax.axhline(0.0, color="0.6", lw=0.5)
+    if log:
+        log_ticks(ax.yaxis, *ylim)
+    else:
+        ax.axhline(0.0, color="0.6", lw=0.5)
     symbol = "\\tau" if word == "torque" else "f"
     plus = "counter-clockwise" if word == "torque" else "along +q"
     ax.set_ylabel(f"${symbol}_{{{joint_math(joint)}}}$ ({unit})\n+: {plus}", fontsize=FONT["label"])
-    ax.set_title(f"{joint_title(joint)}: {word} command inside its guaranteed band", fontsize=FONT["label"], loc="left")
+    number = {id(p): i for i, p in enumerate(plan.phases)}
+    which = f", {_phases_text([number[id(m)] for m in segs])}" if parts > 1 else ""
+    which += " (log scale)" if log else ""
+    ax.set_title(f"{joint_title(joint)}: {word} command inside its guaranteed band{which}", fontsize=FONT["label"],
+                 loc="left")  # fmt: skip
     return drawn
+
+
+#: Every key :func:`_legend_handles` knows (the most a legend may list).
+_ALL_MARKS = frozenset({"contacts", "effort", "band", "upper", "lower", "upper_inf", "upper_off", "lower_inf", "lower_off",
+                        "command", "slack", "narrowest", "hatch"})
 
 
 def _legend_handles(plan, drawn, torque_joints) -> list:
@@ -354,35 +465,47 @@ def plan_card(plan, certificate=None, replays=(), snapshots: int = MAX_SNAPSHOTS
     letters = _letters(len(shots))
     torque_joints = [j for j in names if any(is_contact(p) and p.effort_joint == j for p in plan.phases)]
     velocity_joints = [j for k, j in enumerate(names) if any(np.isfinite(p.qd[:, k]).any() for p in plan.phases)]
+    velocity_panels = _velocity_panels(plan, velocity_joints, units)
     fig = Figure(figsize=A4_PORTRAIT, layout="constrained")
     lines, xs = _header_lines(plan, *verdict(certificate, replays))
     head_in = (8.0 + sum(_height(text, size) for text, size, _, _ in lines) + 4.0) / 72.0
     head, body = fig.subfigures(2, 1, height_ratios=[head_in, A4_PORTRAIT[1] - head_in])
     _header(head, lines, xs)
-    heights = [3.3 if len(shots) > 5 else 1.7, 0.5] + [2.3] * len(torque_joints) + [1.05] * len(velocity_joints)
+    res = plan.task.torque_resolution
+    panels = [(joint, segs, len(groups)) for joint in torque_joints
+              for groups in [scale_groups([p for p in plan.phases if is_contact(p) and p.effort_joint == joint], res)]
+              for segs in groups]  # fmt: skip
+    entries = len(_legend_handles(plan, _ALL_MARKS, torque_joints))  # at most: what is drawn is known later
+    grid_in = A4_PORTRAIT[1] - head_in - _BODY_MARGIN - _LEGEND_LINE * -(-entries // 2)
+    rows, snap_h, torque_h, velocity_h = _layout(plan, shots, len(panels), len(velocity_panels), grid_in)
+    heights = [snap_h, _TIMELINE_HEIGHT] + [torque_h] * len(panels) + [velocity_h] * len(velocity_panels)
     grid = body.add_gridspec(len(heights), 1, height_ratios=heights)
-    drawn = _snapshot_row(body.add_subfigure(grid[0]), plan, shots, letters)
+    drawn = _snapshot_row(body.add_subfigure(grid[0]), plan, shots, letters, rows)
     timeline = body.add_subplot(grid[1])
     plot_mode_timeline(plan, timeline, marks=list(zip([s.t for s in shots], letters)), legend=False, xlabel=False,
                        compact=True)  # fmt: skip
     axes = [timeline]
-    res = plan.task.torque_resolution
-    for i, joint in enumerate(torque_joints):
+    for i, (joint, segs, parts) in enumerate(panels):
         ax = body.add_subplot(grid[2 + i], sharex=timeline)
-        drawn |= _torque_panel(ax, plan, joint, res)
+        drawn |= _torque_panel(ax, plan, joint, segs, res, parts)
         axes.append(ax)
-    for joint in velocity_joints:
+    ticks = plan.sample(tick_times(plan.duration, min(VELOCITY_RATE, VELOCITY_TICKS / plan.duration)))
+    for group in velocity_panels:
         ax = body.add_subplot(grid[len(axes) + 1], sharex=timeline)
-        for ph in plan.phases:  # a free motion's rows hold the velocity until the next row: steps
-            ax.plot(ph.t, ph.qd[:, names.index(joint)], color=joint_colour(hand, joint), lw=1.3,
-                    drawstyle="default" if is_contact(ph) else "steps-post")  # fmt: skip
-        if _shade_other_control(ax, plan, joint, torque=False):
+        for joint in group:  # what the controller is sent: each tick's velocity held until the next (qsplan sample's
+            # rule); nan under torque control
+            ax.plot(ticks.t, ticks.qd[:, names.index(joint)], color=joint_colour(hand, joint), lw=1.3,
+                    drawstyle="steps-post")  # fmt: skip
+        if _shade_other_control(ax, plan, group, torque=False):
             drawn.add("hatch")
         ax.axhline(0.0, color="0.6", lw=0.5)
-        short = joint in ("left", "right")  # a described hand's long joint names stay in the title: short panels
+        joint = group[0]
+        short = len(group) == 1 and joint in ("left", "right")  # a described hand's long names stay in the title
         ax.set_ylabel(f"$\\dot q_{{{joint}}}$ ({units[joint]})" if short else f"$\\dot q$ ({units[joint]})",
                       fontsize=FONT["label"])  # fmt: skip
-        ax.set_title(f"{joint_title(joint)}: velocity command", fontsize=FONT["label"], loc="left")
+        what = (f"{joint_title(joint)}: velocity command" if len(group) == 1 else
+                f"{_joints_title(group)}: velocity command, each in its colour while velocity-controlled")
+        ax.set_title(what, fontsize=FONT["label"], loc="left")
         axes.append(ax)
     switches = [float(p.t[0]) for p in plan.phases[1:]]
     for ax in axes:
@@ -397,4 +520,5 @@ def plan_card(plan, certificate=None, replays=(), snapshots: int = MAX_SNAPSHOTS
     handles = _legend_handles(plan, drawn, torque_joints)
     ncol = 3 if max(len(h.get_label()) for h in handles) <= LEGEND_LABEL_CHARS else 2
     body.legend(handles=handles, loc="outside lower center", ncol=ncol, fontsize=FONT["legend"], frameon=False)
+    place_labels(fig)  # once the layout is known: the marks' labels where they cover no data
     return fig

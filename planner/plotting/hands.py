@@ -26,8 +26,8 @@ from qsplan.mechanics.model.geometry import CONTACT_TOL
 from qsplan.planner.plotting.plan_panels import is_contact
 from qsplan.planner.plotting.style import FONT, axes_or_new, body_style, joint_colour
 
-__all__ = ["phase_pose", "STATES", "TOUCH_TOL", "Snapshot", "effort_direction", "fingers_touching", "hand_limits", "hand_strip_figure",
-           "plan_snapshots", "plot_hand", "row_state", "snapshot_legend_handles"]
+__all__ = ["phase_pose", "SAME_CONFIGURATION", "STATES", "TOUCH_TOL", "Snapshot", "effort_direction", "fingers_touching", "hand_limits", "hand_strip_figure",
+           "pivot_vertex", "plan_snapshots", "plot_hand", "row_state", "snapshot_legend_handles", "state_words"]
 
 #: Relative length of the drawn contact normals (of the finger length, :func:`qsplan.hands.interface.finger_reach`).
 _NORMAL = 0.12
@@ -43,8 +43,14 @@ TOUCH_TOL = CONTACT_TOL
 #: rounding (1e-16 relative), far below any visible motion (10 micrometres at the tip of a 10 cm link).
 _EFFORT_STEP = 1e-4
 
-#: What the hand does at a row of a plan, in the operator's words (:func:`row_state`).
-STATES = ("sliding", "holding", "open", "closing")
+#: Two rows whose workpiece poses and joints differ by at most this (m, rad; m for a prismatic joint) show one
+#: configuration (:func:`plan_snapshots` draws it once): a micron or a microradian, far below what a drawing shows,
+#: far above the rounding of a hold's end and the pivot's closed-form start (1e-16 relative).
+SAME_CONFIGURATION = 1e-6
+
+#: What the hand does at a row of a plan, in the operator's words (:func:`row_state`; a pivot's in full:
+#: :func:`state_words`).
+STATES = ("sliding", "holding", "pivoting", "open", "closing")
 
 
 def fingers_touching(hand, pose, q) -> dict:
@@ -308,8 +314,9 @@ def row_state(plan, i, k) -> tuple:
 
     ``"open"``: a finger is off the workpiece (:func:`qsplan.planner.plotting.hands.fingers_touching`);
     ``"closing"``: off, after a row already off and before a row where every finger touches again (the fingers'
-    approach to the next grasp); ``"sliding"``: every finger touches and the workpiece moves along the phase;
-    ``"holding"``: every finger touches and the workpiece stays (a regrasp's release and re-closed grasp).
+    approach to the next grasp); ``"pivoting"``: a pivot phase (the workpiece turns on a palm vertex);
+    ``"holding"``: a hold phase, or every finger touches and the workpiece stays (a regrasp's release and re-closed
+    grasp); ``"sliding"``: every finger touches and the workpiece moves along the phase.
     """
     ph = plan.phases[i]
     off = _off(plan, ph, k)
@@ -317,18 +324,41 @@ def row_state(plan, i, k) -> tuple:
         n = ph.t.size
         approach = 0 < k < n - 1 and not _off(plan, ph, k + 1) and bool(_off(plan, ph, k - 1))
         return ("closing" if approach else "open"), off
+    kind = getattr(ph, "kind", None) if is_contact(ph) else None
+    if kind in ("pivot", "hold"):
+        return ("pivoting" if kind == "pivot" else "holding"), off
     moving = np.size(ph.x) > 1 and float(np.ptp(ph.x)) > 0.0
     return ("sliding" if moving else "holding"), off
 
 
+def pivot_vertex(plan, i):
+    """The workpiece vertex (as the task writes it) phase ``i`` pivots on, from the plan's ``sequence`` (one step per
+    phase, :class:`qsplan.planner.plan.steps.PivotStep`); None when the plan does not say (or phase ``i`` is no
+    pivot)."""
+    steps = [s for s in plan.sequence if getattr(s, "kind", None) != "search"]
+    if len(steps) != len(plan.phases) or getattr(steps[i], "kind", None) != "pivot":
+        return None
+    return int(steps[i].vertex)
+
+
+def state_words(plan, i, state) -> str:
+    """``state`` (:func:`row_state`) of phase ``i`` for a title: a pivot's with its vertex (``"pivoting on vertex
+    1"``), any other as it is."""
+    if state != "pivoting":
+        return state
+    vertex = pivot_vertex(plan, i)
+    return "pivoting" if vertex is None else f"pivoting on vertex {vertex}"
+
+
 def _candidates(plan, per_segment) -> dict:
     """``{(phase, row): priority}``: 0 the plan's first and last rows; 1 each phase's ends and a regrasp's first and
-    last rows off the workpiece; 2 the rest (a segment's inner samples, a regrasp's other rows)."""
+    last rows off the workpiece; 2 the rest (a segment's inner samples, a regrasp's other rows; a hold has none)."""
     out = {}
     for i, ph in enumerate(plan.phases):
         n = ph.t.size
-        if is_contact(ph):
-            rows = np.unique(np.round(np.linspace(0, n - 1, max(2, per_segment))).astype(int))
+        if is_contact(ph):  # a hold moves nothing: its ends only
+            count = 2 if getattr(ph, "kind", None) == "hold" else max(2, per_segment)
+            rows = np.unique(np.round(np.linspace(0, n - 1, count)).astype(int))
             out |= {(i, int(k)): 1 if k in (0, n - 1) else 2 for k in rows}
         else:
             off = [k for k in range(n) if _off(plan, ph, k)]
@@ -338,12 +368,21 @@ def _candidates(plan, per_segment) -> dict:
     return out
 
 
+def _same_configuration(plan, a, b) -> bool:
+    """Whether rows ``a`` and ``b`` (``(phase, row, ...)``) show one configuration (:data:`SAME_CONFIGURATION`)."""
+    (i, k), (j, m) = a[:2], b[:2]
+    pa, pb = phase_pose(plan, plan.phases[i], k), phase_pose(plan, plan.phases[j], m)
+    qa, qb = np.asarray(plan.phases[i].q[k], float), np.asarray(plan.phases[j].q[m], float)
+    return bool(np.max(np.abs(pa - pb)) <= SAME_CONFIGURATION and np.max(np.abs(qa - qb)) <= SAME_CONFIGURATION)
+
+
 def plan_snapshots(plan, per_segment: int = 3, limit: int | None = None) -> list:
     """The configurations to draw, in time order: the plan's start and end always, each phase's ends, ``per_segment``
     rows along each in-contact segment and a regrasp's rows off the workpiece, at most ``limit``.
 
-    Where two phases meet (same time, same configuration) the later phase's row is kept.  Beyond ``limit`` the rows
-    of least priority go first, thinned evenly (the start and the end stay).
+    Where two phases meet (same time, same configuration) the later phase's row is kept; a row showing the
+    configuration of the row before it (after a hold: nothing moved) is left out.  Beyond ``limit`` the rows of least
+    priority go first, thinned evenly (the start and the end stay).
 
     Returns
     -------
@@ -355,7 +394,11 @@ def plan_snapshots(plan, per_segment: int = 3, limit: int | None = None) -> list
         t = float(plan.phases[i].t[k])
         old = by_t.get(t)
         by_t[t] = (i, k, min(prio, old[2]) if old else prio)
-    keys = [by_t[t] for t in sorted(by_t)]
+    keys = []
+    for key in (by_t[t] for t in sorted(by_t)):  # nothing moved since the last one (a hold): the same picture
+        if keys and key[2] > 0 and _same_configuration(plan, keys[-1], key):
+            continue
+        keys.append(key)
     if limit is not None and len(keys) > limit:
         kept = []
         for prio in (0, 1, 2):

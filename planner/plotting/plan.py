@@ -20,16 +20,18 @@ import numpy as np
 from qsplan.mechanics.errors import SceneError
 from qsplan.mechanics.model.geometry import CONTACT_TOL
 
-from qsplan.planner.plotting.hands import fingers_touching, phase_pose, row_state
+from qsplan.planner.plotting.hands import fingers_touching, phase_pose, row_state, state_words
 from qsplan.planner.plotting.plan_panels import (
     draw_band,
     effort_words,
     is_contact,
     joint_math,
+    log_ticks,
     mark_narrowest,
     phase_label,
+    place_labels,
     plot_mode_timeline,
-    torque_limits,
+    torque_scale,
 )
 from qsplan.planner.plotting.style import FONT, joint_colour, legend_below, torque_text
 
@@ -49,7 +51,8 @@ def plot_plan_bands(plan, axes=None, sharey=False):
 
     One panel per segment (N m against s from the plan's start), titled with its phase number as in
     ``plan.csv``, each scaled to its command, lower edge and margin (bands differ by orders of magnitude
-    between segments), or one scale for all with ``sharey``.  Upper edges solid, lower edges dashed; an
+    between segments; a log scale where its command spans more than a decade:
+    :func:`qsplan.planner.plotting.plan_panels.torque_scale`), or one scale for all with ``sharey``.  Upper edges solid, lower edges dashed; an
     edge beyond the panel is marked at its side, with filled triangles where it is unbounded and hollow
     ones where it is finite; the narrowest point is marked with its width when both its edges are in
     view, and said in the title either way.
@@ -69,26 +72,32 @@ def plot_plan_bands(plan, axes=None, sharey=False):
     from qsplan.planner.plotting.style import new_axes
 
     segs = plan.segments
-    if axes is None:
+    own = axes is None
+    if own:
         _, grid = new_axes(1, len(segs), size=(8.0, 2.1))
         axes = [row[0] for row in grid]
     res = plan.task.torque_resolution
-    shared = torque_limits(segs, res) if sharey else None
+    shared = torque_scale(segs, res) if sharey else None
     hand = plan.task.hand
     number = {id(p): i for i, p in enumerate(plan.phases)}
     for ax, seg in zip(axes, segs):
-        ylim = shared or torque_limits([seg], res)
+        ylim, log = shared or torque_scale([seg], res)
         word, unit = effort_words(hand, seg.effort_joint)
+        if log:
+            ax.set_yscale("log")
         draw_band(ax, seg.t, seg.lower, seg.upper, seg.command, joint_colour(hand, seg.effort_joint), ylim, word=word)
         mark_narrowest(ax, seg, ylim, unit=unit)
-        ax.axhline(0.0, color="0.6", lw=0.5)
+        if log:
+            log_ticks(ax.yaxis, *ylim, most=6)
+        else:
+            ax.axhline(0.0, color="0.6", lw=0.5)
         ax.set_ylim(*ylim)
         ax.set_xlim(seg.t[0], seg.t[-1])
         symbol = "\\tau" if word == "torque" else "f"
         ax.set_ylabel(f"${symbol}_{{{joint_math(seg.effort_joint)}}}$ ({unit})", fontsize=FONT["label"])
         mode, control = phase_label(seg, hand)
         width = float(np.min(seg.width))
-        ax.set_title(f"phase {number[id(seg)]}: {mode}, {control}-controlled; smallest margin "
+        ax.set_title(f"phase {number[id(seg)]}: {mode}, {control}-controlled{' (log scale)' if log else ''}; smallest margin "
                      f"{torque_text(np.min(seg.margin), unit)}; narrowest band "
                      f"{torque_text(width, unit) if np.isfinite(width) else 'unbounded'}", fontsize=FONT["note"] + 0.5,
                      loc="left")  # fmt: skip
@@ -102,6 +111,8 @@ def plot_plan_bands(plan, axes=None, sharey=False):
     model = "one shared coefficient" if plan.task.shared_mu else "each contact's coefficient"
     axes[0].get_figure(root=False).suptitle(f"{plan.task.name}: torque bands guaranteed for {model} in [{lo:g}, "
                                             f"{hi:g}];\ncontroller resolution {res:g} N m", fontsize=FONT["title"])  # fmt: skip
+    if own:  # the figure is complete: the labels where they cover no data
+        place_labels(axes[0].get_figure(root=True))
     return list(axes)
 
 
@@ -130,7 +141,7 @@ def plan_snapshots_figure(plan, per_phase=3, columns=SNAPSHOT_COLUMNS):
     for i, (ax, s) in enumerate(zip(flat, shots)):
         plot_hand(plan.task.hand, s.pose, s.q, ax=ax, contacts=s.touching, effort_joint=s.effort_joint, limits=lim,
                   scale_bar=i == 0, effort_sign=s.effort if s.effort_joint else None)  # fmt: skip
-        ax.set_title(f"t = {s.t:.3g} s\nphase {s.phase}: {s.state}", fontsize=FONT["note"])
+        ax.set_title(f"t = {s.t:.3g} s\nphase {s.phase}: {state_words(plan, s.phase, s.state)}", fontsize=FONT["note"])
     for ax in flat[len(shots):]:
         ax.set_visible(False)
     handles = snapshot_legend_handles(effort=any(s.effort_joint for s in shots), hand=plan.task.hand,
@@ -281,7 +292,7 @@ def animation_frames(plan, max_frames: int) -> list:
             nxt = not [s for s, on in fingers_touching(hand, pose, ph.q[k + 1]).items() if not on]
             state = ("closing" if nxt else "open") if off else "holding"
         contacts = []
-        if state in ("sliding", "holding"):
+        if state in ("sliding", "holding", "pivoting"):
             j = min(k + 1, ph.t.size - 1)
             moving = is_contact(ph) and j != k
             nxt = (phase_pose(plan, ph, j), ph.q[j]) if moving else (pose, q)

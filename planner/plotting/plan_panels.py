@@ -7,7 +7,10 @@ drawn as a free motion of the fingers), so plans with more phases or fields draw
 :func:`qsplan.planner.plotting.hands.plan_snapshots`).  Phases are numbered as
 ``plan.csv`` numbers them (``phase`` 0 first).  Band edges are marked as in Fig. 13
 (:func:`qsplan.planner.plotting.band_panels.plot_band_sweep`): beyond the plot, filled triangles where an edge is
-unbounded, hollow ones where it is finite.  matplotlib is imported inside the functions.
+unbounded, hollow ones where it is finite.  Phases of very different torques get panels of their own, a panel
+whose command spans more than a decade a log scale (:func:`scale_groups`, :func:`torque_scale`); the labels of the
+marks are placed once the figure is laid out, where they cover no line (:func:`place_labels`).  matplotlib is
+imported inside the functions.
 """
 
 from __future__ import annotations
@@ -27,12 +30,15 @@ from qsplan.planner.plotting.style import (
     finger_colour,
     joint_colour,
     legend_below,
+    step_colour,
+    text_width,
     torque_text,
 )
 
-__all__ = ["SLACK", "draw_band", "edge_marker", "effort_sense", "effort_words", "is_contact", "joint_math",
-           "joint_title", "mark_narrowest", "mark_slack", "phase_colour", "phase_label", "plot_mode_timeline", "slack",
-           "timeline_handles", "torque_limits"]
+__all__ = ["LOG_SPAN", "MOVABLE", "SCALE_SHARE", "SLACK", "draw_band", "edge_marker", "effort_sense", "effort_words",
+           "is_contact", "joint_math", "joint_title", "log_ticks", "mark_narrowest", "mark_slack", "phase_colour",
+           "phase_label", "place_labels", "plot_mode_timeline", "scale_groups", "slack", "timeline_handles",
+           "torque_limits", "torque_scale"]
 
 #: Colour of the slack marks (the command's margin to the nearer band edge).
 SLACK = "#1a7f37"
@@ -100,10 +106,12 @@ def phase_label(phase, hand=None) -> tuple:
 
 
 def phase_colour(phase, hand=None) -> str:
-    """The colour of a phase: its torque-controlled joint's finger's, grey for a regrasp."""
+    """The colour of a phase: its torque-controlled joint's finger's, shaded by what it does (a slide as is, a hold
+    lighter, a pivot darker: :func:`qsplan.planner.plotting.style.step_colour`), grey for a regrasp."""
     if not is_contact(phase):
         return REGRASP
-    return finger_colour(phase.effort_joint) if hand is None else joint_colour(hand, phase.effort_joint)
+    base = finger_colour(phase.effort_joint) if hand is None else joint_colour(hand, phase.effort_joint)
+    return step_colour(base, getattr(phase, "kind", "slide"))
 
 
 def torque_limits(segments, resolution=0.0) -> tuple:
@@ -130,6 +138,71 @@ def torque_limits(segments, resolution=0.0) -> tuple:
     bottom = float(np.min(low))
     pad = 0.06 * (top - bottom)
     return bottom - pad, top + pad
+
+
+#: Each phase's own torque range (:func:`torque_limits`) takes at least this share of the height of the panel it is
+#: drawn in; phases whose ranges differ more get panels of their own (:func:`scale_groups`): a reorientation's
+#: 0.1-0.35 N m slide beside its hold and pivot up to 4 N m.
+SCALE_SHARE = 1.0 / 3.0
+
+#: A panel whose commands span more than this ratio (largest to smallest, every command, lower edge and finite upper
+#: edge positive) is drawn on a log scale (:func:`torque_scale`): a pivot's command comes down from the transition's
+#: 4 N m to 0.09 N m, and its 0.04 N m slack must stay visible at both ends.
+LOG_SPAN = 10.0
+
+#: A log panel's bottom: this factor below its least command or lower edge (a margin like the linear panels' 6 %).
+_LOG_PAD = 1.5
+
+
+def scale_groups(segments, resolution=0.0) -> list:
+    """``segments`` (one joint's, in time order) split into runs drawn on one torque scale: a segment joins the run
+    before it while every member's own range (:func:`torque_limits`) stays at least :data:`SCALE_SHARE` of the run's.
+
+    Returns
+    -------
+    list of list
+        The runs, in time order.
+    """
+    groups = []
+    own = {id(s): float(np.subtract(*torque_limits([s], resolution)[::-1])) for s in segments}
+    for seg in segments:
+        if groups:
+            trial = groups[-1] + [seg]
+            lo, hi = torque_limits(trial, resolution)
+            if all(own[id(m)] >= SCALE_SHARE * (hi - lo) for m in trial):
+                groups[-1] = trial
+                continue
+        groups.append([seg])
+    return groups
+
+
+def torque_scale(segments, resolution=0.0) -> tuple:
+    """``((bottom, top), log)``: the y-limits of a panel of ``segments`` and whether it is drawn on a log scale.
+
+    Linear (:func:`torque_limits`) unless the commands span more than :data:`LOG_SPAN` and every command, finite lower
+    edge and finite upper edge is positive: then from :data:`_LOG_PAD` below the least command or lower edge to the
+    linear rule's top.
+    """
+    lin = torque_limits(segments, resolution)
+    cmd = np.concatenate([s.command for s in segments])
+    lower = np.concatenate([s.lower for s in segments])
+    edges = np.concatenate([lower, np.concatenate([s.upper for s in segments])])
+    edges = edges[np.isfinite(edges)]
+    if not (np.all(cmd > 0) and np.all(edges > 0) and float(np.max(cmd)) > LOG_SPAN * float(np.min(cmd))):
+        return lin, False
+    low = float(np.min(np.concatenate([cmd, lower[np.isfinite(lower)]])))
+    return (low / _LOG_PAD, lin[1]), True
+
+
+def log_ticks(axis, lo, hi, most: int = 10) -> None:
+    """Ticks of a log-scaled ``axis`` from ``lo`` to ``hi`` (positive) in plain numbers (``0.05``, ``1``): at 1, 2 and 5
+    times each power of ten, or at the powers alone where that would make more than ``most`` (labels stay apart)."""
+    from matplotlib.ticker import FuncFormatter, LogLocator, NullFormatter
+
+    subs = (1.0,) if 3.0 * np.log10(hi / lo) > most else (1.0, 2.0, 5.0)
+    axis.set_major_locator(LogLocator(subs=subs))
+    axis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:g}"))
+    axis.set_minor_formatter(NullFormatter())
 
 
 def edge_marker(ax, t, y, side, infinite, colour, label=None, ms=5.0):
@@ -189,9 +262,9 @@ def mark_narrowest(ax, seg, ylim, label=True, unit: str = "N m") -> bool:
     right = t < 0.5 * (seg.t[0] + seg.t[-1])
     c = float(seg.command[k])  # the label sits beside the arrow, halfway from the command to the farther end
     y = 0.5 * (c + up) if up - c > c - lo else 0.5 * (lo + c)
-    ax.annotate(f"narrowest {torque_text(up - lo, unit)}", (t, y), xytext=(3 if right else -3, 0),
-                textcoords="offset points", ha="left" if right else "right", va="center", fontsize=FONT["note"],
-                color=NARROWEST, bbox={"boxstyle": "round,pad=0.15", "fc": "white", "ec": "none", "alpha": 0.85})  # fmt: skip
+    if ax.get_yscale() == "log":
+        y = float(np.sqrt(c * (up if up - c > c - lo else lo)))
+    _movable(ax, f"narrowest {torque_text(up - lo, unit)}", (t, y), right, NARROWEST, 3)
     if label:
         ax.plot([], [], color=NARROWEST, marker="$\\updownarrow$", ls="none", ms=9, label="narrowest band (width)")
     return True
@@ -223,10 +296,143 @@ def mark_slack(ax, seg, ylim, unit: str = "N m", avoid=None) -> bool:
     ax.annotate("", xy=(t, e), xytext=(t, c), arrowprops={"arrowstyle": "|-|,widthA=0.25,widthB=0.25", "color": SLACK,
                                                          "lw": 1.2, "shrinkA": 0, "shrinkB": 0})  # fmt: skip
     right = t < 0.5 * (seg.t[0] + seg.t[-1])
-    ax.annotate(f"slack {torque_text(value, unit)}", (t, 0.5 * (c + e)), xytext=(4 if right else -4, 0),
-                textcoords="offset points", ha="left" if right else "right", va="center", fontsize=FONT["note"],
-                color=SLACK, bbox={"boxstyle": "round,pad=0.15", "fc": "white", "ec": "none", "alpha": 0.85})  # fmt: skip
+    y = float(np.sqrt(c * e)) if ax.get_yscale() == "log" else 0.5 * (c + e)
+    _movable(ax, f"slack {torque_text(value, unit)}", (t, y), right, SLACK, 4)
     return True
+
+
+#: ``gid`` of the labels :func:`place_labels` moves off the data once the figure is laid out (a narrowest band's
+#: width, a slack's value).
+MOVABLE = "qsplan-movable-label"
+
+#: How far (points) :func:`place_labels` looks for room around a label's mark, across and along the time axis.
+_LABEL_REACH = (150.0, 90.0)
+
+#: Padding (pixels) around a label's box when it is tested against the data: its rounded box and antialiasing.
+_LABEL_PAD = 2.0
+
+
+def _movable(ax, text, xy, right, colour, gap):
+    """A label of the mark at ``xy`` (data), beside it (right of it when ``right``, ``gap`` points away), with a thin
+    leader shown only when :func:`place_labels` moves it farther."""
+    ann = ax.annotate(text, xy, xytext=(gap if right else -gap, 0), textcoords="offset points",
+                      ha="left" if right else "right", va="center", fontsize=FONT["note"], color=colour, gid=MOVABLE,
+                      bbox={"boxstyle": "round,pad=0.15", "fc": "white", "ec": "none", "alpha": 0.85},
+                      arrowprops={"arrowstyle": "-", "color": colour, "lw": 0.6, "shrinkA": 0, "shrinkB": 0})  # fmt: skip
+    ann.arrow_patch.set_visible(False)
+    ann.set_in_layout(False)
+    return ann
+
+
+def _data_shapes(ax):
+    """``(lines, extents, points)`` of ``ax``'s data in display pixels: polylines (matplotlib paths), their extents
+    (k, 4: x0, y0, x1, y1) and marker positions with their radius (m, 3).  Reference lines (axhline, axvline), spans
+    and fills are not covered data: a label on a wide band's fill hides no line of it."""
+    from matplotlib.path import Path
+
+    lines, points = [], [np.zeros((0, 3))]
+    for ln in ax.get_lines():
+        if not ln.get_visible() or ln.get_transform() != ax.transData:
+            continue
+        xy = ax.transData.transform(np.asarray(ln.get_xydata(), float))
+        ok = np.all(np.isfinite(xy), axis=1)
+        if ln.get_linestyle() not in ("None", "none", " ", ""):
+            cuts = np.flatnonzero(np.diff(ok.astype(int)) != 0) + 1
+            lines += [run for run, good in zip(np.split(xy, cuts), np.split(ok, cuts)) if good.all() and len(run) > 1]
+        if ln.get_marker() not in (None, "None", "none", "", " "):
+            r = 0.5 * ln.get_markersize() * ax.get_figure(root=True).dpi / 72.0
+            points.append(np.column_stack([xy[ok], np.full(int(ok.sum()), r)]))
+    extents = np.array([[*run.min(axis=0), *run.max(axis=0)] for run in lines]).reshape(-1, 4)
+    return [Path(run) for run in lines], extents, np.vstack(points)
+
+
+def _hits(box, shapes) -> int:
+    """How many data items of ``shapes`` (:func:`_data_shapes`) the display box ``box`` covers."""
+    lines, extents, points = shapes
+    near = np.flatnonzero((extents[:, 0] <= box.x1) & (extents[:, 2] >= box.x0) & (extents[:, 1] <= box.y1)
+                          & (extents[:, 3] >= box.y0))  # fmt: skip
+    n = sum(lines[k].intersects_bbox(box, filled=False) for k in near)
+    r = points[:, 2]
+    n += int(np.sum((points[:, 0] >= box.x0 - r) & (points[:, 0] <= box.x1 + r) & (points[:, 1] >= box.y0 - r)
+                    & (points[:, 1] <= box.y1 + r)))  # fmt: skip
+    return int(n)
+
+
+def place_labels(fig) -> None:
+    """Move every movable label (:data:`MOVABLE`) of ``fig`` where it covers no data line or mark and no other text,
+    nearest its mark first: beside it, then above or below it, then farther along the time axis (a thin leader to its
+    mark).
+
+    Lays ``fig`` out first (constrained layout): the labels are placed in display pixels of the final page, and are
+    left out of the layout so that it stays as measured.  Where no place is free, the one covering least.
+    """
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.text import Text
+    from matplotlib.transforms import Bbox
+
+    def axes(f):  # every axes of the figure and its subfigures
+        return list(f.axes) + [ax for sub in f.subfigs for ax in axes(sub)]
+
+    labels = [t for ax in axes(fig) for t in ax.texts if t.get_gid() == MOVABLE and t.get_visible()]
+    if not labels:
+        return
+    canvas = fig.canvas if isinstance(fig.canvas, FigureCanvasAgg) else FigureCanvasAgg(fig)
+    fig.draw_without_rendering()
+    renderer = canvas.get_renderer()
+    taken = {}  # per axes: the boxes of its texts and marks' arrows (pixels)
+    for ann in labels:
+        ax = ann.axes
+        if ax not in taken:
+            boxes = [t.get_window_extent(renderer) for t in ax.texts if t.get_gid() != MOVABLE and t.get_text().strip()]
+            boxes += [t.arrow_patch.get_window_extent(renderer) for t in ax.texts
+                      if getattr(t, "arrow_patch", None) is not None and t.get_gid() != MOVABLE]  # fmt: skip
+            taken[ax] = (boxes, _data_shapes(ax))
+        boxes, shapes = taken[ax]
+        frame = ax.get_window_extent(renderer)
+        anchor = ax.transData.transform(ann.xy)
+        gap, side = abs(float(ann.xyann[0])), 1.0 if ann.get_horizontalalignment() == "left" else -1.0
+        ann.update_positions(renderer)
+        size = Text.get_window_extent(ann, renderer)  # the label's box: the same wherever it goes
+        w, h, px = size.width, size.height, fig.dpi / 72.0
+        best = None
+        for dx, dy, ha, va in _label_offsets(gap, side):
+            x0 = anchor[0] + dx * px - {"left": 0.0, "right": w, "center": 0.5 * w}[ha]
+            y0 = anchor[1] + dy * px - {"bottom": 0.0, "top": h, "center": 0.5 * h}[va]
+            box = Bbox.from_extents(x0, y0, x0 + w, y0 + h).padded(_LABEL_PAD)
+            if not (frame.x0 <= box.x0 and box.x1 <= frame.x1 and frame.y0 <= box.y0 and box.y1 <= frame.y1):
+                continue
+            reach = Bbox.union([box, Bbox.from_extents(*anchor, *anchor)])  # with its leader
+            cost = 4 * sum(b.overlaps(reach) for b in boxes) + _hits(box, shapes)
+            if best is None or cost < best[0]:
+                best = (cost, dx, dy, ha, va, box, reach)
+            if cost == 0:
+                break
+        if best is None:  # no place inside the axes: where it was drawn
+            continue
+        _, dx, dy, ha, va, box, reach = best
+        ann.set_position((dx, dy))
+        ann.set_horizontalalignment(ha)
+        ann.set_verticalalignment(va)
+        ann.arrow_patch.set_visible(abs(dy) > 0 or abs(dx) > gap)
+        boxes.append(reach if ann.arrow_patch.get_visible() else box)
+
+
+def _label_offsets(gap, side) -> list:
+    """Offsets (points) and alignments tried for a label ``gap`` points beside its mark, nearest first, its own side
+    (``side``: +1 right, -1 left) before the other at one distance."""
+    reach_x, reach_y = _LABEL_REACH
+    out = []
+    for dx in np.concatenate([[gap], np.arange(12.0, reach_x + 1.0, 12.0)]):
+        for dy in np.arange(0.0, reach_y + 1.0, 6.0):
+            for sx in (side, -side):
+                for sy in ((1.0, -1.0) if dy else (1.0,)):
+                    out.append((float(np.hypot(dx, dy)), sx != side, sx * dx, sy * dy, "left" if sx > 0 else "right",
+                                "center"))  # fmt: skip
+    for dy in np.arange(6.0, reach_y + 1.0, 6.0):  # straight above or below the mark
+        for sy in (1.0, -1.0):
+            out.append((float(dy), False, 0.0, sy * dy, "center", "bottom" if sy > 0 else "top"))
+    out.sort(key=lambda o: (o[0], o[1]))
+    return [o[2:] for o in out]
 
 
 def timeline_handles(plan) -> list:
@@ -240,6 +446,10 @@ def timeline_handles(plan) -> list:
         out.setdefault((mode, control), Patch(fc=phase_colour(ph, hand), ec="k", lw=0.5, alpha=0.75,
                                               label=f"{mode}, {control}-controlled"))  # fmt: skip
     return list(out.values())
+
+
+#: Room (inches) a label keeps inside its box on the mode timeline: a little white at each end.
+_BAR_PAD = 0.08
 
 
 def plot_mode_timeline(plan, ax=None, marks=None, legend=True, xlabel=True, compact=False):
@@ -267,7 +477,9 @@ def plot_mode_timeline(plan, ax=None, marks=None, legend=True, xlabel=True, comp
     """
     ax = axes_or_new(ax, size=(9.0, 1.9))
     t0, t1 = float(plan.phases[0].t[0]), float(plan.duration)
-    width_in = ax.get_figure(root=True).get_figwidth() * 0.85
+    # the axes' width before the layout (inches): the figure's default margins, narrower than constrained layout
+    # leaves, so a label judged to fit its box does
+    width_in = ax.get_position().width * ax.get_figure(root=True).get_figwidth()
     above, last_x = [], -np.inf
     hand = plan.task.hand
     for i, ph in enumerate(plan.phases):
@@ -275,14 +487,14 @@ def plot_mode_timeline(plan, ax=None, marks=None, legend=True, xlabel=True, comp
         colour = phase_colour(ph, hand)
         ax.barh(0, b - a, left=a, height=0.8, color=colour, alpha=0.75, edgecolor="k", lw=0.5)
         mode, control = phase_label(ph, hand)
-        room = 0.92 * (b - a) / max(t1 - t0, 1e-12) * width_in
+        room = (b - a) / max(t1 - t0, 1e-12) * width_in - _BAR_PAD
         if compact:
             short = mode if not is_contact(ph) else f"{mode}, {control}"
             texts = [f"phase {i}: {short}", f"phase {i}", str(i)]
         else:
-            texts = [f"phase {i}: {mode}\n{control}"]
-        fits = [u for u in texts if max(len(v) for v in u.split("\n")) * FONT["note"] * 0.52 / 72 < room]
-        if fits:
+            texts = [f"phase {i}: {mode}\n{control}", f"phase {i}: {mode}", f"phase {i}"]
+        fits = [u for u in texts if text_width(u, FONT["note"]) / 72.0 < room]
+        if fits and (compact or fits[0] != texts[-1]):
             ax.text(0.5 * (a + b), 0, fits[0], ha="center", va="center", fontsize=FONT["note"])
         else:
             above.append((0.5 * (a + b), str(i) if compact else f"{i}: {mode}"))
@@ -311,7 +523,8 @@ def plot_mode_timeline(plan, ax=None, marks=None, legend=True, xlabel=True, comp
         ax.set_xlabel("t (s) from the plan's start", fontsize=FONT["label"])
     ax.set_title("phases as numbered in plan.csv: contact mode and the torque-controlled joint", fontsize=FONT["label"],
                  loc="left")  # fmt: skip
-    if legend:
+    if legend:  # as many columns as the axes' width holds: a wider legend would narrow the axes
         handles = timeline_handles(plan)
-        legend_below(ax, handles=handles, ncol=min(3, len(handles)))
+        column = max(text_width(h.get_label(), FONT["legend"]) for h in handles) + 3.5 * FONT["legend"]
+        legend_below(ax, handles=handles, ncol=int(np.clip(width_in * 72.0 // column, 1, min(3, len(handles)))))
     return ax

@@ -125,10 +125,12 @@ def _view(x, bars, marks) -> tuple:
     return min(lo, at.min() - VIEW_MIN_PAD), max(hi, at.max() + VIEW_MIN_PAD)
 
 
-def plot_grasp_bars(x, bars, start_x, goal_x, waypoints=(), resolution_text="at least the resolution", ax=None):
+def plot_grasp_bars(x, bars, start_x, goal_x, waypoints=(), resolution_text="at least the resolution", ax=None,
+                    goal_label="goal"):  # fmt: skip
     """One bar per grasp over the workpiece x (m): ``bars`` a list of ``(label, valid (n,), banded (2, n))``;
     ``resolution_text`` says how wide a band counts (``"\u2265 0.02 N m"``).  The view holds every valid grasp and
-    the marks (the start, the waypoints, the goal); the x label says where nothing is valid beyond it.
+    the marks (the start, the waypoints, the goal, marked ``goal_label``; ``goal_x`` None: not marked); the x label
+    says where nothing is valid beyond it.
 
     Returns
     -------
@@ -155,7 +157,8 @@ def plot_grasp_bars(x, bars, start_x, goal_x, waypoints=(), resolution_text="at 
     ax.set_yticklabels([label for label, *_ in bars], fontsize=FONT["note"])
     ax.set_ylim(-0.6, n - 0.6 + 0.2)
     marks = [(float(start_x), "start")] + [(float(w), f"w{k + 1}") for k, w in enumerate(list(waypoints)[:-1])]
-    marks.append((float(goal_x), "goal"))
+    if goal_x is not None:  # None: a goal the preview does not place (a turn)
+        marks.append((float(goal_x), goal_label))
     lo, hi = _view(x, bars, marks)
     ax.set_xlim(lo, hi)
     whole = lo <= x[0] and hi >= x[-1]
@@ -163,7 +166,8 @@ def plot_grasp_bars(x, bars, start_x, goal_x, waypoints=(), resolution_text="at 
                                        f"[{x[0]:.3g}, {x[-1]:.3g}] m"), fontsize=FONT["label"])  # fmt: skip
     marks = _marks(marks, hi - lo)
     for xm, name in marks:
-        ax.axvline(xm, color="k", lw=1.0, ls="-" if "start" in name else ("--" if "goal" in name else ":"), zorder=4)
+        ax.axvline(xm, color="k", lw=1.0, ls="-" if "start" in name else ("--" if goal_label in name else ":"),
+                   zorder=4)  # fmt: skip
     top = ax.secondary_xaxis("top")
     top.set_xticks([m for m, _ in marks])
     top.set_xticklabels([name for _, name in marks], fontsize=FONT["note"])
@@ -195,24 +199,38 @@ def preview_figure(task, preview):
     d = preview.as_dict()
     n = len(preview.grasps)
     bars_h = 1.9 + BAR_HEIGHT * n
-    checks = ((preview.start, d["start"]), (preview.goal, d["goal"]))
-    limits = hand_limits(task.hand, [(task.pose(c.x), _drawable(task, c.q)[0]) for c, _ in checks])
+    turn = preview.slide_end is not None  # a turning goal: its slide's end drawn, the turn said under it
+    checks = ((preview.start, d["start"]), (preview.slide_end, d["slide_end"]) if turn else (preview.goal, d["goal"]))
+    limits = hand_limits(task.hand, [(task.pose(c.x), _drawable(task, c.q)[0]) for c, _ in checks if c.previewed])
     (x0, x1), (y0, y1) = limits
     hand_h = float(np.clip(0.45 * FIGURE_WIDTH * (y1 - y0) / (x1 - x0), 0.6 * HAND_HEIGHT, 1.6 * HAND_HEIGHT))
-    fig = Figure(figsize=(FIGURE_WIDTH, hand_h + 1.2 + bars_h), layout="constrained")
-    top, bottom = fig.subfigures(2, 1, height_ratios=[hand_h + 1.2, bars_h])
+    head = 1.2 + (0.15 if turn else 0.0)  # titles over the hands: a turn's slide end says one line more
+    fig = Figure(figsize=(FIGURE_WIDTH, hand_h + head + bars_h), layout="constrained")
+    top, bottom = fig.subfigures(2, 1, height_ratios=[hand_h + head, bars_h])
     panels = top.subplots(1, 2)
     for ax, (check, words) in zip(panels, checks):
+        if not check.previewed:  # a turning goal the check does not judge: said, nothing drawn
+            ax.axis("off")
+            ax.text(0.0, 1.0, textwrap.fill(check.message, WRAP), transform=ax.transAxes, ha="left", va="top",
+                    fontsize=FONT["note"], color="k")  # fmt: skip
+            continue
         hits = tuple(Collision(tuple(c["bodies"]), c["area_m2"], c["depth_m"]) for c in words["collisions"])
         over = tuple(lim.joint for lim in check.limits)
         plot_configuration(task, check.x, check.q, ax=ax, collisions=hits, limits=limits, highlight=over)
         title, colour = _check_title(words)
+        if check is preview.slide_end:  # the turn after it (the verdict says how it is planned)
+            title += "\nthen " + textwrap.fill(preview.goal.message.partition("; qsplan plan")[0], WRAP)
         ax.set_title(title, fontsize=FONT["note"], color=colour, loc="left")
     ax = bottom.subplots(1, 1)
     bars = [(f"{b.name}  {b.short}", b.valid, b.banded) for b in preview.grasps]
-    plot_grasp_bars(preview.x, bars, preview.start.x, preview.goal.x, preview.waypoints,
-                    f"\u2265 {preview.resolution:g} {preview.resolution_unit}", ax=ax)  # fmt: skip
+    end = preview.slide_end if turn else preview.goal
+    plot_grasp_bars(preview.x, bars, preview.start.x, end.x if end.previewed else None, preview.waypoints,
+                    f"\u2265 {preview.resolution:g} {preview.resolution_unit}", ax=ax,
+                    goal_label=end.where if turn else "goal")  # fmt: skip
+    # a turn not previewed is no failure: the verdict in black when what was previewed holds and nothing is refused
+    fine = preview.ok or (turn and preview.start.ok and preview.slide_end.ok and bool(preview.route)) or (
+        not preview.goal.previewed and not preview.goal.refused and not turn and preview.start.ok)  # fmt: skip
     ax.set_title(textwrap.fill(preview.verdict, 2 * WRAP), fontsize=FONT["note"], loc="left",
-                 color="k" if preview.ok else COLLISION)  # fmt: skip
+                 color="k" if fine else COLLISION)  # fmt: skip
     fig.suptitle(f"qsplan check: {preview.task}", fontsize=FONT["title"])
     return fig

@@ -16,6 +16,7 @@ imported inside the functions so that importing qsplan stays light.
 
 from __future__ import annotations
 
+import functools
 import math
 
 __all__ = [
@@ -34,6 +35,7 @@ __all__ = [
     "PALETTE",
     "REGRASP",
     "SAMPLED",
+    "STEP_SHADE",
     "UPPER",
     "axes_or_new",
     "body_style",
@@ -46,6 +48,8 @@ __all__ = [
     "new_axes",
     "plot_mu_slice",
     "save_figure",
+    "step_colour",
+    "text_width",
     "torque_text",
 ]
 
@@ -61,6 +65,11 @@ _BODIES = {"palm": ("#d9d9d9", "#636363"), "left": ("#9ecae1", FINGER["left"]), 
 _OTHER_BODY = ("#dadaeb", "#54278f")
 #: A phase without a torque-controlled joint (a regrasp).
 REGRASP = "#bdbdbd"
+
+#: What an in-contact phase does, in its colour (:func:`step_colour`): the torque-controlled finger's colour for a
+#: slide, mixed this much with white for a hold (nothing moves) and with black for a pivot (the workpiece turns), so
+#: that the finger stays recognisable and the three kinds differ in every timeline and legend.
+STEP_SHADE = {"slide": 0.0, "hold": 0.6, "pivot": -0.45}
 
 #: Bands: fill, edges, the command, the narrowest point, competitors, samples without a band, the paper's method.
 BAND_FILL = "#9ecae1"
@@ -93,6 +102,33 @@ def joint_colour(hand, name: str) -> str:
     from qsplan.hands.interface import finger_of_joint
 
     return finger_colour(finger_of_joint(hand).get(str(name), name))
+
+
+def step_colour(colour, kind: str) -> str:
+    """``colour`` shaded for a phase of ``kind`` (``"slide"``, ``"hold"``, ``"pivot"``: :data:`STEP_SHADE`; any other
+    kind unchanged)."""
+    from matplotlib.colors import to_hex, to_rgb
+
+    f = STEP_SHADE.get(str(kind), 0.0)
+    towards = 1.0 if f > 0 else 0.0
+    return to_hex(tuple(c + abs(f) * (towards - c) for c in to_rgb(colour)))
+
+
+def text_width(text, size, bold=False) -> float:
+    """Width (points) of ``text``'s longest line drawn at ``size`` points in the default font (its glyphs' outline,
+    no figure or renderer needed)."""
+    return max(_line_width(line, float(size), bool(bold)) for line in str(text).split("\n"))
+
+
+@functools.lru_cache(maxsize=4096)
+def _line_width(line, size, bold) -> float:
+    from matplotlib.font_manager import FontProperties
+    from matplotlib.textpath import TextPath
+
+    if not line.strip():
+        return 0.0
+    prop = FontProperties(weight="bold" if bold else "normal")
+    return float(TextPath((0, 0), line, size=size, prop=prop).get_extents().width)
 
 
 def body_style(name: str) -> tuple:

@@ -14,6 +14,11 @@ planning:
 * the verdict: a route of banded slides (and regrasps) from the start to the goal, found by the planner's
   own search in the window it searches, or what blocks it (:func:`qsplan.planner.plan.obstacles.no_route_report`).
 
+A goal that turns the workpiece (``[goal] theta`` or ``palm``) is not previewed (a later issue): the goal says so,
+and the route's first step is previewed as above, the slide to the flush instant (:attr:`Preview.slide_end`:
+:mod:`qsplan.planner.plan.reorient`'s sub-task, the left finger on the flush edge's upper vertex
+:data:`~qsplan.planner.plan.reorient.FLUSH_APPROACH` short of the instant), or the route's refusal is named.
+
 All of it is read from the planner's own band tables (:func:`qsplan.planner.search.tables.band_tables` of the rows
 :func:`qsplan.planner.plan.autoplan.grasp_rows` gives) on a grid across the whole palm through the start and the
 goal exactly, at the planner's step: nothing is computed twice.  Like the tables, a preview proposes: the planner
@@ -23,7 +28,7 @@ judges its route again sample by sample.  Units SI (m, rad, N m; N for a prismat
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -31,7 +36,7 @@ from qsplan.planner.reports.preview_configs import (ConfigurationCheck, configur
                                                     goal_candidates, start_candidates)  # fmt: skip
 from qsplan.planner.reports.preview_route import route_verdict
 
-__all__ = ["GraspBar", "Preview", "preview_task", "x_ranges"]
+__all__ = ["GraspBar", "Preview", "preview_task", "turn_slide", "x_ranges"]
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -94,12 +99,15 @@ class Preview:
     efforts : tuple of str
         The joints that may be torque-controlled (eq. 32).
     ok : bool
-        Start and goal valid and a banded route between them.
+        Start and goal valid and a banded route between them (never for a turning goal: not previewed).
     route : tuple of str
         The route's phases in words (empty without one).
     verdict : str
     seconds : float
         Wall time of the preview (s).
+    slide_end : ConfigurationCheck or None
+        A turning goal's: the end of the slide to the flush instant, the route's first step, previewed as a goal
+        (the bars, ``route`` and ``verdict`` are that slide's); None otherwise.
     """
 
     task: str
@@ -120,6 +128,7 @@ class Preview:
     route: tuple
     verdict: str
     seconds: float
+    slide_end: ConfigurationCheck | None = None
 
     def as_dict(self) -> dict:
         x = self.x
@@ -137,7 +146,8 @@ class Preview:
                 "resolution": self.resolution, "resolution_unit": self.resolution_unit,
                 "mu_range": list(self.mu_range), "shared_mu": self.shared_mu,
                 "mode": self.mode, "effort_joints": list(self.efforts), "grasps": bars, "ok": self.ok,
-                "route": list(self.route), "verdict": self.verdict, "seconds": self.seconds}  # fmt: skip
+                "route": list(self.route), "verdict": self.verdict, "seconds": self.seconds,
+                "slide_end": None if self.slide_end is None else self.slide_end.as_dict()}  # fmt: skip
 
 
 def x_ranges(x, mask) -> list:
@@ -202,16 +212,73 @@ def preview_task(task, progress=None) -> Preview:
     -------
     Preview
     """
+    from qsplan.planner.task.goal import reorients
+
+    t0 = time.perf_counter()
+    if not reorients(task):
+        return _preview(task, progress, t0)
+    sub, why = turn_slide(task)
+    what = f"a turn ({task.goal.describe()})"
+    if sub is None:  # the route refuses it, or its slide cannot be named: said, the start previewed alone
+        return _preview(task, progress, t0, turn=f"{what}: not previewed by check; {why}",
+                        refused=why.startswith(_REFUSED))  # fmt: skip
+    inner = _preview(sub, progress, t0, goal_name="slide's end")
+    goal = ConfigurationCheck("goal", inner.goal.x, None, None, None, 0, 0,
+                              note=f"{what}: not previewed by check; qsplan plan searches it ({_ROUTE})")  # fmt: skip
+    verdict = (f"goal: {what}, not previewed by check (qsplan plan searches it) / its first step, {why}: "
+               f"{inner.verdict}; the hold and the pivot that follow are not previewed")  # fmt: skip
+    return replace(inner, task=task.name, goal=goal, ok=False, verdict=verdict, slide_end=inner.goal,
+                   seconds=time.perf_counter() - t0)  # fmt: skip
+
+
+#: The route of a turning goal, in words (:mod:`qsplan.planner.plan.reorient`); how a refusal of it begins.
+_ROUTE = "the slide to the flush instant, a certified hold, the pivot"
+_REFUSED = "qsplan plan refuses it: "
+
+
+def turn_slide(task) -> tuple:
+    """``(sub-task, words)``: the slide a turning goal's route starts with (:func:`qsplan.planner.plan.reorient.
+    plan_reorientation`: to the flush instant of the workpiece's longest left side, the left finger on its upper
+    vertex :data:`~qsplan.planner.plan.reorient.FLUSH_APPROACH` short of it), and that step in words; or
+    ``(None, why)``: the route refuses the goal (its message), or the default flush edge is beyond the finger (the
+    route may try another: not previewed)."""
+    from dataclasses import replace as with_goal
+
+    from qsplan.hands.reorient import flush_instant
+    from qsplan.mechanics.errors import QsplanError
+    from qsplan.planner.plan.reorient import FLUSH_APPROACH, pivot_target
+    from qsplan.planner.task.goal import Goal, GoalNotServedError
+
+    hand = task.hand
+    if not hand.reorients:
+        return None, f"{_REFUSED}turning the workpiece is planned for the paper's hand form only"
+    try:
+        pivot_target(task)
+    except GoalNotServedError as exc:
+        return None, f"{_REFUSED}{exc}"
+    try:
+        instant = flush_instant(hand)
+    except QsplanError as exc:
+        return None, f"its slide to the flush instant is not previewed either ({exc}); qsplan plan searches it"
+    x_near = instant.x + FLUSH_APPROACH * np.sign(task.start_x - instant.x)
+    sub = with_goal(task, goal=Goal(float(x_near), ("vertex", int(hand.user_vertices[instant.edge])), None))
+    return sub, (f"the slide to the flush instant (x = {instant.x:.6g} m, the left finger along edge "
+                 f"{int(hand.user_edges[instant.edge])})")  # fmt: skip
+
+
+def _preview(task, progress, t0, goal_name="goal", turn=None, refused=False) -> Preview:
+    """:func:`preview_task` of a task whose goal keeps the orientation (its goal named ``goal_name``), or of a turning
+    goal not previewed (``turn``: what the goal's check says; ``refused``: the route refuses it), the start previewed
+    alone."""
     from qsplan.planner.plan.autoplan import FREE_SEARCH_MARGIN, goal_nodes, grasp_rows, start_nodes
     from qsplan.planner.plan.failure import palm_report
     from qsplan.planner.search.tables import SEARCH_MARGIN, band_tables, table_grid
     from qsplan.planner.states.contact import mode_name
-    from qsplan.planner.task.goal import goal_refusal, palm_x_range, reorientation_verdict
+    from qsplan.planner.task.goal import goal_refusal, palm_x_range
 
-    t0 = time.perf_counter()
     progress = progress or (lambda line: None)
     hand = task.hand
-    refusal = goal_refusal(task) or reorientation_verdict(task)  # a goal off the palm edge: the verdict says why
+    refusal = turn or goal_refusal(task)  # a goal off the palm edge: the verdict says why
     if task.goal is None:
         goal_x = float(task.waypoints[-1])
     else:  # a goal without x (refused) previewed at the start's x
@@ -249,14 +316,17 @@ def preview_task(task, progress=None) -> Preview:
     def checks(first, last):  # the start and the goal, the rows ``first`` and ``last`` drawn where valid
         return (configuration_check(task, tables, i_start, "start", first, start_candidates(tables, task, i_start),
                                     label, features_words(task, "start")),
-                configuration_check(task, tables, i_goal, "goal", last, goal_candidates(tables, task, i_goal), label,
-                                    features_words(task, "goal")))  # fmt: skip
+                configuration_check(task, tables, i_goal, goal_name, last, goal_candidates(tables, task, i_goal),
+                                    label, features_words(task, "goal")))  # fmt: skip
 
     start, goal = checks(starts, [g for g, _ in goals])
     if beyond is not None:  # the start or the goal beyond the palm is not valid; a waypoint's the verdict says
         start = _beyond(start, beyond, task.start_x) if beyond.where == "the start" else start
         goal = _beyond(goal, beyond, goal_x) if beyond.where == "the goal" else goal
-    if refusal is not None:  # no grasp of the formation meets such a goal: the refusal is its problem and the verdict
+    if turn is not None:  # a turning goal not previewed: the goal says so, the verdict with the start's check
+        goal = ConfigurationCheck("goal", goal_x, None, None, None, 0, 0, note=turn, refused=refused)
+        ok, route, verdict, ends = False, (), f"start {'ok' if start.ok else 'not ok'} / goal: {turn}", None
+    elif refusal is not None:  # no grasp of the formation meets such a goal: the refusal is its problem and the verdict
         where = "" if task.goal.x is not None else " (the goal gives no x: drawn at the start's)"
         goal = ConfigurationCheck("goal", goal_x, None, None, None, 0, goal.candidates, f"{refusal}{where}")
         ok, route, verdict, ends = False, (), str(refusal), None

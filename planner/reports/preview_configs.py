@@ -82,6 +82,12 @@ class ConfigurationCheck:
     beyond_palm : str or None
         The task puts the workpiece's resting edge beyond the palm here
         (:func:`qsplan.planner.plan.failure.palm_report`'s message).
+    note : str or None
+        What the check says of a goal it does not judge (a goal that turns the workpiece: not previewed, or refused
+        by the route and why); None: judged.  Such a check is not ok, has no x (``x`` is where the preview stopped)
+        and its message is the note.
+    refused : bool
+        Such a goal is one ``qsplan plan`` refuses (the note says why).
     """
 
     where: str
@@ -95,10 +101,17 @@ class ConfigurationCheck:
     limits: tuple = ()
     collisions: tuple = ()
     beyond_palm: str | None = None
+    note: str | None = None
+    refused: bool = False
 
     @property
     def ok(self) -> bool:
-        return self.valid > 0
+        return self.valid > 0 and self.note is None
+
+    @property
+    def previewed(self) -> bool:
+        """Whether the check judged it (a turning goal's is not)."""
+        return self.note is None
 
     @property
     def problems(self) -> list:
@@ -112,6 +125,8 @@ class ConfigurationCheck:
 
     @property
     def message(self) -> str:
+        if self.note is not None:
+            return f"{self.where}: {self.note}"
         head = f"{self.where} (x = {self.x:.4g} m)"
         if self.ok:
             more = f"; {self.valid} of {self.candidates} grasps meeting it are valid" if self.valid > 1 else ""
@@ -120,7 +135,8 @@ class ConfigurationCheck:
         return f"{head}: not a valid configuration{grasp}: " + "; ".join(self.problems)
 
     def as_dict(self) -> dict:
-        return {"where": self.where, "x_m": self.x, "ok": self.ok, "grasp": self.label,
+        return {"where": self.where, "x_m": self.x if self.previewed else None, "ok": self.ok,
+                "previewed": self.previewed, "refused": self.refused, "grasp": self.label,
                 "q": None if self.q is None else [None if not np.isfinite(v) else float(v) for v in self.q],
                 "valid_grasps": self.valid, "candidate_grasps": self.candidates, "contact": self.contact,
                 "limits": [lim.as_dict() for lim in self.limits],

@@ -70,20 +70,21 @@ def _narrowest(task, tables, route) -> str:
     return f"; narrowest band {_width(s.width, _unit(task, tables.efforts[s.effort]))}"
 
 
-def _automatic(task, tables, bars, window, starts, goals):
+def _automatic(task, tables, bars, window, starts, goals, goal_name="goal"):
     from qsplan.planner.plan.obstacles import no_route_report
     from qsplan.planner.search.widest import widest_route
 
     i_start = tables.index(task.start_x)
     if any((g, i_start) in set(goals) for g in starts):
-        return False, (), f"the start already meets the goal ({task.goal.describe()}): nothing to plan", None
+        return False, (), f"the start already meets the {goal_name} ({task.goal.describe()}): nothing to plan", None
     graph = window_graph(tables, window)
     route = widest_route(graph, [(g, i_start) for g in starts], goals)
     if route is None:
         report = no_route_report(task, tables, graph, starts, i_start, goals, set())
-        return False, (), f"no banded route from the start to the goal: {report.summary}", None
+        return False, (), f"no banded route from the start to the {goal_name}: {report.summary}", None
     words = _route_words(task, tables, bars, route)
-    text = "a banded route exists from the start to the goal: " + ", then ".join(words) + _narrowest(task, tables, route)
+    text = (f"a banded route exists from the start to the {goal_name}: " + ", then ".join(words)
+            + _narrowest(task, tables, route))  # fmt: skip
     return True, words, text, (route.steps[0].grasp, route.steps[-1].to_grasp)
 
 
@@ -151,14 +152,15 @@ def _nearest(x, bars, x0, most: int = 3) -> str:
 
 def route_verdict(task, tables, bars, window, start, goal, starts, goals, beyond) -> tuple:
     """``(ok, route words, verdict, ends)`` of the preview (see the module docstring); ``beyond`` a
-    :class:`qsplan.planner.plan.failure.PalmReport` or None; ``ends`` the route's first and last rows, or None."""
-    head = f"start {'ok' if start.ok else 'not ok'} / goal {'ok' if goal.ok else 'not ok'}"
+    :class:`qsplan.planner.plan.failure.PalmReport` or None; ``ends`` the route's first and last rows, or None.  The
+    goal is named as its check names itself (``goal.where``: a turn's slide previews its end, "slide's end")."""
+    head = f"start {'ok' if start.ok else 'not ok'} / {goal.where} {'ok' if goal.ok else 'not ok'}"
     if beyond is not None:
         return False, (), f"{head} / {beyond.message.removeprefix('no plan: ')}", None
     if not start.ok or not goal.ok:
         bad = [c for c in (start, goal) if not c.ok]
         text = "; ".join(f"the {c.where}: {'; '.join(c.problems)} ({_nearest(tables.x, bars, c.x)})" for c in bad)
         return False, (), f"{head}: {text}", None
-    ok, words, text, ends = _automatic(task, tables, bars, window, starts, goals) if task.goal is not None else \
-        _scripted(task, tables, bars, start)  # fmt: skip
+    ok, words, text, ends = _automatic(task, tables, bars, window, starts, goals, goal.where) \
+        if task.goal is not None else _scripted(task, tables, bars, start)  # fmt: skip
     return ok, words, f"{head} / {text} (a preview on the planner's grid: the planner judges its route again)", ends

@@ -115,3 +115,20 @@ def test_bad_arguments_are_refused_before_drawing(tmp_path, kwargs, match):
     with pytest.raises(QsplanError, match=match):
         plan_animation(None, **kwargs)
     assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.ompl
+def test_a_turning_plan_is_animated_holding_and_pivoting(tmp_path):
+    """Issue 31: the pivot was animated as "sliding".  Each frame's state is its phase's kind; the page says on which
+    vertex the workpiece pivots; the pivot's frames show the workpiece turning."""
+    plan = planned("reorient_task")
+    frames = plan_animation(plan, html_path=tmp_path / "a.html")
+    kinds = [plan.phases[f.phase].kind for f in frames]
+    assert set(kinds) == {"slide", "hold", "pivot"}
+    for f, kind in zip(frames, kinds):
+        assert f.state == {"slide": "sliding", "hold": "holding", "pivot": "pivoting"}[kind]
+        assert f.contacts  # every finger touches: the contacts are drawn
+    turned = [f.pose[2] for f in frames if f.state == "pivoting"]
+    assert turned[-1] == pytest.approx(-0.5) and np.all(np.diff(turned) <= 0)
+    page = (tmp_path / "a.html").read_text()
+    assert "pivoting on vertex 1" in page and "sliding\"" not in page.split("pivoting")[0][-40:]

@@ -164,17 +164,43 @@ def test_plan_refuses_a_counter_clockwise_turn_in_one_line(tmp_path, capsys, mon
     assert not (out / "plan.csv").exists() and not (out / "plan.json").exists()
 
 
-def test_check_reports_a_turning_goal_as_its_verdict(tmp_path, capsys):
-    from qsplan.planner.task.goal import reorientation_verdict
+def test_check_says_what_it_does_not_preview_of_a_turning_goal(tmp_path, capsys):
+    """Issue 31: the check called a turning goal "goal (x = 0 m): not a valid configuration".  It says the turn is not
+    previewed and previews the route's first step, the slide to the flush instant, as ``qsplan plan`` plans it."""
+    from qsplan.hands.reorient import flush_instant
 
-    task = load_task(tilt_file(tmp_path))
-    verdict = str(reorientation_verdict(task))
-    assert goal_refusal(task) is None and "qsplan plan plans the turn" in verdict
-    code = main(["check", str(tilt_file(tmp_path)), "--json", "--out", str(tmp_path / "check")])
+    path = tilt_file(tmp_path)
+    task = load_task(path)
+    assert goal_refusal(task) is None
+    code = main(["check", str(path), "--json", "--out", str(tmp_path / "check")])
     stdout, err = capsys.readouterr()
     doc = json.loads(stdout)
-    assert code == 0 and err == "" and doc["verdict"] == verdict and not doc["ok"] and doc["route"] == []
-    assert doc["start"]["ok"] and not doc["goal"]["ok"] and verdict in doc["goal"]["message"]
+    assert code == 0 and err == "" and not doc["ok"]  # the turn is not judged: never ok
+    goal, end = doc["goal"], doc["slide_end"]
+    assert goal["message"] == ("goal: a turn (theta = -0.5 rad): not previewed by check; qsplan plan searches it (the "
+                               "slide to the flush instant, a certified hold, the pivot)")  # fmt: skip
+    assert not goal["previewed"] and not goal["refused"] and goal["x_m"] is None and "not a valid" not in stdout
+    x = flush_instant(task.hand).x  # the slide's end: the flush instant, 5 um short (the planner's sub-task)
+    assert end["ok"] and end["previewed"] and abs(end["x_m"] - x) < 0.5e-3 and doc["start"]["ok"]
+    assert doc["route"] and doc["route"][0].startswith("slide left from x = 0 to ")
+    assert "the hold and the pivot that follow are not previewed" in doc["verdict"]
     assert (tmp_path / "check" / "check.png").is_file() and (tmp_path / "check" / "check.json").is_file()
-    code = main(["check", str(tilt_file(tmp_path))])
-    assert code == 0 and capsys.readouterr().out.splitlines()[-1] == f"verdict: {verdict}"
+    code = main(["check", str(path)])
+    lines = capsys.readouterr().out.splitlines()
+    assert code == 0 and goal["message"] in lines and end["message"] in lines and lines[-1] == f"verdict: {doc['verdict']}"
+
+
+@pytest.mark.parametrize("edit, why", [
+    (("theta = -0.5", "theta = 0.5"), "qsplan plan refuses it: goal.theta: turning the workpiece counter-clockwise"),
+    (("theta = -0.5", 'palm = "edge:2"'), "qsplan plan refuses it: goal.palm: edge 2 on the palm: the route pivots on"),
+])  # fmt: skip
+def test_check_names_the_route_s_refusal_of_a_turn(tmp_path, capsys, edit, why):
+    path = tilt_file(tmp_path)
+    path.write_text(path.read_text().replace(*edit))
+    code = main(["check", str(path), "--json", "--out", str(tmp_path / "check")])
+    stdout, err = capsys.readouterr()
+    doc = json.loads(stdout)
+    assert code == 0 and err == "" and not doc["ok"] and doc["slide_end"] is None and doc["route"] == []
+    assert doc["goal"]["refused"] and not doc["goal"]["previewed"] and why in doc["goal"]["message"]
+    assert doc["goal"]["message"].startswith("goal: a turn (") and doc["start"]["ok"] and why in doc["verdict"]
+    assert (tmp_path / "check" / "check.png").is_file()

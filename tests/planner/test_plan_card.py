@@ -4,6 +4,7 @@ drawn by kind, narrowest arrows never cut, phase numbers as in plan.csv, a legen
 layout checks of every figure (no overlapping text, no legend over data, units on every axis)."""
 
 import re
+from dataclasses import replace
 
 import numpy as np
 import pytest
@@ -73,6 +74,8 @@ def test_snapshot_labels_match_the_rows(name):
             assert s.touching == touching, (name, s.t)
             if isinstance(ph, ContactSegmentPlan) and ph.kind == "hold":  # nothing moves, the torque ramps
                 assert s.state == "holding" and np.ptp(ph.x) == 0 and s.effort == ph.command[s.row]
+            elif isinstance(ph, ContactSegmentPlan) and ph.kind == "pivot":  # the workpiece turns on a palm vertex
+                assert s.state == "pivoting" and np.ptp(ph.pose[:, 2]) > 0 and s.effort == ph.command[s.row]
             elif isinstance(ph, ContactSegmentPlan):
                 assert s.state == "sliding" and np.ptp(ph.x) > 0 and s.effort == ph.command[s.row]
             elif touching:
@@ -202,3 +205,213 @@ def test_torque_direction_is_shown():
     fig = plan_card(plan)
     for ax in snapshot_axes(fig):
         assert any(getattr(a, "arrowprops", None) and a.arrowprops.get("arrowstyle") == "-|>" for a in ax.texts)
+
+
+# --- issue 31, item 7: what the operator sees of a turning plan ----------------------------------------------------
+
+#: The bundled tasks that turn the workpiece: slide, hold, pivot; both pivot on vertex 1 as their files write it.
+TURNING = ("reorient_task", "reorient_edge_task")
+
+#: Least share of its panel's height the smallest slack of a phase is drawn at: 3 % (about 7 pixels of a torque panel
+#: on the 150 dpi page), the bracket and both lines apart.  Phase 0 of reorient_task on the one 0-8.6 N m axis it had:
+#: 0.5 %.
+MIN_SLACK_SHARE = 0.03
+
+
+def vertex_heights(plan, phase):
+    """Each workpiece vertex's height above the palm (m) at ``phase``'s rows, shape (n, n_v), columns as the task
+    writes the vertices."""
+    hand = plan.task.hand
+    V = np.asarray(hand.workpiece, float)
+    pose = phase.poses(hand.rest_height)
+    y = pose[:, 1:2] + np.sin(pose[:, 2:3]) * V[None, :, 0] + np.cos(pose[:, 2:3]) * V[None, :, 1]
+    out = np.empty_like(y)
+    out[:, np.asarray(hand.user_vertices, int)] = y
+    return out
+
+
+@pytest.mark.parametrize("name", TURNING)
+def test_a_turning_plan_names_and_colours_each_step_kind(name):
+    from matplotlib.colors import to_rgb
+
+    from qsplan.planner.plotting.plan_panels import phase_colour, timeline_handles
+
+    plan = planned(name)
+    kinds = [ph.kind for ph in plan.phases]
+    assert kinds == ["slide", "hold", "pivot"]
+    pivot = plan.phases[2]
+    y = vertex_heights(plan, pivot)  # the workpiece turns on vertex 1, the one on the palm: what the title says
+    assert np.abs(y[:, 1]).max() < 1e-6 and np.ptp(pivot.pose[:, 2]) > 0.3
+    assert np.all(np.delete(y[1:-1], 1, axis=1) > 1e-4)  # every other vertex lifted (the last row may land an edge)
+    fig = plan_card(plan)
+    for ax, s in zip(snapshot_axes(fig), card_snapshots(plan)):
+        title = ax.get_title()
+        expected = {"slide": "sliding", "hold": "holding", "pivot": "pivoting on vertex 1"}[kinds[s.phase]]
+        assert expected in title and (kinds[s.phase] != "pivot" or "sliding" not in title), title
+    assert "pivots on vertex 1, 0 to" in phase_rows(plan)[2][2]
+    # one colour per step kind: in the bars, the card's mode bar and the legend's patches
+    colours = [to_rgb(phase_colour(ph, plan.task.hand)) for ph in plan.phases]
+    for i in range(3):
+        for j in range(i):
+            assert np.linalg.norm(np.subtract(colours[i], colours[j])) > 0.2, (i, j)
+    luminance = [np.dot(c, [0.299, 0.587, 0.114]) for c in colours[1:]]  # the right finger's hold and pivot
+    assert luminance[0] > np.dot(to_rgb(phase_colour(replace(pivot, kind="slide"), plan.task.hand)),
+                                 [0.299, 0.587, 0.114]) > luminance[1]  # fmt: skip
+    patches = {h.get_label(): to_rgb(h.get_facecolor()) for h in timeline_handles(plan)}
+    assert len(patches) == 3 and len(set(patches.values())) == 3
+    legend = {t.get_text(): to_rgb(h.get_facecolor()) for t, h in zip(legend_of(fig).get_texts(),
+                                                                       legend_of(fig).legend_handles)
+              if t.get_text() in patches}  # fmt: skip
+    assert legend == {k: pytest.approx(v, abs=0.02) for k, v in patches.items()}
+    bar = next(a for a in fig.axes if a.get_title(loc="left").startswith("phases as numbered in plan.csv"))
+    drawn = [to_rgb(p.get_facecolor()) for p in bar.patches]
+    assert len(drawn) == 3 and all(np.allclose(d, c, atol=0.02) for d, c in zip(drawn, colours))
+
+
+def command_panel(fig, ph):
+    """The card's axes drawing ``ph``'s command (a line through its rows)."""
+    for ax in torque_axes(fig):
+        for ln in ax.get_lines():
+            x, y = np.asarray(ln.get_xdata(), float), np.asarray(ln.get_ydata(), float)
+            if x.shape == ph.t.shape and np.array_equal(x, ph.t) and np.array_equal(y, ph.command):
+                return ax
+    raise AssertionError(f"no panel draws {ph.name}'s command")
+
+
+#: Least share of its panel's height a phase's command and finite band edges span: a quarter.  Phase 0 of
+#: reorient_task on the one 0-8.6 N m axis it had: 4 %.
+MIN_PHASE_SHARE = 0.25
+
+
+@pytest.mark.parametrize("name", TURNING + ("demo_task", "two_link_regrasp_task"))
+def test_every_phase_is_drawn_on_a_readable_scale(name):
+    """Issue 31: the reorientation card drew phase 0's 0.1-0.35 N m band on the pivot's 8 N m axis.  Each phase's
+    command and band span a quarter of its panel at least, and each slack bracket 3 % of it."""
+    plan = planned(name)
+    fig = plan_card(plan)
+    for ph in plan.segments:
+        ax = command_panel(fig, ph)
+        to_axes = ax.transData + ax.transAxes.inverted()
+        y0, y1 = ax.get_ylim()
+        assert y0 <= ph.command.min() and ph.command.max() <= y1  # the whole command in view
+        values = np.concatenate([ph.command, ph.lower, ph.upper])
+        values = np.clip(values[np.isfinite(values)], y0, y1)
+        frac = to_axes.transform(np.column_stack([np.full(values.size, ph.t[0]), values]))[:, 1]
+        assert np.ptp(frac) >= MIN_PHASE_SHARE, (ph.name, float(np.ptp(frac)))
+    brackets = [(ax, a) for ax in torque_axes(fig) for a in ax.texts
+                if getattr(a, "arrowprops", None) and str(a.arrowprops.get("arrowstyle", "")).startswith("|-|")]
+    assert brackets
+    for ax, a in brackets:
+        to_axes = ax.transData + ax.transAxes.inverted()
+        ends = to_axes.transform([a.xy, a.xyann])[:, 1]
+        assert abs(ends[1] - ends[0]) >= MIN_SLACK_SHARE, (ax.get_title(loc="left"), float(abs(ends[1] - ends[0])))
+
+
+def data_points(ax, renderer_dpi):
+    """Every point of ``ax``'s data lines (not reference lines), densely resampled in display pixels (1 px)."""
+    out = []
+    for ln in ax.get_lines():
+        if not ln.get_visible() or ln.get_transform() != ax.transData:
+            continue
+        xy = ax.transData.transform(np.asarray(ln.get_xydata(), float))
+        for a, b in zip(xy[:-1], xy[1:]):
+            if np.all(np.isfinite([a, b])) and ln.get_linestyle() not in ("None", "none", ""):
+                n = int(np.ceil(np.hypot(*(b - a)))) + 1
+                out.append(a + np.linspace(0.0, 1.0, n)[:, None] * (b - a))
+        out += [p[None, :] for p in xy if np.all(np.isfinite(p))]
+    return np.vstack(out) if out else np.zeros((0, 2))
+
+
+def labels_over_data(fig) -> list:
+    """The narrowest-band and slack labels of ``fig`` whose box holds a point of a data line of their axes."""
+    from matplotlib.text import Text
+
+    from tests.planner.figure_checks import render
+
+    renderer = render(fig)
+    out = []
+    for ax in fig.axes:
+        pts = None
+        for t in ax.texts:
+            if not re.match(r"(narrowest|slack) ", t.get_text()):
+                continue
+            pts = data_points(ax, fig.dpi) if pts is None else pts
+            box = Text.get_window_extent(t, renderer).padded(-1.0)
+            inside = (pts[:, 0] > box.x0) & (pts[:, 0] < box.x1) & (pts[:, 1] > box.y0) & (pts[:, 1] < box.y1)
+            if inside.any():
+                out.append((ax.get_title(loc="left") or ax.get_title(), t.get_text()))
+    return out
+
+
+@pytest.mark.parametrize("name", TURNING + ("demo_task", "two_link_regrasp_task"))
+def test_band_labels_cover_no_data(name):
+    """Issue 31: on reorient_edge_task's card the "narrowest 0.0439 N m" label covered the command and the band where the
+    band is narrowest (3.9-5.4 s)."""
+    from qsplan.planner.plotting.plan import plot_plan_bands
+
+    plan = planned(name)
+    card = plan_card(plan)
+    assert labels_over_data(card) == []
+    assert any(t.get_text().startswith("narrowest ") for ax in card.axes for t in ax.texts) == np.isfinite(
+        min(np.min(s.width) for s in plan.segments))  # fmt: skip
+    bands = plot_plan_bands(plan)[0].get_figure(root=True)
+    assert labels_over_data(bands) == [] and overlapping_texts(bands) == []
+
+
+@pytest.mark.parametrize("name", TURNING + ("two_link_regrasp_task",))
+def test_mode_timeline_labels_fit_their_bars(name):
+    """Issue 31: the mode timeline's pivot label ran past its bar."""
+    from matplotlib.patches import Rectangle
+    from matplotlib.text import Text
+
+    from qsplan.planner.plotting.plan import plot_mode_timeline
+    from tests.planner.figure_checks import render
+
+    plan = planned(name)
+    for ax in (plot_mode_timeline(plan), next(a for a in plan_card(plan).axes
+                                              if a.get_title(loc="left").startswith("phases as numbered"))):  # fmt: skip
+        fig = ax.get_figure(root=True)
+        renderer = render(fig)
+        bars = [p.get_window_extent(renderer) for p in ax.patches if isinstance(p, Rectangle)]
+        assert len(bars) == len(plan.phases)
+        inside = [t for t in ax.texts if type(t) is Text and t.get_position()[1] == 0 and t.get_text().strip()]
+        assert inside  # some labels sit in their bars
+        for t in inside:
+            box = Text.get_window_extent(t, renderer)
+            bar = next(b for b in bars if b.x0 <= 0.5 * (box.x0 + box.x1) <= b.x1)
+            assert bar.x0 <= box.x0 and box.x1 <= bar.x1, t.get_text()
+        assert overlapping_texts(fig) == []
+
+
+def test_velocity_panels_draw_what_the_controller_is_sent(tmp_path):
+    """Issue 31: the card drew a regrasp's velocities as steps where plan.csv and ``qsplan sample`` ramp them from rest
+    to rest.  Each drawn velocity is ``qsplan sample``'s at its ticks (read from the exported plan.csv), it changes no
+    faster than the task's joint acceleration on the regrasp, and integrated it follows the plan's joints."""
+    from qsplan.hands.interface import joint_names
+    from qsplan.planner.export.plan_files import export_plan
+    from qsplan.planner.export.sample import sample_plan
+
+    plan = planned("two_link_regrasp_task")
+    export_plan(plan, tmp_path)
+    fig = plan_card(plan)
+    names = joint_names(plan.task.hand)
+    regrasp = next(i for i, ph in enumerate(plan.phases) if isinstance(ph, RegraspPlan))
+    ph = plan.phases[regrasp]
+    a_max = float(np.max(plan.task.dynamics.joint_accelerations))
+    for joint in names:
+        ax = next(a for a in fig.axes if a.get_title(loc="left") == f"{joint} joint: velocity command")
+        (line,) = [ln for ln in ax.get_lines() if ln.get_transform() == ax.transData and len(ln.get_xdata()) > 10]
+        assert line.get_drawstyle() == "steps-post"  # each tick's command held until the next
+        t, qd = np.asarray(line.get_xdata(), float), np.asarray(line.get_ydata(), float)
+        ticks = sample_plan(tmp_path, t)  # what `qsplan sample` writes for these ticks
+        want = ticks.qd[:, names.index(joint)]
+        assert np.array_equal(np.isnan(qd), np.isnan(want)) and np.nanmax(np.abs(qd - want)) < 1e-9
+        on = (t >= ph.t[0]) & (t < ph.t[-1])
+        dt = float(np.max(np.diff(t)))
+        assert np.max(np.abs(np.diff(qd[on]))) <= 1.05 * a_max * dt + 1e-12  # ramps: no step
+        k = int(np.searchsorted(t, ph.t[0]))  # integrated over the regrasp: the joint's path at its rows
+        q = ph.q[:, names.index(joint)]
+        for tr, qr in zip(ph.t[1:], q[1:]):
+            m = int(np.searchsorted(t, tr))
+            moved = float(np.sum(qd[k:m] * np.diff(t[k:m + 1]))) if m > k else 0.0
+            assert abs(q[0] + moved - qr) <= np.nanmax(np.abs(qd)) * dt + 1e-9
