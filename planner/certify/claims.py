@@ -45,7 +45,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from qsplan.planner.certify.files import META_TOL, _close, _difference, _differs, _narrowest, _num, _show
+from qsplan.planner.certify.stated import META_TOL, close, difference, differs, finite_or_none, narrowest, show
 
 __all__ = ["INFORMATIONAL_PHASE_KEYS", "INFORMATIONAL_STEP_KEYS", "RowEvidence", "phase_claims", "sequence_claims"]
 
@@ -78,7 +78,7 @@ class RowEvidence:
 
 
 def _message(found) -> str:
-    return _differs(found, "the rows'")
+    return differs(found, "the rows'")
 
 
 def _phase_rows(cols, i) -> np.ndarray:
@@ -145,10 +145,10 @@ def _command(cols, rows) -> dict:
     e = [str(cols["effort_joint"][k]) for k in rows]
     tau = np.array([cols[f"tau_{ej}"][k] for ej, k in zip(e, rows)], dtype=float)
     lower = np.array([cols[f"tau_{ej}_min"][k] for ej, k in zip(e, rows)], dtype=float)
-    _, w = _narrowest(cols, rows)
-    return {"margin_N_m": _num(float(np.min(np.asarray(cols["margin"], float)[rows]))),
-            "half_narrowest_band_N_m": None if w is None else 0.5 * w, "max_N_m": _num(float(np.max(tau))),
-            "lower_edge_max_N_m": _num(float(np.max(lower)))}  # fmt: skip
+    _, w = narrowest(cols, rows)
+    return {"margin_N_m": finite_or_none(float(np.min(np.asarray(cols["margin"], float)[rows]))),
+            "half_narrowest_band_N_m": None if w is None else 0.5 * w, "max_N_m": finite_or_none(float(np.max(tau))),
+            "lower_edge_max_N_m": finite_or_none(float(np.max(lower)))}  # fmt: skip
 
 
 def _phase_kind(cols, rows, names) -> str:
@@ -192,7 +192,7 @@ def _core(d, cols, rows, path) -> list:
     if d.get("rows") != rows.size:
         problems.append(f"{d.get('rows')} rows (the file has {rows.size})")
     t = np.asarray(cols["t"], float)
-    if not (_close(d.get("t_start_s"), t[rows[0]]) and _close(d.get("t_end_s"), t[rows[-1]])):
+    if not (close(d.get("t_start_s"), t[rows[0]]) and close(d.get("t_end_s"), t[rows[-1]])):
         problems.append(f"times {d.get('t_start_s')} to {d.get('t_end_s')} s (the rows': {t[rows[0]]:g} to "
                         f"{t[rows[-1]]:g} s)")  # fmt: skip
     if d.get("kind") != kind:
@@ -201,9 +201,9 @@ def _core(d, cols, rows, path) -> list:
         if d.get("mode") != mode or d.get("effort_joint") != effort:
             problems.append(f"mode {d.get('mode')} / effort joint {d.get('effort_joint')} (the rows': {mode} / "
                             f"{effort})")  # fmt: skip
-        tn, w = _narrowest(cols, rows)
+        tn, w = narrowest(cols, rows)
         nb = d.get("narrowest_band") or {}
-        if not (_close(nb.get("t_s"), tn) and _close(nb.get("width_N_m"), w)):
+        if not (close(nb.get("t_s"), tn) and close(nb.get("width_N_m"), w)):
             problems.append(f"narrowest band {nb.get('width_N_m')} at t = {nb.get('t_s')} s (the rows': {w} at "
                             f"{tn:g} s)")  # fmt: skip
     return [f"{path} states " + "; ".join(problems)] if problems else []
@@ -234,7 +234,7 @@ def _more(d, task, cols, rows, path, evidence, names, joint_unit) -> list:
     claim = {k: v for k, v in d.items() if k not in _CORE | unknown | _SPECIAL}
     if isinstance(claim.get("time_scaling"), dict):
         claim["time_scaling"] = {k: v for k, v in claim["time_scaling"].items() if k not in INFORMATIONAL_TIMING_KEYS}
-    found = _difference(claim, truth, path)
+    found = difference(claim, truth, path)
     if found:
         out.append(_message(found))
     if not contact:
@@ -242,14 +242,14 @@ def _more(d, task, cols, rows, path, evidence, names, joint_unit) -> list:
     sets = _contact_sets(cols, rows, evidence)
     if sets is not None:
         for key, value in (("contacts", sets[0]), ("contact_sets", sets[1])):
-            if key in d and (found := _difference(d[key], value, f"{path}.{key}")):
+            if key in d and (found := difference(d[key], value, f"{path}.{key}")):
                 out.append(_message(found) + " (the contacts found in the polygons and the mode column)")
         if "formation" in d:
             last = tuple(sets[1][-1]["contacts"])
             fits = sorted(n for n, f in FORMATIONS.items() if f.contact_names == last)
             if d["formation"] not in fits:
                 whose = " or ".join(fits) or "no registered formation"
-                out.append(f"{path}.formation states {_show(d['formation'])}; the phase's last contacts "
+                out.append(f"{path}.formation states {show(d['formation'])}; the phase's last contacts "
                            f"({', '.join(last)}) are those of {whose}")  # fmt: skip
     if "competitors_precluded" in d:
         out += _competitor_claims(d["competitors_precluded"], cols, rows, path)
@@ -267,12 +267,12 @@ def _competitor_claims(comps, cols, rows, path) -> list:
     planned = {str(cols["mode"][k]) for k in rows}
     lengths = {len(m) for m in planned}
     if not isinstance(comps, list) or not all(isinstance(c, str) for c in comps):
-        return [f"{path}.competitors_precluded states {_show(comps)}; expected a list of modes"]
+        return [f"{path}.competitors_precluded states {show(comps)}; expected a list of modes"]
     bad = [c for c in comps if not c or set(c) - set("RSB") or len(c) not in lengths or c in planned]
     if len(set(comps)) != len(comps):
         bad.append("(a mode listed twice)")
     if bad:
-        return [f"{path}.competitors_precluded states {_show(bad[0])}: not a competitor of the phase's planned "
+        return [f"{path}.competitors_precluded states {show(bad[0])}: not a competitor of the phase's planned "
                 f"mode(s) {', '.join(sorted(planned))} (one letter of R, S, B per contact, another mode)"]  # fmt: skip
     return []
 
@@ -280,7 +280,7 @@ def _competitor_claims(comps, cols, rows, path) -> list:
 def _speed_claims(claim, task, cols, rows, path, names) -> list:
     """The workpiece's largest speed at the quasistatic speed (the module docstring)."""
     if not (isinstance(claim, (int, float)) and not isinstance(claim, bool) and math.isfinite(claim)):
-        return [f"{path}.workpiece_speed_m_s states {_show(claim)}; expected a speed (m/s)"]
+        return [f"{path}.workpiece_speed_m_s states {show(claim)}; expected a speed (m/s)"]
     _, ds, dist = _path(cols, rows)
     moving = ds > 0
     if not moving.any():
@@ -288,7 +288,7 @@ def _speed_claims(claim, task, cols, rows, path, names) -> list:
     mean = float(np.max(dist[moving] / ds[moving]))  # the mean speed over each interval at the quasistatic speed
     _, turned = _moves(cols, rows, names)
     if not turned:  # a translation along a line at one quasistatic speed: every interval's mean is the speed
-        return [] if _close(claim, mean) else [f"{path}.workpiece_speed_m_s states {claim:g} m/s; the rows move the "
+        return [] if close(claim, mean) else [f"{path}.workpiece_speed_m_s states {claim:g} m/s; the rows move the "
                                                f"workpiece at {mean:.10g} m/s at the quasistatic speed"]  # fmt: skip
     limit = float(task.workpiece_speed)
     if claim < mean * (1 - META_TOL) or claim > limit * (1 + META_TOL):
@@ -320,7 +320,7 @@ def sequence_claims(sequence, phases, task, cols, evidence) -> list:
         contact = str(cols["mode"][rows[0]]) != "free"
         kind = _phase_kind(cols, rows, names) if contact else "regrasp"
         if s.get("kind") != kind:
-            out.append((int(rows[0]), "metadata", f"{path}.kind states {_show(s.get('kind'))}; phase {i}'s rows are a "
+            out.append((int(rows[0]), "metadata", f"{path}.kind states {show(s.get('kind'))}; phase {i}'s rows are a "
                                                   f"{kind}"))  # fmt: skip
             continue
         x = np.asarray(cols["x_workpiece"], float)[rows]
@@ -334,7 +334,7 @@ def sequence_claims(sequence, phases, task, cols, evidence) -> list:
         elif contact:
             e = str(cols["effort_joint"][rows[0]])
             truth.update(effort_joint=e, effort_unit=joint_unit(task.hand, e, "tau"))
-            _, w = _narrowest(cols, rows)
+            _, w = narrowest(cols, rows)
             tau = np.asarray(cols[f"tau_{e}"], float)[rows]
             ends = {"slide": ("x_from", "x_to", x), "hold": ("torque_from", "torque_to", tau),
                     "pivot": ("theta_from_rad", "theta_to_rad", th)}[kind]  # fmt: skip
@@ -343,7 +343,7 @@ def sequence_claims(sequence, phases, task, cols, evidence) -> list:
         if kind == "pivot":
             truth.pop("x_from_m"), truth.pop("x_to_m")
         claim = {k: v for k, v in s.items() if k not in unknown}
-        found = _difference(claim, truth, path)
+        found = difference(claim, truth, path)
         if found:
             out.append((int(rows[0]), "metadata", _message(found)))
         if kind == "hold" and "proved_interval" in s:
@@ -375,14 +375,14 @@ def _interval_claims(interval, cols, rows, path, evidence) -> list:
     from qsplan.planner.certify.bands import BAND_RTOL
 
     ends = _edges(interval)
-    where = f"{path}.proved_interval states {_show(interval)}"
+    where = f"{path}.proved_interval states {show(interval)}"
     if ends is None or ends[0] > ends[1]:
         return [f"{where}; expected [lower, upper] (N m, null: unbounded)"]
     lo, hi = ends
     for k in rows:
         e = str(cols["effort_joint"][k])
         band = (float(cols[f"tau_{e}_min"][k]), float(cols[f"tau_{e}_max"][k]))
-        if not (_close(lo, band[0]) and _close(hi, band[1])):
+        if not (close(lo, band[0]) and close(hi, band[1])):
             return [f"{where}; the hold's rows export the band [{band[0]:.10g}, {band[1]:.10g}] (row {int(k)})"]
         rb = evidence.bands.get(int(k))
         if rb is None:
@@ -403,7 +403,7 @@ def _vertex_claims(vertex, task, cols, rows, path, evidence) -> list:
     internal = [int(c.split(":")[1]) for c in palm if c.split(":")[1].isdigit()]
     written = [int(task.hand.vertex_order[k]) for k in internal if 0 <= k < len(task.hand.vertex_order)]
     if len(palm) != 1 or len(written) != 1 or vertex != written[0] or isinstance(vertex, bool):
-        return [f"{path}.vertex states {_show(vertex)}; after its first row the pivot rests on the palm with "
+        return [f"{path}.vertex states {show(vertex)}; after its first row the pivot rests on the palm with "
                 f"{', '.join(palm) or 'nothing'} (vertex {', '.join(map(str, written)) or 'none'} as the task writes "
                 "it)"]  # fmt: skip
     return []

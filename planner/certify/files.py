@@ -13,17 +13,13 @@ sequence, :mod:`qsplan.planner.certify.claims`), or labelled informational by th
 
 from __future__ import annotations
 
-import json
 import math
 
 import numpy as np
 
-__all__ = ["META_TOL", "agreement_checks", "metadata_checks", "schema_checks"]
+from qsplan.planner.certify.stated import META_TOL, close, difference, differs, narrowest, plain
 
-#: Tolerance (s, m, N m, relative where a number is larger than 1) between a number the metadata states and the
-#: rows': the export writes both from the same float, so only a tampered file differs; 1e-9 forgives the
-#: decimal round trip of a hand-edited but equal value.
-META_TOL = 1e-9
+__all__ = ["META_TOL", "agreement_checks", "metadata_checks", "schema_checks"]
 
 
 def _fill(name: str) -> float:
@@ -71,74 +67,6 @@ def schema_checks(doc) -> list:
     return [(None, "files", f"plan.json: {e}") for e in check_schedule_document(doc)[:5]]
 
 
-def _close(a, b) -> bool:
-    if a is None or b is None:
-        return a is None and b is None
-    try:
-        a, b = float(a), float(b)
-    except (TypeError, ValueError):
-        return False
-    if not (math.isfinite(a) and math.isfinite(b)):
-        return a == b
-    return abs(a - b) <= META_TOL * max(1.0, abs(a), abs(b))
-
-
-def _num(v):
-    return float(v) if v is not None and math.isfinite(v) else None
-
-
-def _narrowest(cols, rows) -> tuple:
-    """``(t, width or None)`` of the narrowest band over in-contact ``rows`` (None: all unbounded)."""
-    e = cols["effort_joint"]
-    widths = np.array([cols[f"tau_{e[i]}_max"][i] - cols[f"tau_{e[i]}_min"][i] for i in rows], dtype=float)
-    widths = np.where(np.isnan(widths), np.inf, widths)
-    k = int(np.argmin(widths))
-    return float(cols["t"][rows[k]]), _num(widths[k])
-
-
-def _plain(value):
-    return json.loads(json.dumps(value, allow_nan=False))
-
-
-def _show(v) -> str:
-    """A claimed or true value for a message (plain JSON, long ones cut)."""
-    text = json.dumps(v, allow_nan=True)
-    return text if len(text) <= 240 else text[:237] + "..."
-
-
-def _difference(claim, truth, path: str):
-    """``(path, claimed, true)`` where ``claim`` (what the metadata states) first differs from ``truth`` (numbers to
-    :data:`META_TOL`, ``null`` only with ``null``), or None: every key ``claim`` states must hold ``truth``'s value (a
-    key it leaves out states nothing: plans written before a key existed lack it)."""
-    if isinstance(claim, dict):
-        if not isinstance(truth, dict):
-            return path, claim, truth
-        for key, value in claim.items():
-            if key not in truth:
-                return f"{path}.{key}", value, "(nothing the certifier can check)"
-            found = _difference(value, truth[key], f"{path}.{key}")
-            if found:
-                return found
-        return None
-    if isinstance(claim, list):
-        if not isinstance(truth, list) or len(claim) != len(truth):
-            return path, claim, truth
-        return next((d for i, (a, b) in enumerate(zip(claim, truth)) if (d := _difference(a, b, f"{path}[{i}]"))),
-                    None)  # fmt: skip
-    numeric = isinstance(claim, (int, float)) and not isinstance(claim, bool)
-    if numeric and isinstance(truth, (int, float)) and not isinstance(truth, bool):
-        return None if _close(claim, truth) else (path, claim, truth)
-    return None if (claim == truth and type(claim) is type(truth)) else (path, claim, truth)
-
-
-def _differs(found, whose: str = "the task's") -> str:
-    """A message for :func:`_difference`'s answer: ``"metadata.x states 1, not the task's 2"``."""
-    path, claim, truth = found
-    if isinstance(claim, list) and isinstance(truth, list) and len(claim) != len(truth):
-        return f"{path} states {len(claim)} entries {_show(claim)}, not {whose} {len(truth)} {_show(truth)}"
-    return f"{path} states {_show(claim)}, not {whose} {_show(truth)}"
-
-
 def metadata_checks(meta, task, cols, evidence=None) -> list:
     """Every fact ``plan.json``'s metadata states, against the task, the rows and ``evidence`` (what the row checks
     found: :class:`qsplan.planner.certify.claims.RowEvidence`; each phase's and step's claims,
@@ -165,7 +93,7 @@ def metadata_checks(meta, task, cols, evidence=None) -> list:
         lacking = [key for key in ("friction", "torque_resolution_N_m", "force_margin") if key not in meta]
         if lacking:  # stated by every plan
             raise KeyError(lacking[0])
-        claim(_close(meta["torque_resolution_N_m"], task.torque_resolution),
+        claim(close(meta["torque_resolution_N_m"], task.torque_resolution),
               f"torque resolution {meta['torque_resolution_N_m']} is not the task's {task.torque_resolution:g}")
         hand = hand_metadata(task.hand)
         hand.pop("description_source", None)  # where the description was read from: not a fact of the plan
@@ -179,20 +107,20 @@ def metadata_checks(meta, task, cols, evidence=None) -> list:
                 ignored = {"hand": "description_source", "task_record": "name"}.get(key)
                 claimed = {k: v for k, v in meta[key].items() if k != ignored} \
                     if ignored and isinstance(meta[key], dict) else meta[key]
-                found = _difference(claimed, _plain(truth), f"metadata.{key}")
-                claim(found is None, found and _differs(found))
+                found = difference(claimed, plain(truth), f"metadata.{key}")
+                claim(found is None, found and differs(found))
         if "disturbance" in meta or task.disturbance is not None:
-            found = _difference(meta.get("disturbance"), _plain(disturbance_metadata(task)), "metadata.disturbance")
-            claim(found is None, found and _differs(found))
+            found = difference(meta.get("disturbance"), plain(disturbance_metadata(task)), "metadata.disturbance")
+            claim(found is None, found and differs(found))
         phases = meta["phases"]
         out += phase_claims(phases, task, cols, evidence)
         if "sequence" in meta:
             out += sequence_claims(meta["sequence"], phases, task, cols, evidence)
         contact = np.flatnonzero(cols["mode"] != "free")
         if contact.size:
-            t, w = _narrowest(cols, contact)
+            t, w = narrowest(cols, contact)
             nb = meta["narrowest_band"]
-            claim(_close(nb["t_s"], t) and _close(nb["width_N_m"], w),
+            claim(close(nb["t_s"], t) and close(nb["width_N_m"], w),
                   f"narrowest band {nb['width_N_m']} at t = {nb['t_s']} s; the rows' is {w} at t = {t:g} s")
     except (KeyError, TypeError, IndexError, ValueError, ZeroDivisionError) as exc:
         out.append((None, "metadata", f"plan.json's metadata lacks or garbles a field ({type(exc).__name__}: {exc})"))
