@@ -48,10 +48,11 @@ def _drawable(task, q):
     return q, not bad.any()
 
 
-def plot_configuration(task, x, q, ax=None, collisions=(), limits=None, highlight=()):
+def plot_configuration(task, x, q, ax=None, collisions=(), limits=None, highlight=(), pose=None):
     """The hand with the workpiece at ``x`` (m) and joints ``q`` (n_j,; None or NaN joints: drawn faded at mid-range),
     every overlap of ``collisions`` (:class:`qsplan.hands.collision.Collision`) in red: both bodies outlined, their
-    intersection filled; ``highlight``: more body names (``"palm"``, ``"workpiece"``, a joint) to outline in red.
+    intersection filled; ``highlight``: more body names (``"palm"``, ``"workpiece"``, a joint) to outline in red;
+    ``pose`` ``(x, y, theta)`` (m, m, rad) where the workpiece does not rest on its bottom edge at ``x``.
 
     Returns
     -------
@@ -64,7 +65,8 @@ def plot_configuration(task, x, q, ax=None, collisions=(), limits=None, highligh
     from qsplan.planner.plotting.hands import hand_limits, plot_hand
 
     ax = axes_or_new(ax, size=(3.6, HAND_HEIGHT))
-    hand, pose = task.hand, task.pose(x)
+    hand = task.hand
+    pose = task.pose(x) if pose is None else np.asarray(pose, dtype=float)
     q_draw, closed = _drawable(task, q)
     limits = limits or hand_limits(hand, [(pose, q_draw)])
     valid = closed and not collisions and not highlight
