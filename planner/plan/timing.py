@@ -34,7 +34,7 @@ import numpy as np
 
 from qsplan.planner.task.dynamics import task_dynamics
 
-__all__ = ["PhaseTiming", "SCALE_ITERATIONS", "piece_scale", "quasistatic_rows", "scale_rate", "time_scale"]
+__all__ = ["PhaseTiming", "SCALE_ITERATIONS", "path_covered", "piece_scale", "quasistatic_rows", "scale_rate", "time_scale"]
 
 #: Rounds of cutting ``α`` and the peak when a slide's curvature makes a joint's command change faster than the
 #: trapezoid alone predicts (each round cuts by the measured excess; the bundled plans need at most one).
@@ -234,11 +234,21 @@ def time_scale(plan):
             t, q, v, qd, pieces, alpha, peak, binding = _regrasp(task, ph)
             new = replace(ph, t=t0 + t, q=q, qd=qd, speed_scale=v)
         phases.append(new)
-        # the record states what the rows realise (alpha, peak: the rule's parameters)
+        # the record states what the rows realise (alpha, peak: the rule's parameters; the path they cover)
+        if np.any(v > 0):
+            T = path_covered(t, v)
         timing.append(PhaseTiming(ph.name, pieces, scale_rate(t, v), float(np.max(v, initial=0.0)), float(t[-1]), T,
                                   binding))  # fmt: skip
         t0 = float(new.t[-1])
     return replace(plan, phases=tuple(phases), timing=tuple(timing))
+
+
+def path_covered(t, u) -> float:
+    """The path parameter (s, quasistatic seconds) rows at times ``t`` with speed scales ``u`` cover by the rule: ``u``
+    linear in time between rows, ``sum (u_k + u_{k+1}) dt / 2``.  A regrasp's legs cover each the slowest joint's
+    quasistatic time, whatever times its OMPL path had."""
+    t, u = np.asarray(t, dtype=float), np.asarray(u, dtype=float)
+    return float(np.sum(0.5 * (u[:-1] + u[1:]) * np.diff(t)))
 
 
 def scale_rate(t, u) -> float:
