@@ -44,7 +44,7 @@ from qsplan.planner.plan.steps import HoldStep, PivotStep, realised_steps
 from qsplan.planner.task.goal import Goal, GoalNotServedError
 
 __all__ = ["FLUSH_APPROACH", "HOLD_MIN_DURATION", "HOLD_ROWS", "HOLD_TORQUE_RATE", "PIVOT", "PIVOT_EFFORT_JOINTS", "PIVOT_STEP",
-           "hold_phase", "pivot_phase", "pivot_rows", "pivot_target", "plan_reorientation", "widest_pivot"]
+           "hold_phase", "pivot_phase", "pivot_rows", "pivot_target", "plan_reorientation", "route_slide", "widest_pivot"]
 
 #: How far (m) short of the flush instant the slide's band tables end: five times the contact tolerance (1 um), so
 #: the polygons show the four contacts of the palm edge there (the left finger's second contact 5 um open); the
@@ -301,27 +301,23 @@ def _slip_reversal(hand, c):
     return int(np.flatnonzero(c.theta < first.theta)[0]), first.theta, first.name.removeprefix("slip_")
 
 
-def plan_reorientation(task, options=None, progress=None, planner: str = "widest") -> Plan:
-    """Plan a goal that turns the workpiece: slide to the flush instant, hold, pivot (the module docstring).
+def route_slide(task) -> tuple:
+    """``(flush instant, sub-task, words)``: the route's first step, the slide to the flush instant of the longest left
+    side of the workpiece the left finger fits along (:func:`qsplan.hands.reorient.left_sides`), planned as a task
+    whose goal is the left finger on that side's upper vertex :data:`FLUSH_APPROACH` short of it.
 
     Raises
     ------
     GoalNotServedError
-        The route cannot serve the goal (named field and why).
-    PlanFailure
-        A phase of the route has no plan (the report says where and why).
+        A hand not of the paper's form; no left side, or none the finger fits along (each named with where its ends
+        lie).
     """
     from qsplan.hands.reorient import flush_instant, left_sides
-    from qsplan.planner.plan.autoplan import plan_automatic
-    from qsplan.planner.plan.timing import time_scale
 
-    progress = progress or (lambda line: None)
-    started = time.perf_counter()
     hand = task.hand
     if not hand.reorients:
         raise _refuse("goal.theta", "turning the workpiece is planned for the paper's hand form only (two single-link "
                                     "revolute fingers, Fig. 9)")  # fmt: skip
-    theta_goal = pivot_target(task)
     field = "goal.theta" if task.goal.theta is not None else "goal.palm"
     sides = left_sides(hand)
     if not sides:
@@ -337,19 +333,38 @@ def plan_reorientation(task, options=None, progress=None, planner: str = "widest
     else:
         raise _refuse(field, "the route lays the left finger flush along a left side of the workpiece, and none fits "
                              "along it (" + "; ".join(misfits) + ")")  # fmt: skip
-    upper_vertex = int(hand.user_vertices[instant.edge])
-    progress(f"reorientation: slide to the flush instant (x = {instant.x:.6g} m, the left finger along edge "
-             f"{int(hand.user_edges[instant.edge])}), hold, pivot on vertex {int(hand.user_vertices[PIVOT])} to "
-             f"theta = {theta_goal:.4g} rad")  # fmt: skip
     x_near = instant.x + FLUSH_APPROACH * np.sign(task.start_x - instant.x)
-    sub = replace(task, goal=Goal(float(x_near), ("vertex", upper_vertex), None))
+    sub = replace(task, goal=Goal(float(x_near), ("vertex", int(hand.user_vertices[instant.edge])), None))
+    step = (f"the slide to the flush instant (x = {instant.x:.6g} m, the left finger along edge "
+            f"{int(hand.user_edges[instant.edge])})")  # fmt: skip
+    return instant, sub, step
+
+
+def plan_reorientation(task, options=None, progress=None, planner: str = "widest") -> Plan:
+    """Plan a goal that turns the workpiece: slide to the flush instant, hold, pivot (the module docstring).
+
+    Raises
+    ------
+    GoalNotServedError
+        The route cannot serve the goal (named field and why).
+    PlanFailure
+        A phase of the route has no plan (the report says where and why).
+    """
+    from qsplan.planner.plan.autoplan import plan_automatic
+    from qsplan.planner.plan.timing import time_scale
+
+    progress = progress or (lambda line: None)
+    started = time.perf_counter()
+    hand = task.hand
+    theta_goal = pivot_target(task)
+    instant, sub, step = route_slide(task)
+    progress(f"reorientation: {step}, hold, pivot on vertex {int(hand.user_vertices[PIVOT])} to theta = "
+             f"{theta_goal:.4g} rad")  # fmt: skip
     try:
         slide = plan_automatic(sub, options, progress, planner, timed=False)
     except PlanFailure as exc:  # said as the route's step, drawn with the task it was planned as
         from qsplan.planner.plan.failure import StepReport
 
-        step = (f"the slide to the flush instant (x = {instant.x:.6g} m, the left finger along edge "
-                f"{int(hand.user_edges[instant.edge])})")  # fmt: skip
         raise PlanFailure(StepReport(step, sub, exc.report)) from None
     phases = list(slide.phases)
     last = phases[-1]

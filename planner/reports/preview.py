@@ -239,37 +239,17 @@ _REFUSED = "qsplan plan refuses it: "
 def turn_slide(task) -> tuple:
     """``(sub-task, words)``: the slide a turning goal's route starts with (:func:`qsplan.planner.plan.reorient.
     plan_reorientation`: to the flush instant of the workpiece's longest left side, the left finger on its upper
-    vertex :data:`~qsplan.planner.plan.reorient.FLUSH_APPROACH` short of it), and that step in words; or
-    ``(None, why)``: the route refuses the goal (its message), or the finger does not fit along the longest left
-    side (the route tries the others: not previewed)."""
-    from dataclasses import replace as with_goal
+    vertex :data:`~qsplan.planner.plan.reorient.FLUSH_APPROACH` short of it: :func:`~qsplan.planner.plan.reorient.
+    route_slide`), and that step in words; or ``(None, why)``: the route refuses the goal (its message)."""
+    from qsplan.planner.plan.reorient import pivot_target, route_slide
+    from qsplan.planner.task.goal import GoalNotServedError
 
-    from qsplan.hands.reorient import flush_instant, left_sides
-    from qsplan.mechanics.errors import QsplanError
-    from qsplan.planner.plan.reorient import FLUSH_APPROACH, pivot_target
-    from qsplan.planner.task.goal import Goal, GoalNotServedError
-
-    hand = task.hand
-    if not hand.reorients:
-        return None, f"{_REFUSED}turning the workpiece is planned for the paper's hand form only"
     try:
         pivot_target(task)
+        _, sub, step = route_slide(task)
     except GoalNotServedError as exc:
         return None, f"{_REFUSED}{exc}"
-    sides = left_sides(hand)  # the route's flush edges, longest first
-    if not sides:
-        return None, (f"{_REFUSED}the route lays the left finger flush along a left side of the workpiece (an edge "
-                      "whose lower end is below its upper end), and this workpiece has none")  # fmt: skip
-    try:
-        instant = flush_instant(hand, sides[0])
-    except QsplanError:  # beyond the finger: the route tries the next left side, which the check does not
-        return None, (f"its slide to the flush instant is not previewed either: the left finger does not fit along "
-                      f"the workpiece's longest left side (edge {int(hand.user_edges[sides[0]])}); qsplan plan "
-                      "tries the other left sides")  # fmt: skip
-    x_near = instant.x + FLUSH_APPROACH * np.sign(task.start_x - instant.x)
-    sub = with_goal(task, goal=Goal(float(x_near), ("vertex", int(hand.user_vertices[instant.edge])), None))
-    return sub, (f"the slide to the flush instant (x = {instant.x:.6g} m, the left finger along edge "
-                 f"{int(hand.user_edges[instant.edge])})")  # fmt: skip
+    return sub, step
 
 
 def _preview(task, progress, t0, goal_name="goal", turn=None, refused=False) -> Preview:

@@ -39,7 +39,7 @@ from qsplan.mechanics.errors import NoAnswerError, QsplanError
 from qsplan.planner.task.fields import task_number
 
 __all__ = ["Goal", "FEATURE_KINDS", "GOAL_KEYS", "THETA_TOL", "GoalNotServedError", "check_goal_served", "feature_text",
-           "goal_refusal", "goal_turns", "parse_feature", "make_goal", "reorientation_verdict", "reorients", "make_start_features", "palm_x_range", "task_positions"]
+           "goal_refusal", "goal_turns", "parse_feature", "make_goal", "reorients", "make_start_features", "palm_x_range", "task_positions"]
 
 #: The feature kinds of a goal: the fingertip on an edge, the inner long edge on a vertex.
 FEATURE_KINDS = ("edge", "vertex")
@@ -192,18 +192,6 @@ def goal_refusal(task) -> GoalNotServedError | None:
                                             "places it by the workpiece's x (m); "
                                             f"{_REORIENTATION}")  # fmt: skip
     return None
-
-
-def reorientation_verdict(task) -> GoalNotServedError | None:
-    """What ``qsplan check`` says of a goal that turns the workpiece (:func:`reorients`), or None: its preview covers
-    the palm-edge formation only; ``qsplan plan`` plans such a goal through the flush instant, a hold and the pivot
-    (:mod:`qsplan.planner.plan.reorient`), or refuses it by name."""
-    if not reorients(task):
-        return None
-    field = "goal.theta" if task.goal.theta is not None else "goal.palm"
-    return GoalNotServedError(field, f"{field}: the goal turns the workpiece ({task.goal.describe()}): the check "
-                                     "previews the palm-edge formation only; qsplan plan plans the turn (the slide to "
-                                     "the flush instant, a certified hold, the pivot) or refuses it by name")  # fmt: skip
 
 
 def check_goal_served(task) -> None:
