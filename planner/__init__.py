@@ -26,7 +26,7 @@ Public API (loaded on first use, so ``import qsplan.planner`` stays light):
 * no plan: :class:`PlanFailure` (a :class:`NoAnswerError`) with its :class:`FailureReport`
 * export: :func:`export_plan`, :func:`read_plan_csv`, :func:`export_schedule`, :func:`check_outputs`
 * replay and verification: :func:`replay_plan`, :func:`friction_samples`, :class:`Replay`; in MuJoCo
-  (``pip install 'qsplan[sim]'``): :func:`replay_mujoco`, :func:`scene_xml`
+  (``pip install '.[sim]'``): :func:`replay_mujoco`, :func:`scene_xml`
 * controller-rate samples of a plan: ``plan.sample(times)``, or of a plan directory or file :func:`sample_plan`;
   :class:`PlanSamples`
 * independent certification of an exported plan: :func:`certify_plan`, :class:`Certificate`

@@ -4,5 +4,5 @@
 vectors of the task's set (:mod:`qsplan.hands.reclose` closes the fingers again between segments).
 :mod:`.mujoco_scene` writes the task's scene for MuJoCo (``scene.xml`` beside each plan) and
 :mod:`.mujoco_replay` (:func:`~.mujoco_replay.replay_mujoco`) executes the exported commands in MuJoCo
-(``qsplan replay PLAN_DIR --engine mujoco``; ``pip install 'qsplan[sim]'``).
+(``qsplan replay PLAN_DIR --engine mujoco``; ``pip install '.[sim]'``).
 """

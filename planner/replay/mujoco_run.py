@@ -2,9 +2,12 @@
 
 :class:`MujocoSim` compiles the task's scene once (:func:`qsplan.planner.replay.mujoco_scene.scene_xml`) and
 executes a plan's controller samples (:class:`qsplan.planner.export.sample.PlanSamples`) at any friction
-vector (:meth:`MujocoSim.run`), returning what the replay judges: the workpiece pose at every row and each
-paper contact's mean normal force (MuJoCo's contact sensors, summed at every physics step) and mean slip speed
-(the relative displacement of its bodies' points that touched at the start) over the row's judged interval.
+vector (:meth:`MujocoSim.run`), returning what the replay judges: the workpiece pose and the joints at every row and
+each paper contact's mean normal force (MuJoCo's contact sensors, summed at every physics step) and mean slip speed
+(the relative displacement, along the contact's tangent, of its bodies' points that touched at the start) over the
+row's judged interval.  :meth:`MujocoSim.planned_slip` measures the plan's own slip the same way between its rows'
+configurations, and :attr:`MujocoSim.creep_rate` is what MuJoCo's friction model lets a contact that does not slide
+creep (:mod:`qsplan.planner.replay.mujoco_replay` compares the two).
 """
 
 from __future__ import annotations
@@ -15,11 +18,22 @@ import numpy as np
 
 from qsplan.mechanics.errors import QsplanError
 
-__all__ = ["SNAPSHOT_REACH", "MujocoSim", "RunTrace"]
+__all__ = ["CONTACT_REACH", "NORMAL_GAP", "SNAPSHOT_REACH", "MujocoSim", "RunTrace", "creep_rates"]
 
 #: How far apart (m) two geoms may be for their closest points to be searched (``mj_geomDistance``'s ``distmax``):
 #: a contact farther than 1 cm is broken whatever its slip.
 SNAPSHOT_REACH = 0.01
+
+#: Smallest separation (m) whose closest points give a contact's normal when MuJoCo has no active contact on the
+#: pair: 0.1 um is 10^10 ulps of a coordinate of 0.1 m, so the direction is exact; a closer pair that is not in
+#: contact has no defined normal, and its whole relative displacement counts as slip (the larger reading).
+NORMAL_GAP = 1e-7
+
+#: Distance (m) within which MuJoCo's collision reports a contact at a plan's row (``pair margin`` of the geometry
+#: model :meth:`MujocoSim.contact_jacobians` uses): the plan's contacts touch within the certifier's micron, and a
+#: turned foot sinks ``FOOT_RADIUS (1 - cos theta)`` (27 um at 0.75 rad) into the palm, a penetration, found at any
+#: margin; 10 um finds every planned contact and no open one of a row.
+CONTACT_REACH = 1e-5
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -33,12 +47,54 @@ class RunTrace:
     force : ndarray, shape (m, 4)
         Mean normal force (N) of palm:0, palm:1, left, right over the row's judged interval (ticks).
     slip : ndarray, shape (m, 4)
-        Their mean slip speed (m/s) in the plane over that interval.
+        Their mean slip speed (m/s) over that interval: the displacement along the contact's tangent (the normal part,
+        the soft contact's penetration changing, is no slip).
+    q : ndarray, shape (m, n_j)
+        The joints' positions (rad or m) at each row's tick.
     """
 
     pose: np.ndarray
     force: np.ndarray
     slip: np.ndarray
+    q: np.ndarray
+
+
+def creep_rates(model, pairs) -> np.ndarray:
+    """Fastest creep (m/s) per newton of friction force of each paper contact that MuJoCo holds without sliding.
+
+    MuJoCo's friction is soft (Computation chapter, "Soft constraint model"; Modeling, "Solver parameters:
+    Friction"): a friction row of an elliptic cone has no position term, its reference acceleration is ``-B v``,
+    and inside the cone its force is ``f = (a_ref - a) / R``.  A contact whose force stays inside the cone (it does
+    not slide in Coulomb's sense) therefore settles, within ``1 / B`` (0.1 ms), to the creep ``v = R f / B``; the
+    fastest is at the cone's edge, ``|f| = mu f_n``.  ``R = (1 - d) / d * A_hat / impratio`` with ``A_hat`` the
+    compiler's diagonal inertia of the pair (the two bodies' ``body_invweight0``) and ``d >= solimp[0]`` (largest
+    at the least impedance), ``B = 2 / (solimp[1] timeconst)``.  A contact of several MJCF pairs (a finger's links)
+    takes the largest.
+
+    Parameters
+    ----------
+    model : mujoco.MjModel
+    pairs : sequence of (int, sequence of int)
+        Each paper contact's index and its MJCF pair ids.
+
+    Returns
+    -------
+    ndarray, shape (4,)
+        ``v / (mu f_n)``, (m/s)/N.
+    """
+    out = np.zeros(4)
+    impratio = max(float(model.opt.impratio), 1e-10)
+    for c, ids in pairs:
+        for i in ids:
+            dmin, dmax = (float(v) for v in model.pair_solimp[i, :2])
+            timeconst = float(model.pair_solref[i, 0])
+            if timeconst <= 0:
+                raise QsplanError("scene: a contact pair's solref is in the direct format; its creep is not derived")
+            b1, b2 = (int(model.geom_bodyid[g]) for g in (model.pair_geom1[i], model.pair_geom2[i]))
+            a_hat = float(model.body_invweight0[b1, 0] + model.body_invweight0[b2, 0])
+            r = (1.0 - dmin) / dmin * a_hat / impratio
+            out[c] = max(out[c], r * dmax * timeconst / 2.0)
+    return out
 
 
 class MujocoSim:
@@ -106,7 +162,19 @@ class MujocoSim:
         hi = np.where(same_next, nxt, np.where(same_prev, self.row_tick, self.row_tick + 1))
         last = t.size - 1
         self.judged = np.column_stack([np.clip(lo, 0, last - 1), np.clip(np.maximum(hi, lo + 1), 1, last)])
+        # the same intervals in rows: the plan's own slip over them (planned_slip)
+        k = np.arange(rows_t.size)
+        self.judged_rows = np.column_stack([np.where(same_next | ~same_prev, k, k - 1),
+                                            np.where(same_next, k + 1, k)])  # fmt: skip
         self.start_pose = np.array([cols[k][0] for k in ("x_workpiece", "y_workpiece", "theta_workpiece")], float)
+        self.creep_rate = creep_rates(m, self.pairs)
+        self.cols = cols
+        # each pair's finger joints (indices into samples.joints; none for the palm's)
+        from qsplan.hands.interface import finger_joint_names
+
+        fingers = dict(zip(("left", "right"), finger_joint_names(task.hand)))
+        self.pair_joints = [[names.index(n) for n in fingers.get(c, ())] for c in contact_pairs(task.hand)]
+        self.task, self._geometry = task, None
 
     def _command(self, i: int, hold: bool = False) -> None:
         """Send tick ``i``'s commands: the servo of a velocity or held joint restarts its reference ramp at ``q`` (plus
@@ -124,12 +192,17 @@ class MujocoSim:
         d.ctrl[self.servo] = qd
         d.ctrl[self.motor] = np.where(torque, np.nan_to_num(s.tau[i]), 0.0)
 
-    def _snapshot(self) -> tuple:
-        """Where each paper contact touches now: ``(points (4, 3), body pairs (4, 2), body positions, orientations)``;
-        a contact's point is the midpoint of its nearest pair's closest points (MuJoCo's ``mj_geomDistance``)."""
-        mj, m, d = self.mj, self.model, self.data
-        points, bodies = np.zeros((4, 3)), np.zeros((4, 2), dtype=int)
+    def _snapshot(self, d=None, contacts: bool = True) -> tuple:
+        """Where each paper contact touches in ``d`` (default the run's data): ``(points (4, 3), body pairs (4, 2),
+        normals (4, 3), body positions, orientations)``; a contact's point is the midpoint of its nearest pair's
+        closest points (MuJoCo's ``mj_geomDistance``), its normal MuJoCo's contact frame on that pair when
+        ``contacts`` and one is active, else the closest points' direction when at least :data:`NORMAL_GAP` apart,
+        else zero (undefined)."""
+        mj, m = self.mj, self.model
+        d = self.data if d is None else d
+        points, bodies, normals = np.zeros((4, 3)), np.zeros((4, 2), dtype=int), np.zeros((4, 3))
         fromto = np.zeros(6)
+        nearest = {}
         for c, geoms in self.geoms:
             best = np.inf
             for g1, g2 in geoms:
@@ -138,21 +211,119 @@ class MujocoSim:
                     best = dist
                     points[c] = 0.5 * (fromto[:3] + fromto[3:])
                     bodies[c] = m.geom_bodyid[g1], m.geom_bodyid[g2]
-        return points, bodies, d.xpos.copy(), d.xmat.copy().reshape(-1, 3, 3)
+                    nearest[c] = (g1, g2)
+                    gap = fromto[3:] - fromto[:3]
+                    n = float(np.linalg.norm(gap))
+                    normals[c] = gap / n if n >= NORMAL_GAP else 0.0
+        if contacts:
+            for i in range(d.ncon):
+                con = d.contact[i]
+                for c, pair in nearest.items():
+                    if {int(con.geom1), int(con.geom2)} == set(pair):
+                        normals[c] = con.frame[:3]
+        return points, bodies, normals, d.xpos.copy(), d.xmat.copy().reshape(-1, 3, 3)
 
     @staticmethod
     def _slide(start, end) -> np.ndarray:
-        """Each contact's relative displacement (m) in the plane from snapshot ``start`` to ``end``: the material
-        points of its two bodies that touched at the start, carried by each body to the end, shape (4,)."""
-        points, bodies, x0, r0 = start
-        _, _, x1, r1 = end
+        """Each contact's slip (m) from snapshot ``start`` to ``end``: the material points of its two bodies that
+        touched at the start, carried by each body to the end; their separation in the plane along the contact's
+        tangent (all of it where the start has no normal), shape (4,)."""
+        points, bodies, normals, x0, r0 = start
+        x1, r1 = end[3], end[4]
         out = np.zeros(4)
         for c in range(4):
             carried = []
             for b in bodies[c]:
                 local = r0[b].T @ (points[c] - x0[b])
                 carried.append(x1[b] + r1[b] @ local)
-            out[c] = float(np.hypot(*(carried[0] - carried[1])[:2]))
+            gap = carried[0] - carried[1]
+            gap[2] = 0.0
+            n = normals[c].copy()
+            n[2] = 0.0
+            norm = float(np.linalg.norm(n))
+            if norm > 0:
+                gap -= (gap @ n) / norm**2 * n
+            out[c] = float(np.linalg.norm(gap))
+        return out
+
+    def _distances(self, d, pairs) -> np.ndarray:
+        """Signed distance (m) of each paper contact in ``pairs`` in ``d``: its nearest MJCF pair's."""
+        fromto = np.zeros(6)
+        return np.array([min(self.mj.mj_geomDistance(self.model, d, g1, g2, SNAPSHOT_REACH, fromto)
+                             for g1, g2 in self.geoms[c][1]) for c in pairs])  # fmt: skip
+
+    def contact_jacobians(self, pairs) -> list:
+        """How the contacts ``pairs[k]`` (paper contact indices) of each row ``k`` open, at the row's planned
+        configuration: per contact point MuJoCo's collision finds there (a finger flush on an edge touches at two),
+        ``n . (v_2 - v_1)`` at the point (``n`` the contact normal, from geom 1 to geom 2, ``v`` the bodies'
+        velocities there, MuJoCo's ``mj_jac``) as ``(J_pose (n, 3), J_q (n, n_j), d (n,))``: its rates per unit of
+        the workpiece's pose and of each joint, and its signed distance in the scene (the scene's own geometry: a
+        turned foot sinks into the palm, :func:`qsplan.planner.replay.mujoco_replay.pose_errors`); ``None`` where a
+        row has none."""
+        from qsplan.planner.replay.mujoco_scene import scene_xml
+
+        mj, cols = self.mj, self.cols
+        if self._geometry is None:  # a model of its own: the run's contacts keep their margin of zero
+            self._geometry = mj.MjModel.from_xml_string(scene_xml(self.task))
+            self._geometry.pair_margin[:] = CONTACT_REACH
+        m = self._geometry
+        d = mj.MjData(m)
+        names = self.samples.joints
+        pose = np.column_stack([np.asarray(cols[k], float) for k in ("x_workpiece", "y_workpiece", "theta_workpiece")])
+        q = np.column_stack([np.asarray(cols[f"q_{n}"], float) for n in names])
+        dofs = np.r_[m.jnt_dofadr[[m.joint(n).id for n in ("workpiece_x", "workpiece_y", "workpiece_theta")]],
+                     m.jnt_dofadr[[m.joint(n).id for n in names]]]  # fmt: skip
+        owner = {}
+        for c, geoms in self.geoms:
+            for g1, g2 in geoms:
+                owner[(g1, g2)] = owner[(g2, g1)] = c
+        jac1, jac2 = np.zeros((3, m.nv)), np.zeros((3, m.nv))
+        out = []
+        for k, mine in enumerate(pairs):
+            d.qpos[:3] = pose[k]
+            d.qpos[self.qadr] = np.nan_to_num(q[k])
+            mj.mj_fwdPosition(m, d)
+            rows, seen = [], set()
+            for i in range(d.ncon):
+                con = d.contact[i]
+                if owner.get((int(con.geom1), int(con.geom2))) not in mine:
+                    continue
+                key = (int(con.geom1), int(con.geom2), round(float(con.pos[0]), 9), round(float(con.pos[1]), 9))
+                if key in seen:  # the prism's two faces touch at the same point of the plane
+                    continue
+                seen.add(key)
+                n = np.array(con.frame[:3])
+                mj.mj_jac(m, d, jac1, None, con.pos, int(m.geom_bodyid[con.geom1]))
+                mj.mj_jac(m, d, jac2, None, con.pos, int(m.geom_bodyid[con.geom2]))
+                rows.append(np.r_[n @ (jac2 - jac1)[:, dofs], con.dist])
+            if not rows:
+                out.append(None)
+                continue
+            rows = np.array(rows)
+            out.append((rows[:, :3], rows[:, 3:-1], rows[:, -1]))
+        return out
+
+    def planned_slip(self) -> np.ndarray:
+        """The plan's own mean slip speed (m/s) of each paper contact over every row's judged interval, measured as
+        :meth:`run` measures MuJoCo's (:meth:`_slide`) between the planned configurations (the rows' poses and every
+        joint's ``q`` column) at the interval's end rows, shape (m, 4).  The plan's contacts touch (within the
+        certifier's micron), so the whole displacement is slip."""
+        mj, m, cols = self.mj, self.model, self.cols
+        d = self.mj.MjData(m)
+        names = self.samples.joints
+        t = np.asarray(cols["t"], float)
+        pose = np.column_stack([np.asarray(cols[k], float) for k in ("x_workpiece", "y_workpiece", "theta_workpiece")])
+        q = np.column_stack([np.asarray(cols[f"q_{n}"], float) for n in names])
+        shots = {}
+        for k in np.unique(self.judged_rows):
+            d.qpos[:3] = pose[k]
+            d.qpos[self.qadr] = np.nan_to_num(q[k])
+            mj.mj_kinematics(m, d)
+            shots[int(k)] = self._snapshot(d, contacts=False)
+        out = np.zeros((t.size, 4))
+        for r, (a, b) in enumerate(self.judged_rows):
+            if b > a and t[b] > t[a]:
+                out[r] = self._slide(shots[int(a)], shots[int(b)]) / (t[b] - t[a])
         return out
 
     def run(self, mu) -> RunTrace:
@@ -173,7 +344,7 @@ class MujocoSim:
         if self.n_preload:
             mj.mj_step(m, d, nstep=self.n_preload)
         n_rows, n_ticks = self.row_tick.size, s.t.size
-        pose = np.zeros((n_rows, 3))
+        pose, q = np.zeros((n_rows, 3)), np.zeros((n_rows, len(self.qadr)))
         tick_force = np.zeros((n_ticks - 1, 4))  # mean normal force over the tick (N), every physics step summed
         acc = np.zeros(m.nsensordata)
         rows_at, shots = {}, {}
@@ -183,6 +354,7 @@ class MujocoSim:
         for i in range(n_ticks):
             for r in rows_at.get(i, ()):
                 pose[r] = d.qpos[:3]
+                q[r] = d.qpos[self.qadr]
             if i in ends:
                 shots[i] = self._snapshot()
             if i == n_ticks - 1:
@@ -198,4 +370,4 @@ class MujocoSim:
         for r, (a, b) in enumerate(self.judged):
             force[r] = tick_force[a:b].mean(axis=0)
             slip[r] = self._slide(shots[a], shots[b]) / (s.t[b] - s.t[a])
-        return RunTrace(pose, force, slip)
+        return RunTrace(pose, force, slip, q)

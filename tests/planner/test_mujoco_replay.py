@@ -121,7 +121,7 @@ def test_cli_without_mujoco_names_the_extra(short_demo, monkeypatch, capsys):
     assert main(["replay", str(short_demo), "--task", "demo_task"]) == 2
     err = capsys.readouterr().err.strip()
     assert len(err.splitlines()) == 1 and err.startswith("qsplan: error: --engine")
-    assert "pip install 'qsplan[sim]'" in err
+    assert "pip install '.[sim]'" in err
 
 
 def test_cli_refuses_a_bad_run_count(short_demo, capsys):
