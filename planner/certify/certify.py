@@ -107,7 +107,6 @@ CHECKS = {
 #: Every kind of violation, in the order of the checks.
 KINDS = tuple(CHECKS)
 
-
 @dataclass(frozen=True, slots=True)
 class Violation:
     """One failed check.

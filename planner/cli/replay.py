@@ -31,9 +31,10 @@ from __future__ import annotations
 
 import json
 
+from qsplan.planner.certify.scope import SCOPE
 from qsplan.planner.cli.options import EXIT_FAILED
 
-__all__ = ["COVERAGE", "ENGINES", "FLAGS", "MAX_RUNS", "add_parser", "run"]
+__all__ = ["COVERAGE", "ENGINES", "MUJOCO_ADDS", "FLAGS", "MAX_RUNS", "add_parser", "run"]
 
 #: The engines ``--engine`` offers.
 ENGINES = ("mujoco",)
@@ -45,13 +46,15 @@ FLAGS = {"n_random": "--runs", "engine": "--engine", "plan": "PLAN_DIR", "task":
 #: on one core), so 1000 runs of the longest bundled plan (15 s) take about a day.
 MAX_RUNS = 1000
 
-#: What the certificate covers and what a MuJoCo replay adds: the command's help and the plan card say it.
-COVERAGE = ("The certificate (qsplan verify) proves the exported rows in the quasistatic rigid-body model from the "
-            "task alone: each row's contact mode the only one for every friction in the set, every torque inside its "
-            "guaranteed band, the holds, geometry and timing. A MuJoCo replay adds evidence, not proof: the commands "
-            "executed at 1 kHz with compliant contacts, finite-stiffness servos and inertia, between rows too, at "
-            "the friction set's vertices and sampled points; it compares a contact's mode where MuJoCo's soft "
-            "friction resolves the slip, and the pose once the servos' measured deflection is taken out.")
+#: What a MuJoCo replay adds to the certificate (:data:`qsplan.planner.certify.scope.SCOPE`).
+MUJOCO_ADDS = ("A MuJoCo replay adds evidence, not proof: the commands executed at 1 kHz with compliant contacts, "
+               "finite-stiffness servos and inertia, between rows too, at the friction set's vertices and sampled "
+               "points; it compares a contact's mode where MuJoCo's soft friction resolves the slip, and the pose once "
+               "the servos' measured deflection is taken out.")
+
+#: What the certificate covers and what a MuJoCo replay adds: this command's help says it (the plan card and
+#: ``qsplan verify --help`` say the first part).
+COVERAGE = SCOPE + " " + MUJOCO_ADDS
 
 
 def add_parser(subparsers):

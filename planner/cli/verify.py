@@ -24,6 +24,7 @@ from __future__ import annotations
 import json
 import sys
 
+from qsplan.planner.certify.scope import SCOPE
 from qsplan.planner.cli.options import EXIT_FAILED, EXIT_USAGE, cli_message
 
 __all__ = ["FLAGS", "MAX_LINES", "add_parser", "run"]
@@ -36,7 +37,8 @@ MAX_LINES = 20
 
 
 def add_parser(subparsers):
-    p = subparsers.add_parser("verify", help="certify an exported plan row by row from the task alone")
+    p = subparsers.add_parser("verify", help="certify an exported plan row by row from the task alone",
+                              description="Certify an exported plan row by row from the task alone. " + SCOPE)
     p.add_argument("plan", metavar="PLAN_DIR", help="plan directory (plan.csv or plan.json), or one of the files")
     p.add_argument("--task", metavar="TASK", help="task file (.toml) or a bundled task's name (demo_task, ...); "
                                                   "default: the task recorded in plan.json")

@@ -24,6 +24,7 @@ import textwrap
 
 import numpy as np
 
+from qsplan.planner.certify.scope import SCOPE_SHORT
 from qsplan.planner.plan.sampling import tick_times
 from qsplan.planner.plotting.hands import plan_snapshots, pivot_vertex, state_words
 from qsplan.planner.plotting.plan_panels import (
@@ -101,7 +102,7 @@ def verdict(certificate=None, replays=()) -> tuple:
         pts = max((r.friction_points for r in certificate.rows), default=0)
         what = f"{len(certificate.rows)} rows checked from the task alone, {pts} friction vectors per contact row"
         if certificate.ok:
-            parts.append(f"CERTIFIED ({what}, no violation)")
+            parts.append(f"CERTIFIED ({what}, no violation): {SCOPE_SHORT}")
         else:
             parts.append(f"NOT CERTIFIED ({len(certificate.violations)} violations; {what})")
             ok = False
