@@ -354,17 +354,27 @@ def palm_top_edge(hand) -> int:
 
 
 def finger_inner_edge(hand, body: str) -> int:
-    """The edge of a finger's last link facing the other finger: outward normal ``-y`` in the link frame for the
-    left finger, ``+y`` for the right one (the paper's form, Fig. 9)."""
+    """The edge of a finger's last link facing the other finger: of the link's polygon at mid-range joints, the edge
+    whose outward normal points most toward the other finger's side (world ``+x`` for the left finger, ``-x`` for
+    the right one).  The paper's form (Fig. 9): the link frame's ``-y`` edge of the left finger, ``+y`` of the right;
+    a jaw: its face toward the other jaw."""
     from qsplan.hands.interface import manipulator_of
+    from qsplan.hands.workpiece import rotation
+    from qsplan.mechanics.model.manipulator import link_poses
 
     link = finger_link(hand, body)
     if link < 0:
         raise QsplanError(f"body: expected 'left' or 'right'; got {body!r}")
-    shape = manipulator_of(hand).joints[link].link_shape
+    man = manipulator_of(hand)
+    shape = man.joints[link].link_shape
     if shape is None:
         raise QsplanError(f"body: the {body} finger's last link has no polygon")
-    return _edge_facing(np.asarray(shape, dtype=float), (0.0, -1.0) if body == "left" else (0.0, 1.0), body)
+    P = np.asarray(shape, dtype=float)
+    lim = np.asarray(hand.description.joint_limits, dtype=float)
+    angle = link_poses(man, 0.5 * (lim[:, 0] + lim[:, 1]))[link][2]
+    toward = np.array([1.0, 0.0]) if body == "left" else np.array([-1.0, 0.0])
+    normals = np.array([_outward(P, k)[3] @ rotation(angle).T for k in range(len(P))])
+    return int(np.argmax(normals @ toward))
 
 
 def _edge_facing(P, direction, body) -> int:

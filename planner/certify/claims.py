@@ -45,6 +45,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from qsplan.mechanics.errors import QsplanError
+
 from qsplan.planner.certify.stated import META_TOL, close, difference, differs, finite_or_none, narrowest, show
 
 __all__ = ["INFORMATIONAL_PHASE_KEYS", "INFORMATIONAL_STEP_KEYS", "RowEvidence", "phase_claims", "sequence_claims"]
@@ -214,8 +216,6 @@ _CORE = frozenset({"index", "rows", "t_start_s", "t_end_s", "kind", "mode", "eff
 
 def _more(d, task, cols, rows, path, evidence, names, joint_unit) -> list:
     """The rest of a phase's claims (the module docstring), each against the rows or ``evidence``."""
-    from qsplan.hands.formations import FORMATIONS
-
     contact = str(cols["mode"][rows[0]]) != "free"
     truth, out = {}, []
     unknown = set(INFORMATIONAL_PHASE_KEYS)  # not checked: informational, or what broken rows leave unknown (named)
@@ -245,17 +245,43 @@ def _more(d, task, cols, rows, path, evidence, names, joint_unit) -> list:
             if key in d and (found := difference(d[key], value, f"{path}.{key}")):
                 out.append(_message(found) + " (the contacts found in the polygons and the mode column)")
         if "formation" in d:
-            last = tuple(sets[1][-1]["contacts"])
-            fits = sorted(n for n, f in FORMATIONS.items() if f.contact_names == last)
-            if d["formation"] not in fits:
-                whose = " or ".join(fits) or "no registered formation"
-                out.append(f"{path}.formation states {show(d['formation'])}; the phase's last contacts "
-                           f"({', '.join(last)}) are those of {whose}")  # fmt: skip
+            out += _formation_claim(d["formation"], task, cols, rows, tuple(sets[1][-1]["contacts"]), path)
     if "competitors_precluded" in d:
         out += _competitor_claims(d["competitors_precluded"], cols, rows, path)
     if "workpiece_speed_m_s" in d and "speed_scale" in cols:
         out += _speed_claims(d["workpiece_speed_m_s"], task, cols, rows, path, names)
     return out
+
+
+def _formation_claim(name, task, cols, rows, last, path) -> list:
+    """A phase's ``formation``: a registered one (the palm edge's) whose contacts are the phase's last set, or a
+    generated pivot (:func:`qsplan.hands.pivots.pivot_from_name`) whose constraints hold at every row of the phase
+    (each gap within the contact tolerance) and whose pivot vertex is on the palm at its last row."""
+    from qsplan.hands.formations import FORMATIONS
+    from qsplan.hands.manifold import gaps
+    from qsplan.hands.pivots import pivot_from_name
+    from qsplan.mechanics.model.geometry import CONTACT_TOL
+    from qsplan.planner.certify.rows import row_pose, row_q
+
+    pivot = pivot_from_name(name)
+    if pivot is None:
+        fits = sorted(n for n, f in FORMATIONS.items() if f.contact_names == last)
+        if name in fits:
+            return []
+        whose = " or ".join(fits) or "no registered formation"
+        return [f"{path}.formation states {show(name)}; the phase's last contacts ({', '.join(last)}) are those of "
+                f"{whose}"]  # fmt: skip
+    names = task.hand.joint_names
+    try:
+        worst = max(float(np.max(np.abs(gaps(task.hand, pivot.constraints(task.hand),
+                                                 np.concatenate([row_pose(cols, k), row_q(cols, k, names)])))))
+                    for k in rows)  # fmt: skip
+    except (QsplanError, IndexError) as exc:
+        return [f"{path}.formation states {show(name)}, not a formation of this hand and workpiece ({exc})"]
+    if not worst <= CONTACT_TOL or f"palm:{pivot.vertex}" not in last:
+        return [f"{path}.formation states {show(name)}; its contacts are {worst:.3g} m open at the phase's rows (or its "
+                f"pivot vertex is off the palm: the last contacts {', '.join(last)})"]  # fmt: skip
+    return []
 
 
 #: Keys checked by their own rule rather than equality.

@@ -269,10 +269,10 @@ def plan_task(task: Task, options: PlannerOptions | None = None, progress=None, 
     check_goal_served(task)  # a goal in another formation (theta, another palm feature): refused by name first
     from qsplan.planner.task.goal import reorients
 
-    if reorients(task):  # the route through the flush instant, a hold and the pivot
-        from qsplan.planner.plan.reorient import plan_reorientation
+    if reorients(task):  # a route of formations: the slide to a flush instant, holds and pivots
+        from qsplan.planner.plan.turning import plan_turn
 
-        return plan_reorientation(task, options, progress, sequence_planner)
+        return plan_turn(task, options, progress, sequence_planner)
     beyond = palm_report(task)  # from the task's geometry alone, before any table or grid is built
     if beyond is not None:
         raise PlanFailure(beyond)

@@ -78,7 +78,7 @@ def failed_configuration(task, report) -> tuple:
     d = report.as_dict()
     band = _band_report(report)
     kind = d.get("kind")  # a report of another kind (a refused certificate): the start is drawn
-    if kind == "invalid configuration":
+    if kind == "invalid configuration" or (kind == "no turn" and report.pose is not None):
         x, q = float(report.x), None if report.q is None else np.asarray(report.q, float)
     elif kind == "beyond the palm":
         return float(report.x), None, (), ()
@@ -136,23 +136,19 @@ def _x_strip(ax, task, report, x_failed):
     legend_below(ax, handles, ncol=3)
 
 
-def _goal_theta(task):
-    """The angle (rad) a turning goal asks (its ``theta``, or where its palm edge lands), or None where the planner
-    does not place it."""
-    from qsplan.planner.plan.reorient import pivot_target
-    from qsplan.planner.task.goal import GoalNotServedError
-
-    try:
-        return float(pivot_target(task))
-    except GoalNotServedError:
-        return None
+def _goal_theta(task, report):
+    """The angle (rad) a turning goal asks: its ``theta``, or where a formation the search tried lands its palm edge
+    (the report's ``goal_theta``); None where nothing places it."""
+    if task.goal is not None and task.goal.theta is not None:
+        return float(task.goal.theta)
+    return getattr(report, "goal_theta", None)
 
 
-def _theta_strip(ax, task, theta_failed):
+def _theta_strip(ax, task, report, theta_failed):
     """The workpiece's angle (deg) for a goal that turns it: the start (0), the goal's angle, the failed row."""
     from matplotlib.lines import Line2D
 
-    goal = _goal_theta(task)
+    goal = _goal_theta(task, report)
     pts = [0.0, np.degrees(theta_failed)]
     ax.axvline(0.0, color="k", lw=1.0)
     handles = [Line2D([], [], color="k", lw=1.0, label="start (theta = 0)")]
@@ -214,7 +210,7 @@ def failure_figure(task, report, path=None):
     turned = f", theta = {np.degrees(pose[2]):.4g} deg" if pose[2] != 0.0 else ""
     ax.set_title(f"workpiece x = {x:.4g} m{turned}, {what}{red}", fontsize=FONT["note"])
     if reorients(task):  # a goal that turns the workpiece: its angle, not its x, says how far the route came
-        _theta_strip(strip, task, float(pose[2]))
+        _theta_strip(strip, task, report, float(pose[2]))
     else:
         _x_strip(strip, task, report, x)
     lines = textwrap.wrap(message, WRAP)

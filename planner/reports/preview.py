@@ -14,10 +14,10 @@ planning:
 * the verdict: a route of banded slides (and regrasps) from the start to the goal, found by the planner's
   own search in the window it searches, or what blocks it (:func:`qsplan.planner.plan.obstacles.no_route_report`).
 
-A goal that turns the workpiece (``[goal] theta`` or ``palm``) is not previewed (a later issue): the goal says so,
-and the route's first step is previewed as above, the slide to the flush instant (:attr:`Preview.slide_end`:
-:mod:`qsplan.planner.plan.reorient`'s sub-task, the left finger on the flush edge's upper vertex
-:data:`~qsplan.planner.plan.reorient.FLUSH_APPROACH` short of the instant), or the route's refusal is named.
+A goal that turns the workpiece (``[goal] theta`` or ``palm``) is previewed as the planner's formation search sees
+it (:func:`qsplan.planner.plan.turning.survey`): every pivot formation of the hand and workpiece, where each ends and
+why (an event and its angle, a band below the resolution) or its narrowest band (:attr:`Preview.formations`); then
+the slide to the flush instant of the one with the widest bands, previewed as above (:attr:`Preview.slide_end`).
 
 All of it is read from the planner's own band tables (:func:`qsplan.planner.search.tables.band_tables` of the rows
 :func:`qsplan.planner.plan.autoplan.grasp_rows` gives) on a grid across the whole palm through the start and the
@@ -36,7 +36,7 @@ from qsplan.planner.reports.preview_configs import (ConfigurationCheck, configur
                                                     goal_candidates, start_candidates)  # fmt: skip
 from qsplan.planner.reports.preview_route import route_verdict
 
-__all__ = ["GraspBar", "Preview", "preview_task", "turn_slide", "x_ranges"]
+__all__ = ["GraspBar", "Preview", "preview_task", "torque_words", "x_ranges"]
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -106,8 +106,11 @@ class Preview:
     seconds : float
         Wall time of the preview (s).
     slide_end : ConfigurationCheck or None
-        A turning goal's: the end of the slide to the flush instant, the route's first step, previewed as a goal
-        (the bars, ``route`` and ``verdict`` are that slide's); None otherwise.
+        A turning goal's: the end of the slide to the flush instant of the formation with the widest pivot bands,
+        the route's first step, previewed as a goal (the bars and ``route`` are that slide's); None otherwise.
+    formations : tuple of qsplan.planner.plan.turning.FormationOutcome
+        A turning goal's: every pivot formation the search sees, where each ends and why, or its narrowest band
+        (:func:`qsplan.planner.plan.turning.survey`).
     """
 
     task: str
@@ -129,6 +132,7 @@ class Preview:
     verdict: str
     seconds: float
     slide_end: ConfigurationCheck | None = None
+    formations: tuple = ()
 
     def as_dict(self) -> dict:
         x = self.x
@@ -147,7 +151,8 @@ class Preview:
                 "mu_range": list(self.mu_range), "shared_mu": self.shared_mu,
                 "mode": self.mode, "effort_joints": list(self.efforts), "grasps": bars, "ok": self.ok,
                 "route": list(self.route), "verdict": self.verdict, "seconds": self.seconds,
-                "slide_end": None if self.slide_end is None else self.slide_end.as_dict()}  # fmt: skip
+                "slide_end": None if self.slide_end is None else self.slide_end.as_dict(),
+                "formations": [o.as_dict() for o in self.formations]}  # fmt: skip
 
 
 def x_ranges(x, mask) -> list:
@@ -212,44 +217,43 @@ def preview_task(task, progress=None) -> Preview:
     -------
     Preview
     """
-    from qsplan.planner.task.goal import reorients
+    from qsplan.planner.task.goal import GoalNotServedError, reorients
 
     t0 = time.perf_counter()
     if not reorients(task):
         return _preview(task, progress, t0)
-    sub, why = turn_slide(task)
+    from qsplan.planner.plan.turning import slide_task, survey
+
     what = f"a turn ({task.goal.describe()})"
-    if sub is None:  # the route refuses it, or its slide cannot be named: said, the start previewed alone
-        return _preview(task, progress, t0, turn=f"{what}: not previewed by check; {why}",
-                        refused=why.startswith(_REFUSED))  # fmt: skip
+    try:
+        surveyed = survey(task, progress)
+    except GoalNotServedError as exc:  # refused by name: said, the start previewed alone
+        return _preview(task, progress, t0, turn=f"{what}: {_REFUSED}{exc}", refused=True)
+    formations = tuple(s.outcome for s in surveyed)
+    lines = "; ".join(o.line() for o in formations) or "the hand and workpiece offer no pivot formation"
+    reaching = [s for s in surveyed if s.pieces is not None]
+    if not reaching:
+        out = _preview(task, progress, t0, turn=f"{what}: no formation reaches it ({lines})", refused=True)
+        return replace(out, formations=formations, seconds=time.perf_counter() - t0)
+    best = max(reaching, key=lambda s: s.outcome.band)  # the first of equals, as the planner keeps
+    sub, step = slide_task(task, best.pivot, best.start)
     inner = _preview(sub, progress, t0, goal_name="slide's end")
     goal = ConfigurationCheck("goal", inner.goal.x, None, None, None, 0, 0,
-                              note=f"{what}: not previewed by check; qsplan plan searches it ({_ROUTE})")  # fmt: skip
-    verdict = (f"goal: {what}, not previewed by check (qsplan plan searches it) / its first step, {why}: "
-               f"{inner.verdict}; the hold and the pivot that follow are not previewed")  # fmt: skip
-    return replace(inner, task=task.name, goal=goal, ok=False, verdict=verdict, slide_end=inner.goal,
-                   seconds=time.perf_counter() - t0)  # fmt: skip
+                              note=f"{what}: the formations searched: {lines}")  # fmt: skip
+    verdict = (f"goal: {what}: {best.outcome.words} reaches it, narrowest pivot band "
+               f"{torque_words(best.outcome.band)}; its first step, {step}: {inner.verdict} (the holds are proved "
+               "when planned)")  # fmt: skip
+    return replace(inner, task=task.name, goal=goal, ok=inner.ok, verdict=verdict, slide_end=inner.goal,
+                   formations=formations, seconds=time.perf_counter() - t0)  # fmt: skip
 
 
-#: The route of a turning goal, in words (:mod:`qsplan.planner.plan.reorient`); how a refusal of it begins.
-_ROUTE = "the slide to the flush instant, a certified hold, the pivot"
+#: How a refusal of a turning goal begins.
 _REFUSED = "qsplan plan refuses it: "
 
 
-def turn_slide(task) -> tuple:
-    """``(sub-task, words)``: the slide a turning goal's route starts with (:func:`qsplan.planner.plan.reorient.
-    plan_reorientation`: to the flush instant of the workpiece's longest left side, the left finger on its upper
-    vertex :data:`~qsplan.planner.plan.reorient.FLUSH_APPROACH` short of it: :func:`~qsplan.planner.plan.reorient.
-    route_slide`), and that step in words; or ``(None, why)``: the route refuses the goal (its message)."""
-    from qsplan.planner.plan.reorient import pivot_target, route_slide
-    from qsplan.planner.task.goal import GoalNotServedError
-
-    try:
-        pivot_target(task)
-        _, sub, step = route_slide(task)
-    except GoalNotServedError as exc:
-        return None, f"{_REFUSED}{exc}"
-    return sub, step
+def torque_words(width: float) -> str:
+    """A band's width for the verdict: ``0.214 N m``, or ``unbounded above``."""
+    return f"{width:.4g} N m" if np.isfinite(width) else "unbounded above"
 
 
 def _preview(task, progress, t0, goal_name="goal", turn=None, refused=False) -> Preview:

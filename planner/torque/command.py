@@ -38,12 +38,13 @@ def choose_command(lower, upper, safety_margin, max_margin=None):
     """The effort with the largest margin inside each band.
 
     * bounded band: the midpoint, margin = half the width; with ``max_margin``, a band
-      wider than twice it gets ``lower + max_margin`` instead (no torque far above the
-      one the mode needs: near a blow-up of the upper edge the midpoint runs away) or, in
-      a segment whose bands are unbounded below and nowhere unbounded above (a finger
-      squeezing with negative torque, whose lower edge is the one that blows up),
-      ``upper - max_margin``: the edge the mode needs is the same along the segment, so the
-      command stays continuous where an unbounded edge becomes finite;
+      wider than twice it gets ``max_margin`` inside the edge nearer zero instead (no torque far beyond the one
+      the mode needs: near a blow-up of the far edge the midpoint runs away): ``lower + max_margin`` in a segment
+      that pushes with positive efforts, ``upper - max_margin`` in one that pushes with negative efforts (its bands
+      unbounded below and nowhere unbounded above, a finger squeezing whose lower edge blows up; or, bounded
+      everywhere, their midpoints' median negative).  The edge is the same along the segment, so the command stays
+      continuous where an unbounded edge becomes finite; and the rule is the mirror image of itself (an effort's
+      sign flipped, the command's is);
     * unbounded above (below): ``lower + safety_margin`` (``upper - safety_margin``), margin = ``safety_margin``
       (a midpoint does not exist);
     * unbounded on both sides: 0, margin inf;
@@ -70,7 +71,11 @@ def choose_command(lower, upper, safety_margin, max_margin=None):
         raise QsplanError(f"max margin: expected a finite effort of at least the safety margin {safety_margin:g}; "
                           f"got {max_margin!r}")  # fmt: skip
     lo_f, up_f = np.isfinite(lower), np.isfinite(upper)
-    from_upper = bool(np.any(np.isneginf(lower) & up_f)) and not np.any(np.isposinf(upper))
+    bounded = lo_f & up_f
+    if np.any(np.isinf(lower)) or np.any(np.isinf(upper)):
+        from_upper = bool(np.any(np.isneginf(lower) & up_f)) and not np.any(np.isposinf(upper))
+    else:  # bounded everywhere: the side of zero the bands lie on (their midpoints' median)
+        from_upper = bool(bounded.any() and np.median(0.5 * (lower[bounded] + upper[bounded])) < 0.0)
     with np.errstate(invalid="ignore"):
         half = 0.5 * (upper - lower)
         if max_margin is not None:
@@ -118,10 +123,11 @@ def command_rule(safety_margin, max_margin=None, resolution=None) -> dict:
         rule = ("midpoint of a bounded band; lower + safety_margin where unbounded above (upper - safety_margin "
                 "where unbounded below); 0 where unbounded on both sides")
     else:
-        rule = ("one margin m = max_margin kept from both edges along the whole segment: lower + m where the band "
-                "is wider than 2 m, its midpoint where it is narrower; lower + safety_margin where unbounded above "
-                "(upper - safety_margin where unbounded below); m = min(half the segment's narrowest band, "
-                f"{MAX_MARGIN_RESOLUTIONS:g} torque resolutions) unless given")
+        rule = ("one margin m = max_margin kept from both edges along the whole segment: m inside the edge nearer "
+                "zero where the band is wider than 2 m (lower + m in a segment pushing with positive efforts, upper - "
+                "m in one pushing with negative efforts), its midpoint where it is narrower; lower + safety_margin "
+                "where unbounded above (upper - safety_margin where unbounded below); m = min(half the segment's "
+                f"narrowest band, {MAX_MARGIN_RESOLUTIONS:g} torque resolutions) unless given")
     out = {"rule": rule, "safety_margin_N_m": float(safety_margin),
            "max_margin_N_m": None if max_margin is None else float(max_margin)}  # fmt: skip
     if resolution is not None:

@@ -18,14 +18,14 @@ import pytest
 from qsplan.planner.cli.main import main
 from qsplan.planner.pipeline.run import CERTIFICATE_REFUSED
 from qsplan.planner.plan.failure import NOT_RUN_BAND_AT_END, NOT_RUN_GOAL, NOT_RUN_INVALID, SEARCHED_BANDS
-from qsplan.planner.plan.reorient import AFTER_SLIDE
+from qsplan.planner.plan.pivot import IN_SEARCH
+from qsplan.planner.plan.turning import SEARCHED_FORMATIONS
 from qsplan.planner.task.task import task_paths
 
 #: ``planner_status`` of a task refused from its geometry (a position beyond the palm).
 NOT_RUN_GEOMETRY = "not run (refused from the task's geometry)"
 
-#: The demo's workpiece as the bundled tasks write it, and the README's pentagon: its left sides do not fit along the
-#: left finger at a flush instant (the upper one reaches past the fingertip, the lower one below the joint).
+#: The demo's workpiece as the bundled tasks write it, and the README's pentagon (its pivots' fingers meet at once).
 DEMO_SHAPE = "workpiece = [[0.0, 0.0], [0.080, 0.0], [0.085, 0.080], [0.008, 0.100]]"
 README_PENTAGON = "workpiece = [[0.0, 0.0], [0.08, 0.0], [0.09, 0.06], [0.04, 0.1], [-0.01, 0.06]]"
 
@@ -42,29 +42,29 @@ CASES = {
                                           "no route (band closes)", SEARCHED_BANDS),
     "waypoints whose band closes": ("scripted_regrasp_task", [("range = [0.0, 0.2]", "range = [0.0, 0.9]")],
                                     "band closes", NOT_RUN_BAND_AT_END),
-    "theta counter-clockwise": ("reorient_task", [("\ntheta = -0.5", "\ntheta = 0.5")], "goal not served",
-                                NOT_RUN_GOAL),
-    "theta past the slip reversal": ("reorient_task", [("\ntheta = -0.5", "\ntheta = -0.85")],
-                                     "invalid configuration", AFTER_SLIDE),
-    "theta far past it": ("reorient_task", [("\ntheta = -0.5", "\ntheta = -1.2")], "invalid configuration",
-                          AFTER_SLIDE),
-    "theta whose slide to the flush instant closes": ("reorient_task", [("range = [0.0, 0.2]", "range = [0.0, 0.9]")],
+    "theta counter-clockwise (its one pivot has no band)": ("reorient_task", [("\ntheta = -0.5", "\ntheta = 0.5")],
+                                                             "invalid configuration", IN_SEARCH),
+    "theta past the second piece's band": ("reorient_task", [("\ntheta = -0.5", "\ntheta = -0.85")],
+                                           "invalid configuration", IN_SEARCH),
+    "theta far past it": ("reorient_task", [("\ntheta = -0.5", "\ntheta = -1.2")], "no turn", SEARCHED_FORMATIONS),
+    "theta whose slide to the flush instant closes": ("reorient_task", [("torque_resolution = 0.02",
+                                                                         "torque_resolution = 0.3")],
                                                       "no route (band closes)", SEARCHED_BANDS),
-    "theta on a house whose slide step ends in an overlap": ("pentagon_task", [("waypoints = [0.02, -0.02]", ""),
-                                                                                ("[friction]", "[goal]\ntheta = -0.3\n\n[friction]")],
-                                                             "invalid configuration", NOT_RUN_INVALID),
-    "theta on a pentagon with no left side the finger fits": ("reorient_task", [(DEMO_SHAPE, README_PENTAGON),
-                                                                                ("\ntheta = -0.5", "\ntheta = -0.3")],
-                                                              "goal not served", NOT_RUN_GOAL),
-    "theta with the two-link hand": ("two_link_task", [("x = -0.03", "theta = -0.3")], "goal not served", NOT_RUN_GOAL),
-    "theta with the parallel jaw": ("parallel_jaw_task", [("x = -0.02", "theta = -0.3")], "goal not served",
-                                    NOT_RUN_GOAL),
+    "theta on a house": ("pentagon_task", [("waypoints = [0.02, -0.02]", ""),
+                                           ("[friction]", "[goal]\ntheta = -0.3\n\n[friction]")],
+                         "no turn", SEARCHED_FORMATIONS),
+    "theta on a pentagon whose pivots end at once": ("reorient_task", [(DEMO_SHAPE, README_PENTAGON),
+                                                                       ("\ntheta = -0.5", "\ntheta = -0.3")],
+                                                     "no turn", SEARCHED_FORMATIONS),
+    "theta with the two-link hand": ("two_link_task", [("x = -0.03", "theta = -0.3")], "no turn", SEARCHED_FORMATIONS),
+    "theta with the parallel jaw": ("parallel_jaw_task", [("x = -0.02", "theta = -0.3")], "no turn",
+                                    SEARCHED_FORMATIONS),
     "palm vertex without theta": ("reorient_task", [("\ntheta = -0.5", '\npalm = "vertex:1" #')], "goal not served",
                                   NOT_RUN_GOAL),
-    "palm edge of a tall quadrilateral": ("reorient_task", [("\ntheta = -0.5", '\npalm = "edge:1" #')],
-                                          "invalid configuration", AFTER_SLIDE),
-    "palm edge the pivot cannot land": ("reorient_edge_task", [('palm = "edge:1"', 'palm = "edge:3"')],
-                                        "goal not served", NOT_RUN_GOAL),
+    "palm edge of a tall quadrilateral": ("reorient_task", [("\ntheta = -0.5", '\npalm = "edge:1" #')], "no turn",
+                                          SEARCHED_FORMATIONS),
+    "palm edge no pivot lands": ("reorient_edge_task", [('palm = "edge:1"', 'palm = "edge:3"')], "no turn",
+                                 SEARCHED_FORMATIONS),
 }
 
 
@@ -110,18 +110,21 @@ def test_the_failure_kinds_cover_every_goal_kind_and_hand():
     assert hands == {"two-link", "parallel jaw"}
 
 
-def test_a_turn_stops_at_its_first_event_with_its_pose(tmp_path, capsys):
-    """theta = -1.2 rad: the slip reversal at -45.69 deg comes before the overlap at -55 deg, and is reported there,
-    with the workpiece's pose (turned) for the drawing."""
+def test_a_turn_no_formation_reaches_names_each_and_draws_the_farthest(tmp_path, capsys):
+    """theta = -1.2 rad: the clockwise pivot passes its slip reversal (-45.69 deg) through a hold and ends where the
+    right finger meets the workpiece (-55.05 deg); the counter-clockwise one does not serve the goal.  The report
+    names both and carries the pose where the farthest ended (drawn by failure.png)."""
     task_file = _task_file(tmp_path, "reorient_task", [("\ntheta = -0.5", "\ntheta = -1.2")])
     report = _failed_run(tmp_path, capsys, task_file, plots=False)
-    assert "contact right stops sliding at theta = -45.69 deg" in report["reason"]
-    x, y, theta = report["pose"]
-    assert report["x_m"] == x and -46.0 < theta * 180 / 3.141592653589793 < -45.69
+    ended, other = report["formations"]
+    assert ended["status"] == "ended" and "right finger overlap" in ended["why"]
+    assert -55.2 < ended["theta_rad"] * 180 / 3.141592653589793 < -54.8
+    assert other["status"] == "not this goal" and report["pose"] == ended["pose"]
 
 
 def test_a_failed_step_of_a_route_names_the_step(tmp_path, capsys):
-    task_file = _task_file(tmp_path, "reorient_task", [("range = [0.0, 0.2]", "range = [0.0, 0.9]")])
+    """A resolution wider than the slide's band: the pivot is judged first (it passes), then its slide fails."""
+    task_file = _task_file(tmp_path, "reorient_task", [("torque_resolution = 0.02", "torque_resolution = 0.3")])
     report = _failed_run(tmp_path, capsys, task_file, plots=False)
     assert report["route_step"].startswith("the slide to the flush instant (x = -0.0422")
     assert report["message"].startswith(f"no plan: {report['route_step']}: ")

@@ -91,15 +91,11 @@ def test_goals_of_the_palm_edge_formation_without_x_are_refused(goal, field):
 @pytest.mark.parametrize("goal, field, why", [
     ({"x": -0.04, "theta": -0.5}, "goal.x", "the pivot decides x"),
     ({"theta": 2 * THETA_TOL, "x": -0.04}, "goal.x", "the pivot decides x"),
-    ({"theta": 0.3, "palm": "vertex:1"}, "goal.theta", "counter-clockwise"),
-    ({"theta": 0.3}, "goal.theta", "counter-clockwise"),
-    ({"theta": -0.3, "palm": "vertex:2"}, "goal.palm", "pivots on vertex 1"),
     ({"palm": "vertex:1"}, "goal.theta", "give the angle too"),
     ({"palm": "vertex:1", "x": -0.04}, "goal.x", "the pivot decides x"),
-    ({"palm": "edge:2"}, "goal.palm", "edge 1 is"),
     ({"palm": "edge:1", "x": -0.04}, "goal.x", "the pivot decides x"),
 ])  # fmt: skip
-def test_turning_goals_the_route_cannot_serve_are_refused_by_name(goal, field, why, monkeypatch):
+def test_turning_goals_no_formation_can_mean_are_refused_by_name(goal, field, why, monkeypatch):
     from qsplan.planner.plan import autoplan
     from qsplan.planner.plan.scripted import plan_task
     from qsplan.planner.task.goal import reorients
@@ -109,10 +105,34 @@ def test_turning_goals_the_route_cannot_serve_are_refused_by_name(goal, field, w
 
     monkeypatch.setattr(autoplan, "plan_automatic", never)
     task = demo_with(goal)
-    assert reorients(task) and goal_refusal(task) is None  # the reorientation route decides
+    assert reorients(task) and goal_refusal(task) is None  # the formation search decides
     with pytest.raises(GoalNotServedError, match=f"^{field}: .*{why}") as info:
         plan_task(task)
     assert info.value.field == field and not isinstance(info.value, ValueError)
+
+
+@pytest.mark.parametrize("goal, why", [
+    ({"theta": 0.3, "palm": "vertex:1"}, ["it turns the workpiece clockwise", "it pivots on vertex 0"]),
+    ({"theta": -0.3, "palm": "vertex:2"}, ["it pivots on vertex 1", "it turns the workpiece counter-clockwise"]),
+    ({"palm": "edge:2"}, ["turning clockwise on vertex 1 lands edge 1", "turning counter-clockwise on vertex 0 lands edge 3"]),
+])  # fmt: skip
+def test_turning_goals_no_formation_reaches_report_every_formation(goal, why, monkeypatch):
+    """The demo's hand and workpiece offer two pivots (clockwise on vertex 1 with the left finger flush, its mirror);
+    a goal neither can serve is refused with each formation and why, before any slide is planned."""
+    from qsplan.planner.plan import autoplan
+    from qsplan.planner.plan.results import PlanFailure
+    from qsplan.planner.plan.scripted import plan_task
+
+    def never(*args, **kwargs):
+        raise AssertionError("the planner ran a slide for a goal no formation reaches")
+
+    monkeypatch.setattr(autoplan, "plan_automatic", never)
+    with pytest.raises(PlanFailure) as info:
+        plan_task(demo_with(goal))
+    report = info.value.report.as_dict()
+    assert report["kind"] == "no turn" and [f["status"] for f in report["formations"]] == ["not this goal"] * 2
+    assert [f["why"] for f in report["formations"]] == why
+    assert report["formations"][0]["formation"] == "pivot:v1:left:e3:vertex2"
 
 
 @pytest.mark.parametrize("goal", [{"x": -0.04, "theta": 0.0}, {"x": -0.04, "theta": -THETA_TOL / 2},
@@ -146,28 +166,26 @@ def test_existing_goals_are_unchanged(name):
     assert goal.theta is None and goal.palm is None and goal_refusal(load_task(task_paths()[name])) is None
 
 
-def test_plan_refuses_a_counter_clockwise_turn_in_one_line(tmp_path, capsys, monkeypatch):
-    from qsplan.planner.plan import autoplan
-
-    def never(*args, **kwargs):
-        raise AssertionError("the planner ran on a goal it refuses")
-
-    monkeypatch.setattr(autoplan, "plan_automatic", never)
+def test_plan_refuses_a_turn_no_formation_reaches_in_one_line(tmp_path, capsys):
+    """The demo's counter-clockwise pivot (the right finger flush on edge 1) has no band at its transition: the one
+    formation that could serve theta = +0.5 rad is named with where it closes, in one line and ``failure.json``."""
     path = tilt_file(tmp_path)
     path.write_text(path.read_text().replace("theta = -0.5", "theta = 0.5"))
     out = tmp_path / "out"
     code = main(["plan", str(path), "--out", str(out), "--no-plots", "--verify", "0", "--quiet"])
     stdout, err = capsys.readouterr()
     assert code == 2 and stdout == "" and len(err.splitlines()) == 1 and "Traceback" not in err
-    assert err.startswith("qsplan: error: goal.theta: turning the workpiece counter-clockwise (theta = 0.5 rad) is "
-                          "not planned")  # fmt: skip
+    assert err.startswith("qsplan: error: no plan: no guaranteed band at least the torque resolution") and \
+        "pivot on vertex 0 from theta = 0" in err  # fmt: skip
+    assert json.loads((out / "failure.json").read_text())["planner_status"].startswith("ran: ")
     assert not (out / "plan.csv").exists() and not (out / "plan.json").exists()
 
 
-def test_check_says_what_it_does_not_preview_of_a_turning_goal(tmp_path, capsys):
-    """Issue 31: the check called a turning goal "goal (x = 0 m): not a valid configuration".  It says the turn is not
-    previewed and previews the route's first step, the slide to the flush instant, as ``qsplan plan`` plans it."""
-    from qsplan.hands.reorient import flush_instant
+def test_check_previews_a_turning_goal_as_the_formation_search_sees_it(tmp_path, capsys):
+    """Issue 31 called a turning goal "goal (x = 0 m): not a valid configuration"; issue 32: the check shows every
+    formation the search sees (where each ends, or its band) and previews the slide to the flush instant of the one
+    that reaches the goal, as ``qsplan plan`` plans it."""
+    from qsplan.hands.pivots import pivot_formations
 
     path = tilt_file(tmp_path)
     task = load_task(path)
@@ -175,26 +193,27 @@ def test_check_says_what_it_does_not_preview_of_a_turning_goal(tmp_path, capsys)
     code = main(["check", str(path), "--json", "--out", str(tmp_path / "check")])
     stdout, err = capsys.readouterr()
     doc = json.loads(stdout)
-    assert code == 0 and err == "" and not doc["ok"]  # the turn is not judged: never ok
+    assert code == 0 and err == "" and doc["ok"]
     goal, end = doc["goal"], doc["slide_end"]
-    assert goal["message"] == ("goal: a turn (theta = -0.5 rad): not previewed by check; qsplan plan searches it (the "
-                               "slide to the flush instant, a certified hold, the pivot)")  # fmt: skip
-    assert not goal["previewed"] and not goal["refused"] and goal["x_m"] is None and "not a valid" not in stdout
-    x = flush_instant(task.hand).x  # the slide's end: the flush instant, 5 um short (the planner's sub-task)
+    assert [f["status"] for f in doc["formations"]] == ["reaches the goal", "not this goal"]
+    assert goal["message"].startswith("goal: a turn (theta = -0.5 rad): the formations searched: pivot on vertex 1")
+    assert doc["verdict"].startswith("goal: a turn (theta = -0.5 rad): pivot on vertex 1 (clockwise), the left finger "
+                                     "flush on edge 3, the right finger on vertex 2 reaches it")  # fmt: skip
+    x = float(pivot_formations(task.hand)[0][1][0])  # the slide's end: the flush instant, 5 um short
     assert end["ok"] and end["previewed"] and abs(end["x_m"] - x) < 0.5e-3 and doc["start"]["ok"]
     assert doc["route"] and doc["route"][0].startswith("slide left from x = 0 to ")
-    assert "the hold and the pivot that follow are not previewed" in doc["verdict"]
-    assert (tmp_path / "check" / "check.png").is_file() and (tmp_path / "check" / "check.json").is_file()
-    code = main(["check", str(path)])
-    lines = capsys.readouterr().out.splitlines()
-    assert code == 0 and goal["message"] in lines and end["message"] in lines and lines[-1] == f"verdict: {doc['verdict']}"
 
 
 @pytest.mark.parametrize("edit, why", [
-    (("theta = -0.5", "theta = 0.5"), "qsplan plan refuses it: goal.theta: turning the workpiece counter-clockwise"),
-    (("theta = -0.5", 'palm = "edge:2"'), "qsplan plan refuses it: goal.palm: edge 2 on the palm: the route pivots on"),
+    (("theta = -0.5", "theta = 0.5"), "no formation reaches it (pivot on vertex 1 (clockwise), the left finger flush "
+                                      "on edge 3, the right finger on vertex 2: not this goal: it turns the workpiece "
+                                      "clockwise; pivot on vertex 0 (counter-clockwise), the right finger flush on edge "
+                                      "1, the left finger on vertex 3: no band at theta = 0 deg: no guaranteed band"),
+    (("theta = -0.5", 'palm = "edge:2"'), "no formation reaches it (pivot on vertex 1 (clockwise), the left finger "
+                                          "flush on edge 3, the right finger on vertex 2: not this goal: turning "
+                                          "clockwise on vertex 1 lands edge 1"),
 ])  # fmt: skip
-def test_check_names_the_route_s_refusal_of_a_turn(tmp_path, capsys, edit, why):
+def test_check_names_every_formation_of_a_turn_none_reaches(tmp_path, capsys, edit, why):
     path = tilt_file(tmp_path)
     path.write_text(path.read_text().replace(*edit))
     code = main(["check", str(path), "--json", "--out", str(tmp_path / "check")])
