@@ -30,10 +30,11 @@ from qsplan.mechanics.errors import QsplanError
 __all__ = ["GAP_TOL", "MAX_NEWTON", "MAX_STEP", "ManifoldPoints", "VertexOnLine", "along_edges", "constraint_jacobian", "gaps",
            "project", "sweep", "tangent"]
 
-#: Newton's stopping gap (m): far below the contact tolerance (1e-6 m) that the contact search and the certifier
-#: use, and above the ~1e-16 m rounding of a 0.1 m polygon, so a projected configuration is a contact to every
-#: reader's tolerance.
-GAP_TOL = 1e-12
+#: Newton's stopping gap (m): fifty rounding units of a 0.1 m coordinate (2e-17 m each), far below the contact
+#: tolerance (1e-6 m) the contact search and the certifier use.  Newton converges quadratically, so this costs one
+#: iteration more than a looser 1e-12 and leaves angles exact to ~1e-14 rad (1e-12 m left them 1e-11 rad off a
+#: closed form).
+GAP_TOL = 1e-15
 
 #: Newton iterations before a projection gives up: from a prediction one step along the tangent it converges
 #: quadratically in 2-4; a configuration out of reach (a finger that cannot close there) does not converge at all.
