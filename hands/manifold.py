@@ -122,7 +122,9 @@ def _polygon(hand, body: str, c) -> np.ndarray:
 
 
 def _ccw(P) -> bool:
-    return float(np.dot(P[:, 0], np.roll(P[:, 1], -1)) - np.dot(np.roll(P[:, 0], -1), P[:, 1])) > 0.0
+    """Whether the ring ``P`` runs counter-clockwise (the shoelace formula's sign)."""
+    x, y = P[:, 0], P[:, 1]
+    return float(x[:-1] @ y[1:] - x[1:] @ y[:-1] + x[-1] * y[0] - x[0] * y[-1]) > 0.0
 
 
 def _located(hand, constraints, c) -> tuple:
@@ -217,13 +219,14 @@ def sweep(hand, constraints, c0, driving: int, values, free) -> ManifoldPoints:
     prev = project(hand, constraints, c0, free)
     reached = 0
     if prev is not None:
+        t = tangent(hand, constraints, prev, driving, free)
         for i, v in enumerate(values):
-            t = tangent(hand, constraints, prev, driving, free)
-            guess = prev + t * (v - prev[driving])
+            guess = prev + t * (v - prev[driving])  # predicted along the last point's tangent
             guess[driving] = v
             found = project(hand, constraints, guess, free)
             if found is None:
                 break
-            c[i], dc[i], prev = found, tangent(hand, constraints, found, driving, free), found
+            t = tangent(hand, constraints, found, driving, free)
+            c[i], dc[i], prev = found, t, found
             reached = i + 1
     return ManifoldPoints(c, dc, int(driving), reached)

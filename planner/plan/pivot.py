@@ -107,7 +107,7 @@ def pivot_geometry(task, pivot, start, theta_goal: float) -> PivotGeometry:
     hand = task.hand
     path = pivot_path(hand, pivot, start, pivot_thetas(0.0, theta_goal))
     cons = pivot.constraints(hand)
-    n, end = path.theta.size, None
+    n, end, contacts = path.theta.size, None, []
     for i in range(n):
         if i >= path.reached:
             end = PivotEnd(i, float(path.theta[i]), "reach", "no configuration of the formation: a finger cannot "
@@ -129,6 +129,7 @@ def pivot_geometry(task, pivot, start, theta_goal: float) -> PivotGeometry:
         except SceneError as exc:
             end = PivotEnd(i, float(path.theta[i]), "configuration", str(exc))
             break
+        contacts.append(found)
         if i == n - 1 and i > 0:  # the goal's row may make a contact (an edge landing): not in the motion
             prev = (path.pose[i - 1], path.q[i - 1])
             found = [f for f, m in zip(found, made_contacts(hand, prev, (pose, q), found)) if not m]
@@ -137,31 +138,32 @@ def pivot_geometry(task, pivot, start, theta_goal: float) -> PivotGeometry:
                                                                 f"formation has {_expected_contacts(i, n)}")  # fmt: skip
             break
     valid = n if end is None else end.row
-    cuts = _reversals(task, pivot, path, valid)
+    cuts = _reversals(task, pivot, path, valid, contacts)
     return PivotGeometry(path, end, cuts)
 
 
-def _slips(hand, pose, q, dpose, dq) -> np.ndarray:
+def _slips(hand, pose, q, dpose, dq, found=None) -> np.ndarray:
     """Each contact's sliding speed per unit turning rate (m/rad) at one row of a pivot, canonical order (eq. 6's
-    ``W_t^T nu - J_t qdot`` with the manifold's tangent)."""
+    ``W_t^T nu - J_t qdot`` with the manifold's tangent); ``found``: the row's contacts when already searched."""
     from qsplan.hands.found_contacts import row_contact_scene
 
     n_j = len(hand.joint_names)
-    scene = row_contact_scene(hand, pose, q, np.zeros(n_j, bool), dq)
+    scene = row_contact_scene(hand, pose, q, np.zeros(n_j, bool), dq, found=found)
     nu = np.array([dpose[0] + dpose[2] * pose[1], dpose[1] - dpose[2] * pose[0], dpose[2]])
     return scene.Wt.T @ nu - scene.Jt @ dq
 
 
-def _reversals(task, pivot, path, valid: int) -> tuple:
+def _reversals(task, pivot, path, valid: int, contacts) -> tuple:
     """The angles (rad, bisected to :data:`REVERSAL_TOL`) where a contact's sliding direction reverses along the
-    four-contact rows ``1 .. valid - 1`` of ``path``; each later cut from the previous one's side."""
+    four-contact rows ``1 .. valid - 1`` of ``path`` (``contacts``: each row's, searched); each later cut from the
+    previous one's side."""
     from qsplan.hands.pivots import pivot_path
 
     hand = task.hand
     rows = range(1, valid)
     if len(rows) < 2:
         return ()
-    slips = [_slips(hand, path.pose[i], path.q[i], path.dpose[i], path.dq[i]) for i in rows]
+    slips = [_slips(hand, path.pose[i], path.q[i], path.dpose[i], path.dq[i], contacts[i]) for i in rows]
     signs = [np.sign(s) for s in slips]
     cuts = []
     for a, b in zip(range(len(rows) - 1), range(1, len(rows))):
@@ -196,10 +198,12 @@ def _chord_rates(path, i: int, other: int) -> tuple:
     return (path.pose[other] - path.pose[i]) / dth, (path.q[other] - path.q[i]) / dth
 
 
-def piece_phase(task, name, pivot, path, rows, effort_joint: str, rate: float, transition: bool) -> ContactSegmentPlan:
+def piece_phase(task, name, pivot, path, rows, effort_joint: str, rate: float, transition: bool,
+                contacts=None) -> ContactSegmentPlan:  # fmt: skip
     """One piece of a pivot: ``path``'s ``rows`` (indices, in order), ``effort_joint`` torque-controlled, the other
     joints driven along the manifold at turning ``rate`` (rad/s, its sign the pivot's direction); ``transition``: the
-    first row is the flush instant (the lifting vertex's letter ``B``).  Times from 0 at the quasistatic speed.
+    first row is the flush instant (the lifting vertex's letter ``B``); ``contacts``: each row's contacts, when
+    already searched (:func:`qsplan.hands.found_contacts.ordered_contacts`).  Times from 0 at the quasistatic speed.
 
     Raises
     ------
@@ -218,7 +222,7 @@ def piece_phase(task, name, pivot, path, rows, effort_joint: str, rate: float, t
     for k, i in enumerate(rows):
         # the joints' rates: at rest the chord to the neighbour (the workpiece's follow from the contacts)
         dq = _chord_rates(path, i, rows[1] if k == 0 else rows[-2])[1] if k in (0, n - 1) else path.dq[i]
-        found = ordered_contacts(hand, path.pose[i], path.q[i])
+        found = ordered_contacts(hand, path.pose[i], path.q[i]) if contacts is None else contacts[k]
         drop = None
         if k == n - 1 and n > 1:  # a contact the motion makes at its last row (an edge landing) is not in it
             prev = rows[-2]
@@ -275,16 +279,19 @@ def widest_piece(task, name, pivot, path, rows, transition: bool, progress=None)
     """:func:`piece_phase` with each closing joint torque-controlled in turn, the one whose narrowest band is widest
     (the finger not lying flush first: it keeps a tie, and when its bands are all unbounded above the other is not
     computed); the first one's failure when neither has a band."""
+    from qsplan.hands.found_contacts import ordered_contacts
+
     hand = task.hand
     fingers = (pivot.other_finger, pivot.flush)
     joints = [hand.joint_names[hand.closing_joints[0 if f == "left" else 1]] for f in fingers]
     rate = pivot_rate(task, path, rows)
+    contacts = [ordered_contacts(hand, path.pose[i], path.q[i]) for i in rows]  # searched once for both joints
     found, first_failure = [], None
     for e in joints:
         if found and np.isinf(np.min(found[0].width)):
             break  # unbounded everywhere: nothing is wider
         try:
-            found.append(piece_phase(task, name, pivot, path, rows, e, rate, transition))
+            found.append(piece_phase(task, name, pivot, path, rows, e, rate, transition, contacts))
         except PlanFailure as exc:
             first_failure = first_failure or exc
             if progress:
