@@ -73,9 +73,12 @@ def synthetic_rows(iterations, G=6, n=400, seed=1):
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--iterations", type=int, default=2000, help="iteration budget of the sampling planners")
+    ap.add_argument("--turning", action="store_true", help="only the turning tasks and the fidelity table")
     args = ap.parse_args(argv)
     tasks = {stem: load_task(p) for stem, p in task_paths().items()}
     tasks = {k: t for k, t in tasks.items() if t.goal is not None}
+    if args.turning:
+        return turning_rows(tasks)
     # the band tables: the paper's hand, goals on the palm edge (a turning goal: its own table below)
     paper = {k: t for k, t in tasks.items() if hasattr(t.hand, "finger_length") and t.goal.x is not None}
     print(f"{'task':<22} {'planner':<9} {'search s':>9} {'evaluated':>10} {'narrowest N m':>14} {'regrasps':>9}")
@@ -122,25 +125,95 @@ def hold_margin(task, ph) -> float:
     return min(prove_hold(scene, torques=[t], disturbance=task.disturbance).margin for t in ph.command[[0, -1]])
 
 
+def turning_tasks(tasks) -> dict:
+    """The bundled turning tasks and the variants issue 32 asks of the formation search: the demo turned past its
+    slip reversal (theta = -0.84 rad: two pivots through a hold), the demo mirrored (theta = +0.5 rad: counter-
+    clockwise), the two-link hand and the parallel jaw asked to turn."""
+    from dataclasses import replace
+
+    from qsplan.planner.task.goal import Goal
+
+    out = {k: t for k, t in tasks.items() if t.goal.x is None}
+    demo = tasks["reorient_task"]
+    out["reorient -0.84 rad"] = replace(demo, goal=Goal(None, None, None, theta=-0.84))
+    out["mirrored +0.5 rad"] = _mirrored()
+    for stem in ("two_link_task", "parallel_jaw_task"):
+        t = load_task(task_paths()[stem])
+        out[f"{stem.split('_task')[0]} -0.3 rad"] = replace(t, goal=Goal(None, None, None, theta=-0.3))
+    return out
+
+
+def _mirrored():
+    """``reorient_task`` with its workpiece reflected x -> -x (vertices kept counter-clockwise), its turn reversed."""
+    import tempfile
+    from pathlib import Path
+
+    text = task_paths()["reorient_task"].read_text()
+    text = text.replace("workpiece = [[0.0, 0.0], [0.080, 0.0], [0.085, 0.080], [0.008, 0.100]]",
+                        "workpiece = [[-0.080, 0.0], [0.0, 0.0], [-0.008, 0.100], [-0.085, 0.080]]")
+    text = text.replace("\ntheta = -0.5", "\ntheta = 0.5")
+    path = Path(tempfile.mkdtemp()) / "mirrored.toml"
+    path.write_text(text)
+    return load_task(path)
+
+
 def turning_rows(tasks):
-    """The goals that turn the workpiece (issue 23: slide, hold, pivot): time, states, the route's phases, the
-    narrowest band, the holds and their smallest proof margin, the motion's duration."""
+    """The goals that turn the workpiece (issue 32: the formation search): time, states, formations searched, the
+    route's phases, the narrowest band, the holds and their smallest proof margin, the motion's duration."""
+    from qsplan.planner.plan.results import PlanFailure
+    from qsplan.planner.plan.turning import survey
+
     print()
-    print(f"{'turning task':<22} {'plan s':>7} {'states':>7} {'phases':<20} {'narrowest N m':>14} {'holds':>6} "
-          f"{'hold margin N':>14} {'motion s':>9}")  # fmt: skip
-    for stem, task in tasks.items():
+    print(f"{'turning task':<22} {'plan s':>7} {'states':>7} {'forms':>5} {'phases':<34} {'narrowest N m':>14} "
+          f"{'holds':>6} {'hold margin N':>14} {'motion s':>9}")  # fmt: skip
+    for stem, task in turning_tasks(tasks).items():
+        forms = len(survey(task))
         t0 = time.perf_counter()
         try:
             plan = plan_task(task)
-        except Exception as exc:  # a refused goal: its reason
-            print(f"{stem:<22} {time.perf_counter() - t0:7.2f} refused: {str(exc)[:90]}")
+        except PlanFailure as exc:  # a refused goal: its reason
+            print(f"{stem:<22} {time.perf_counter() - t0:7.2f} {'':>7} {forms:5d} refused: {str(exc)[:110]}")
             continue
         secs = time.perf_counter() - t0
         holds = [p for p in plan.segments if p.kind == "hold"]
         margin = min((hold_margin(task, h) for h in holds), default=float("nan"))
         kinds = " ".join(p.kind if p.in_contact else "regrasp" for p in plan.phases)
-        print(f"{stem:<22} {secs:7.2f} {plan.validity_checks:7d} {kinds:<20} {plan.narrowest()[2]:14.4g} "
+        print(f"{stem:<22} {secs:7.2f} {plan.validity_checks:7d} {forms:5d} {kinds:<34} {plan.narrowest()[2]:14.4g} "
               f"{len(holds):6d} {margin:14.4g} {plan.duration:9.2f}")  # fmt: skip
+    fidelity(tasks["reorient_task"])
+
+
+def fidelity(demo):
+    """Issue 32 item 4: from the demo's start, at friction [0, 0] and [0, 0.2], the furthest turn the search reaches:
+    every formation, where its geometry ends, and where its bands first fall below the resolution before that."""
+    from dataclasses import replace
+
+    import numpy as np
+
+    from qsplan.planner.plan.pivot import pivot_geometry
+    from qsplan.planner.plan.results import PlanFailure
+    from qsplan.planner.plan.turning import _pieces
+    from qsplan.hands.pivots import pivot_formations
+    from qsplan.planner.task.goal import Goal
+
+    print()
+    print(f"{'friction':<11} {'formation':<70} {'geometry ends (deg)':>20} {'bands hold to (deg)':>20}  what blocks")
+    for mu in ((0.0, 0.0), (0.0, 0.2)):
+        for pivot, start in pivot_formations(demo.hand):
+            far = pivot.direction * 1.6  # beyond any event: where the geometry ends
+            task = replace(demo, mu_range=mu, goal=Goal(None, None, None, theta=far))
+            geo = pivot_geometry(task, pivot, start, far)
+            end = geo.end.theta if geo.end is not None else far
+            last = float(geo.path.theta[max((geo.end.row if geo.end else geo.path.theta.size) - 1, 1)])
+            try:
+                pieces = _pieces(task, pivot, start, last, pivot_geometry(task, pivot, start, last), None)
+                reach, why = last, geo.end.words if geo.end else "-"
+                n = len(pieces)
+            except PlanFailure as exc:
+                reach, why, n = float(exc.report.pose[2]), exc.report.reason, 0
+            label = f"{pivot.words(demo.hand)}"[:70]
+            print(f"{str(list(mu)):<11} {label:<70} {np.degrees(end):20.2f} {np.degrees(reach):20.2f}  "
+                  f"{why[:90]}{'' if not n else f' ({n} pieces)'}")  # fmt: skip
 
 
 if __name__ == "__main__":
