@@ -8,7 +8,9 @@ ramps a torque, proved for every friction (:mod:`qsplan.mechanics.bands.hold`), 
   demo's inertial box; and, for the route search, the left finger torque-controlled with the right one held;
 * (b) the demo's slide end at rest (its last row: four contacts), the left finger held, the right torque anywhere in
   its exported band; beyond the interval, the witness motion;
-* (c) every joint held (a release instant), at both.
+* (c) every joint held (a release instant), at both;
+* (d) the programmes on HiGHS directly (:func:`qsplan.mechanics.solver.lp.solve_lp`; ``scipy.optimize.linprog``
+  before issue 33): the time of every proof above, and what importing ``scipy.optimize`` costs a fresh process.
 
 The friction set does not enter the proof: the margins at the 32 vertices of the friction box are compared with the
 scene's own (equal bit for bit).
@@ -20,16 +22,18 @@ Usage, from the repository root::
 
 import argparse
 import csv
+import subprocess
+import sys
 import time
 from itertools import product
 from pathlib import Path
 
 import numpy as np
-from scipy.optimize import linprog
 
 from qsplan.hands.interface import scene_at
 from qsplan.hands.reorient import flush_instant, paper_form, transition_scene
 from qsplan.mechanics.bands.hold import hold_matrix, hold_torque_interval, prove_hold
+from qsplan.mechanics.solver.lp import solve_lp
 from qsplan.planner.task.dynamics import inertial_box
 from qsplan.planner.task.task import demo_task_path, load_task
 
@@ -58,8 +62,8 @@ def held(scene):
 def immobilised(scene):
     """No motion ``x != 0`` with ``A x >= 0`` (every joint held): ``sum(A x) = 1`` is infeasible."""
     A = hold_matrix(scene)
-    res = linprog(np.zeros(A.shape[1]), A_ub=-A, b_ub=np.zeros(len(A)), A_eq=A.sum(axis=0)[None], b_eq=[1.0],
-                  bounds=[(None, None)] * A.shape[1], method="highs")  # fmt: skip
+    res = solve_lp(np.zeros(A.shape[1]), A_ub=-A, b_ub=np.zeros(len(A)), A_eq=A.sum(axis=0)[None], b_eq=[1.0],
+                   bounds=[(None, None)] * A.shape[1])  # fmt: skip
     return res.status == 2
 
 
@@ -74,7 +78,23 @@ def interval_row(label, scene, box, margin, repeat):
     return lo, hi
 
 
+#: Every proof :func:`proof_row` printed: ``(label, scene, torques, box)``, for section (d).
+PROOFS = []
+
+
+def highs_directly(repeat):
+    """Section (d): the time of every proof of (a)-(c), and what importing scipy.optimize costs a fresh process (the
+    proofs ran ``scipy.optimize.linprog`` before issue 33; ``tests/mechanics/test_hold.py`` compares the verdicts)."""
+    total = sum(timed(lambda: prove_hold(sc, tau, b), repeat)[1] for _, sc, tau, b in PROOFS)
+    code = "import time; t = time.perf_counter(); import scipy.optimize; print(time.perf_counter() - t)"
+    imports = min(float(subprocess.run([sys.executable, "-c", code], capture_output=True, text=True).stdout)
+                  for _ in range(3))  # fmt: skip
+    print(f"\n(d) the {len(PROOFS)} proofs above on HiGHS directly: {1e3 * total:.2f} ms together (medians); importing "
+          f"scipy.optimize, which they no longer need, costs a fresh process {imports:.3f} s (best of 3)")  # fmt: skip
+
+
 def proof_row(label, scene, torques, box, repeat):
+    PROOFS.append((label, scene, torques, box))
     proof, s = timed(lambda: prove_hold(scene, torques, box), repeat)
     verdict = "proved" if proof.proved else "REFUSED"
     where = "" if torques is None else "[" + ", ".join(f"{t:.4g}" for t in np.ravel(torques)) + "]"
@@ -150,6 +170,7 @@ def main():
             elif p.proved:
                 lam = ", ".join(f"{n} {x:.4g}" for n, x in zip(p.contact_names, p.certificates[0]))
                 print(f"    certificate (N, frictionless equilibrium, first vertex): {lam}")
+    highs_directly(args.repeat)
 
 
 if __name__ == "__main__":

@@ -179,10 +179,12 @@ def hold_load(scene: Scene, torques, wrench=None) -> np.ndarray:
     return np.concatenate([scene.g_obj + w, np.asarray(torques, dtype=float).reshape(-1) - scene.g_man[e]])
 
 
-def _linprog(*args, **kwargs):
-    from scipy.optimize import linprog
+def _lp(*args, **kwargs):
+    """``scipy.optimize.linprog(..., method="highs")``'s answer from HiGHS directly (:func:`qsplan.mechanics.solver.lp.
+    solve_lp`: the same solver and settings, without ~0.5 s of importing ``scipy.optimize``)."""
+    from qsplan.mechanics.solver.lp import solve_lp
 
-    return linprog(*args, method="highs", **kwargs)
+    return solve_lp(*args, **kwargs)
 
 
 def _certificate(A, p, sigma_min):
@@ -193,8 +195,8 @@ def _certificate(A, p, sigma_min):
     cost[-1] = -1.0  # maximise t
     ub = np.hstack([-np.eye(n_c), np.ones((n_c, 1))])  # t - lambda_i <= 0
     eq = np.hstack([A.T, np.zeros((m, 1))])
-    res = _linprog(cost, A_ub=ub, b_ub=np.zeros(n_c), A_eq=eq, b_eq=-p,
-                   bounds=[(None, None)] * n_c + [(None, MARGIN_CAP)])  # fmt: skip
+    bounds = [(None, None)] * n_c + [(None, MARGIN_CAP)]
+    res = _lp(cost, A_ub=ub, b_ub=np.zeros(n_c), A_eq=eq, b_eq=-p, bounds=bounds)
     if res.status != 0:  # full rank: A^T lambda = -p always has solutions, so the programme is feasible and bounded
         raise QsplanError(f"prove_hold: HiGHS gave no answer for the hold's certificate ({res.message})")
     lam = res.x[:n_c]
@@ -208,8 +210,7 @@ def _witness(A, p):
 
     The dual of :func:`_certificate` (uncapped): its optimum is ``-t``."""
     n_c, m = A.shape
-    res = _linprog(-p, A_ub=-A, b_ub=np.zeros(n_c), A_eq=A.sum(axis=0)[None], b_eq=[1.0],
-                   bounds=[(None, None)] * m)  # fmt: skip
+    res = _lp(-p, A_ub=-A, b_ub=np.zeros(n_c), A_eq=A.sum(axis=0)[None], b_eq=[1.0], bounds=[(None, None)] * m)
     if res.status != 0:  # called when refused: the cone holds a ray, and (pointed at full rank) its slice is compact
         raise QsplanError(f"prove_hold: HiGHS gave no answer for the hold's witness ({res.message})")
     return res.x, float(p @ res.x)
@@ -342,7 +343,7 @@ def hold_torque_interval(scene: Scene, disturbance=None, margin: float = INTERVA
     bounds = [(None, None)] + [(float(margin), None)] * (K * n_c)
     ends = []
     for sign in (1.0, -1.0):
-        res = _linprog(np.eye(1 + K * n_c)[0] * sign, A_eq=eq, b_eq=rhs, bounds=bounds)
+        res = _lp(np.eye(1 + K * n_c)[0] * sign, A_eq=eq, b_eq=rhs, bounds=bounds)
         if res.status == 2:
             return (np.nan, np.nan)
         if res.status == 3:

@@ -25,6 +25,7 @@ __all__ = [
     "equilibrium_columns",
     "equilibrium_matrix",
     "contact_forces",
+    "equilibrium_solve",
     "equilibrium_stage",
 ]
 
@@ -150,7 +151,43 @@ def contact_forces(kin: Kinematics, cA: np.ndarray, mu: np.ndarray, n_c: int):
     return c_n, c_t
 
 
-def equilibrium_stage(scene: Scene, pool: "ScenePool", kin: Kinematics, mu: np.ndarray, tau_e: np.ndarray, tol: Tolerances):
+def equilibrium_solve(Q: np.ndarray, rhs: np.ndarray, kin: Kinematics, mu: np.ndarray, n_c: int, tol: Tolerances):
+    """Eqs. (26) and (28) given ``Q_AI`` and the right-hand side of every row (the part every layout shares).
+
+    Parameters
+    ----------
+    Q : ndarray, shape (m, k, k)
+        ``Q_AI`` (:func:`equilibrium_columns`); overwritten with the identity where singular.
+    rhs : ndarray, shape (m, k)
+        ``(-g_obj, tau_e - g_man,e)`` of each row (eqs. 2-3).
+    kin : Kinematics
+        The rows' modes (``codes``, ``idx``, ``contact``, ``xi``).
+    mu : ndarray, shape (m, n_c)
+
+    Returns
+    -------
+    status : ndarray of int8, shape (m,)
+    c_n, c_t : ndarray, shape (m, n_c)
+    boundary : ndarray of bool, shape (m,)
+        An inequality of (28) holds only within the force tolerance.
+    """
+    status = np.zeros(Q.shape[0], dtype=np.int8)
+    q_sing = hadamard_ratio(Q) < tol.singular
+    status[q_sing] = StatusCode.EQUILIBRIUM_SINGULAR
+    Q[q_sing] = np.eye(Q.shape[1])
+    cA = np.linalg.solve(Q, rhs[..., None])[..., 0]
+
+    c_n, c_t = contact_forces(kin, cA, mu, n_c)
+
+    ftol = tol.force * np.maximum(np.max(np.abs(cA), axis=1), np.max(np.abs(rhs), axis=1))
+    worst = worst_slack(kin.codes, mu, c_n, c_t)  # eq. (28), and c_n >= 0 at rolling contacts (eq. 9)
+    coul = ~q_sing & (worst < -ftol)
+    status[coul] = StatusCode.COULOMB_VIOLATED
+    return status, c_n, c_t, worst <= ftol
+
+
+def equilibrium_stage(scene: Scene, pool: "ScenePool", kin: Kinematics, mu: np.ndarray, tau_e: np.ndarray, tol: Tolerances,
+                      g_obj: np.ndarray | None = None):  # fmt: skip
     """Equilibrium (26)-(27) and Coulomb (28) for kinematically admissible modes.
 
     Parameters
@@ -159,6 +196,8 @@ def equilibrium_stage(scene: Scene, pool: "ScenePool", kin: Kinematics, mu: np.n
         Friction coefficients per row (rows may repeat a mode with other mu).
     tau_e : ndarray, shape (m, n_e)
         Efforts of the effort-controlled joints per row.
+    g_obj : ndarray, shape (m, 3), optional
+        The workpiece's load per row (N, N, N m; eq. 2), in place of the scene's.
 
     Returns
     -------
@@ -168,25 +207,14 @@ def equilibrium_stage(scene: Scene, pool: "ScenePool", kin: Kinematics, mu: np.n
     boundary : ndarray of bool, shape (m,)
         An inequality of (28) holds only within the force tolerance.
     """
-    n_c = scene.n_contacts
     E, V = pool.E, pool.V
     m = kin.codes.shape[0]
-    status = np.zeros(m, dtype=np.int8)
     Q = equilibrium_matrix(pool, kin, mu)
-    q_sing = hadamard_ratio(Q) < tol.singular
-    status[q_sing] = StatusCode.EQUILIBRIUM_SINGULAR
-    Q[q_sing] = np.eye(Q.shape[1])
-    rhs = np.concatenate([np.broadcast_to(-scene.g_obj, (m, 3)), tau_e - scene.g_man[E]], axis=1)
-    cA = np.linalg.solve(Q, rhs[..., None])[..., 0]
-
-    c_n, c_t = contact_forces(kin, cA, mu, n_c)
-
-    ftol = tol.force * np.maximum(np.max(np.abs(cA), axis=1), np.max(np.abs(rhs), axis=1))
-    worst = worst_slack(kin.codes, mu, c_n, c_t)  # eq. (28), and c_n >= 0 at rolling contacts (eq. 9)
-    coul = ~q_sing & (worst < -ftol)
-    status[coul] = StatusCode.COULOMB_VIOLATED
+    load = np.broadcast_to(-scene.g_obj, (m, 3)) if g_obj is None else -g_obj
+    rhs = np.concatenate([load, tau_e - scene.g_man[E]], axis=1)
+    status, c_n, c_t, boundary = equilibrium_solve(Q, rhs, kin, mu, scene.n_contacts, tol)
 
     tau = np.empty((m, scene.n_joints))
     tau[:, E] = tau_e
     tau[:, V] = (c_n @ scene.Jn + c_t @ scene.Jt)[:, V] + scene.g_man[V]  # eq. (27), from eq. (3)
-    return status, c_n, c_t, tau, worst <= ftol
+    return status, c_n, c_t, tau, boundary

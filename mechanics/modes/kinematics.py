@@ -184,7 +184,9 @@ def contact_motion(pool, idx: np.ndarray, P: np.ndarray):
     Parameters
     ----------
     pool : ScenePool or StateBatch
-        Modes of one scene or states of a batch, as in :func:`kinematics_matrix`.
+        Modes of one scene or states of a batch, as in :func:`kinematics_matrix`; or the modes of each of a stack of
+        scenes (:class:`qsplan.mechanics.solver.many.StackedPools`: rows ``(S, 2 n_c, ...)``, ``velocity`` (S, 1, n_j),
+        ``idx`` one set per mode; ``P`` and the results with leading axes (S, m)).
     idx : ndarray of int, shape (m, k) or (k,)
     P : ndarray, shape (R, k, k)
         ``P_AI`` (:func:`kinematics_matrix`), nonsingular (raises ``numpy.linalg.LinAlgError``
@@ -206,6 +208,8 @@ def contact_motion(pool, idx: np.ndarray, P: np.ndarray):
     qdot = z[..., :3]
     if pool.Wrows.ndim == 2:  # rows shared by the modes: two matrix products
         v = qdot @ pool.Wrows.T - thetadot @ pool.Jrows.T  # eq. (5), (R, 2 n_c)
+    elif qdot.ndim == pool.Wrows.ndim:  # modes (m) of each of a stack of scenes (S, m, 3): the one-scene products
+        v = qdot @ pool.Wrows.swapaxes(-1, -2) - thetadot @ pool.Jrows.swapaxes(-1, -2)  # per scene, bit for bit
     else:  # rows per state
         v = np.einsum("sj,srj->sr", qdot, pool.Wrows) - np.einsum("sj,srj->sr", thetadot, pool.Jrows)
     return qdot, thetadot, v[..., :n_c], v[..., n_c:]

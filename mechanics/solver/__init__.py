@@ -7,5 +7,7 @@
 * :mod:`.search` - the exact pruned search over those breaking sets
 * :mod:`.all_modes` - the public :func:`solve`, choosing among the three
 * :mod:`.many` - every mode's status at many friction vectors of one scene (the kinematic stage once):
-  :func:`~.many.solve_many` and its per-vector reference; mu-space maps and the plan certifier use it
+  :func:`~.many.solve_many` and its per-vector reference; mu-space maps use it; and of many scenes at once
+  (:func:`~.many.solve_many_scenes`, each scene's vectors with their own loads): the plan certifier
+* :mod:`.lp` - one small linear programme on HiGHS directly (the certified holds), without ``scipy.optimize``
 """

@@ -42,8 +42,8 @@ from qsplan.planner.certify.contacts import hold_row, judged_contact_checks, jud
 from qsplan.planner.certify.files import META_TOL, agreement_checks, metadata_checks, schema_checks
 from qsplan.planner.certify.inputs import (plan_columns_required, plan_sources, read_plan,
                                            read_plan_file, task_from_metadata)  # fmt: skip
-from qsplan.planner.certify.modes import (disturbance_checks, mode_checks, mode_misfit, row_scene, slip_reversals,
-                                          slip_velocities)  # fmt: skip
+from qsplan.planner.certify.modes import (ModeJob, disturbance_checks, mode_checks, mode_misfit, plan_mode_checks,
+                                          row_scene, slip_reversals, slip_velocities)  # fmt: skip
 from qsplan.planner.certify.timing import hold_checks, row_velocity, timing_checks
 from qsplan.planner.certify.route import (ENDPOINT_TOL, FREE_PATH_STEP, endpoint_checks, free_path_checks,
                                           rest_checks, structure_checks)  # fmt: skip
@@ -265,8 +265,9 @@ def certify_plan(plan, task, *, n_random: int = 8, seed: int = 0, force_margin: 
     progress : callable, optional
         Called with a line of text now and then.
     batched : bool
-        Solve all friction vectors of a row in one batch (the kinematic stage once); False:
-        the reference, :func:`qsplan.mechanics.solve` once per friction vector.  Same certificate.
+        Solve every in-contact row x wrench vertex x friction vector of the plan in one batch
+        (:func:`qsplan.planner.certify.modes.plan_mode_checks`); False: the reference, row by row, wrench by wrench,
+        :func:`qsplan.mechanics.solve` once per friction vector.  Same certificate.
 
     Returns
     -------
@@ -313,6 +314,7 @@ def certify_plan(plan, task, *, n_random: int = 8, seed: int = 0, force_margin: 
     scenes = {}  # in-contact rows' scenes: their bands recomputed in one batch per mode
     named = {}  # in-contact rows' contacts, as their mode letters follow them (the metadata's contact sets)
     general = task.hand.reorients  # any formation: the row's contacts found in the polygons
+    jobs, mode_at = [], {}  # batched: the rows' mode checks, solved together after the loop; where their answers go
     for k in range(n):
         mode = str(cols["mode"][k])
         found = limit_checks(task, cols, k)
@@ -357,12 +359,15 @@ def certify_plan(plan, task, *, n_random: int = 8, seed: int = 0, force_margin: 
                     scenes[k] = scene
                     mus = friction_points(task, int(n_random), rng, len(scene.contact_names))
                     pts = len(mus)
-                    if not hold_row(cols, k):  # a hold: nothing moves, the hold proof decides (hold_checks)
+                    if not hold_row(cols, k) and batched:  # a hold: nothing moves, the hold proof decides
+                        jobs.append(ModeJob(k, scene, mus, _xdot_rows(cols, k, names)))
+                        mode_at[k] = len(found)
+                    elif not hold_row(cols, k):  # the reference, row by row
                         more, excluded = mode_checks(task, cols, k, mus, force_margin, _xdot_rows(cols, k, names),
-                                                     batched, scene)  # fmt: skip
+                                                     False, scene)  # fmt: skip
                         found += more
                         if task.disturbance is not None:
-                            found += disturbance_checks(task, cols, k, mus, force_margin, batched, scene)
+                            found += disturbance_checks(task, cols, k, mus, force_margin, False, scene)
                     slips = slip_velocities(task, cols, k, scene)
                     if (slips is not None and slip is not None and slip[:2] == (k - 1, phase[k])
                             and len(slip[2]) == len(slips)):  # fmt: skip
@@ -372,6 +377,9 @@ def certify_plan(plan, task, *, n_random: int = 8, seed: int = 0, force_margin: 
         verdict_info.append((mode, pts, excluded))
         if progress is not None and (k + 1) % 50 == 0:
             progress(f"certified {k + 1} of {n} rows")
+    for k, (more, excluded) in plan_mode_checks(task, cols, jobs, force_margin).items():
+        found_at[k][mode_at[k]:mode_at[k]] = more
+        verdict_info[k] = (verdict_info[k][0], verdict_info[k][1], excluded)
     bands = recomputed_bands(task, cols, scenes)
     for k, rb in bands.items():
         found_at[k] += band_checks(task, cols, k, rb)

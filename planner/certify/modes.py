@@ -5,7 +5,14 @@ the effort-controlled joints those with a torque command, the others driven at t
 and asks which modes its commands make feasible at every friction vector to test, with the
 mechanics' :func:`qsplan.mechanics.solve_many` (the kinematic stage once, the equilibrium and
 Coulomb stage for every vector in one batch: the solver's own decisions, bit for bit) or its
-reference :func:`qsplan.mechanics.solve_many_reference` (the solver once per vector).
+reference :func:`qsplan.mechanics.solve_many_reference` (the solver once per vector);
+:func:`disturbance_checks` asks again at every vertex of the task's wrench box.
+
+:func:`plan_mode_checks` gives both checks' answers for every row of a plan at once: every row x wrench vertex x
+friction vector in one call of :func:`qsplan.mechanics.solver.many.solve_many_scenes` (each row's statuses those of
+:func:`~qsplan.mechanics.solve_many`, bit for bit), the second look at degenerate modes in one more, and the same
+verdicts and messages as :func:`mode_checks` then :func:`disturbance_checks` row by row (the reference; the tests
+compare the certificates).
 
 Both share the mechanics library (the model), nothing of the planner's bookkeeping.
 Units SI (m, rad, s, N, N m).
@@ -13,12 +20,14 @@ Units SI (m, rad, s, N, N m).
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 
 from qsplan.mechanics import DEFAULT_TOLERANCES, Tolerances, solve_many, solve_many_reference
 
-__all__ = ["MOTION_RTOL", "EXACT_TOLERANCES", "SLIP_SIGN_TOL", "disturbance_checks", "mode_checks", "mode_misfit", "row_scene", "slip_velocities",
-           "slip_reversals"]
+__all__ = ["MOTION_RTOL", "EXACT_TOLERANCES", "FORCES_PER_CALL", "SLIP_SIGN_TOL", "ModeJob", "disturbance_checks", "mode_checks",
+           "mode_misfit", "plan_mode_checks", "row_scene", "slip_velocities", "slip_reversals"]
 
 #: Relative difference tolerated between the workpiece speed the solver computes from
 #: the exported velocity command and the one the rows' poses show (finite differences of
@@ -34,6 +43,12 @@ MOTION_RTOL = 1e-2
 #: threshold at which the stability study (``benchmarks/bench_stability.py``) saw no LU failure.
 EXACT_TOLERANCES = Tolerances(singular=1e-15, velocity=1e-13)
 
+#: Numbers (normal forces and workpiece velocities, 8 bytes each) one call of
+#: :func:`qsplan.mechanics.solver.many.solve_many_scenes` keeps for :func:`plan_mode_checks` (every mode at every row x
+#: wrench vertex x friction vector): 2^22, ~32 MB, so that a long plan's rows are solved in several calls (the demo's
+#: 81 rows need ~1.3 M: one call); the answers do not depend on it.
+FORCES_PER_CALL = 1 << 22
+
 #: Sliding speed (m/s) within which a contact's sliding direction is not compared between rows: the rows'
 #: positions are written to full precision, so a finite difference over a 0.05 s step is exact to ~1e-15 m/s;
 #: a sliding direction that reverses between two rows shows speeds of 1e-4 m/s on either side.
@@ -42,6 +57,35 @@ SLIP_SIGN_TOL = 1e-12
 
 def _fmt_mu(mu) -> str:
     return "[" + ", ".join(f"{m:.4g}" for m in mu) + "]"
+
+
+# The messages of the mode check (one per kind, at the first friction vector showing it), shared by the row-by-row
+# reference (mode_checks) and the plan at once (plan_mode_checks).
+
+def _competitor_msg(others, mu, mode) -> str:
+    return f"competitor {'/'.join(others)} feasible at mu = {_fmt_mu(mu)} (planned {mode})"
+
+
+def _planned_msg(mode, mu, why) -> str:
+    return f"planned mode {mode} not feasible at mu = {_fmt_mu(mu)} ({why})"
+
+
+def _undecided_msg(letters, status, mu, tight) -> str:
+    return (f"mode {letters} is nearly degenerate ({status.replace('_', ' ')}) at mu = {_fmt_mu(mu)}: its feasibility "
+            f"is not decided ({tight.replace('_', ' ')} at machine precision)")  # fmt: skip
+
+
+def _force_msg(c_n, i_c, force_margin, mu) -> str:
+    return f"normal force {c_n:.4g} N at contact {i_c} below the margin {force_margin:g} N at mu = {_fmt_mu(mu)}"
+
+
+def _motion_msg(xdot, xdot_rows, mu) -> str:
+    return (f"the commands move the workpiece at {xdot * 1e3:.4g} mm/s at mu = {_fmt_mu(mu)}; "
+            f"the rows show {xdot_rows * 1e3:.4g} mm/s")  # fmt: skip
+
+
+def _under_msg(msg, w) -> str:
+    return f"{msg}, under the disturbance wrench [{w[0]:.4g} N, {w[1]:.4g} N, {w[2]:.4g} N m]"
 
 
 def row_scene(task, cols, k, judged=None):
@@ -184,10 +228,10 @@ def mode_checks(task, cols, k, mus, force_margin=0.0, xdot_rows=np.nan, batched=
         row = sv.codes[i]
         if n_feasible[i] > planned[i] and "mode" not in found:
             others = [letters[j] for j in np.flatnonzero(feasible[i]) if letters[j] != mode]
-            found["mode"] = f"competitor {'/'.join(others)} feasible at mu = {_fmt_mu(mu)} (planned {mode})"
+            found["mode"] = _competitor_msg(others, mu, mode)
         if not planned[i] and "planned" not in found:
             why = "not tested" if j_mode is None else names[row[j_mode]]
-            found["planned"] = f"planned mode {mode} not feasible at mu = {_fmt_mu(mu)} ({why})"
+            found["planned"] = _planned_msg(mode, mu, why)
         if degenerate[i].any():
             key = tuple(mu) if np.any(degenerate[i] & (row == singular)) else "kinematic"
             if key not in exact_cache:
@@ -198,22 +242,18 @@ def mode_checks(task, cols, k, mus, force_margin=0.0, xdot_rows=np.nan, batched=
             undecided = np.flatnonzero(degenerate[i] & ~still)
             if undecided.size and "undecided" not in found:
                 j = undecided[0]
-                found["undecided"] = (f"mode {letters[j]} is nearly degenerate ({names[row[j]].replace('_', ' ')}) "
-                                      f"at mu = {_fmt_mu(mu)}: its feasibility is not decided "
-                                      f"({names[tight[j]].replace('_', ' ')} at machine precision)")  # fmt: skip
+                found["undecided"] = _undecided_msg(letters[j], names[row[j]], mu, names[tight[j]])
         if not planned[i]:
             continue
         c_n, qdot = sv.c_n[i, j_mode], sv.qdot[i, j_mode]
         loaded = c_n[held]  # a breaking contact carries no force: the margin binds the others (eq. 28 made strict)
         if force_margin > 0 and loaded.size and loaded.min() < force_margin and "force margin" not in found:
             i_c = int(held[np.argmin(loaded)])
-            found["force margin"] = (f"normal force {c_n[i_c]:.4g} N at contact {i_c} below the margin "
-                                     f"{force_margin:g} N at mu = {_fmt_mu(mu)}")  # fmt: skip
+            found["force margin"] = _force_msg(c_n[i_c], i_c, force_margin, mu)
         xdot = qdot[0] - qdot[2] * float(cols["y_workpiece"][k])  # qdot is the world origin's velocity
         if np.isfinite(xdot_rows) and "motion" not in found:
             if np.sign(xdot) != np.sign(xdot_rows) or abs(xdot - xdot_rows) > MOTION_RTOL * abs(xdot_rows):
-                found["motion"] = (f"the commands move the workpiece at {xdot * 1e3:.4g} mm/s at mu = {_fmt_mu(mu)}; "
-                                   f"the rows show {xdot_rows * 1e3:.4g} mm/s")  # fmt: skip
+                found["motion"] = _motion_msg(xdot, xdot_rows, mu)
     kinds = {"planned": "mode", "mode": "mode"}
     set_aside = tuple(sorted(letters[j] for j in np.flatnonzero(excluded)))
     return [(kinds.get(kind, kind), msg) for kind, msg in found.items()], set_aside
@@ -232,5 +272,182 @@ def disturbance_checks(task, cols, k, mus, force_margin, batched, scene) -> list
         loaded = replace(scene, g_obj=scene.g_obj + w)
         more, _ = mode_checks(task, cols, k, mus, force_margin, np.nan, batched, loaded)
         for kind, msg in more:
-            found.setdefault(kind, f"{msg}, under the disturbance wrench [{w[0]:.4g} N, {w[1]:.4g} N, {w[2]:.4g} N m]")
+            found.setdefault(kind, _under_msg(msg, w))
     return list(found.items())
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class ModeJob:
+    """One in-contact row for :func:`plan_mode_checks`: what :func:`mode_checks` takes for it.
+
+    Attributes
+    ----------
+    row : int
+    scene : Scene
+        The row's scene (:func:`row_scene`).
+    mus : ndarray, shape (m, n_c)
+        Its friction vectors.
+    xdot_rows : float
+        The workpiece's ``x`` velocity (m/s) the rows show; nan: not checked.
+    """
+
+    row: int
+    scene: object
+    mus: np.ndarray
+    xdot_rows: float
+
+
+def _first(flags) -> np.ndarray:
+    """The first True along the last axis of ``flags`` (..., m): its index, or ``m`` where none."""
+    m = flags.shape[-1]
+    return np.where(flags.any(axis=-1), flags.argmax(axis=-1), m)
+
+
+class _RowJudge:
+    """:func:`mode_checks` at the undisturbed scene and at each wrench vertex (the row's blocks) of one row, from
+    its statuses at every block x friction vector (``sv``: shape (B m, n_modes), block-major)."""
+
+    def __init__(self, job, mode, sv, n_blocks):
+        from qsplan.mechanics import Status
+
+        self.job, self.mode, self.sv = job, mode, sv
+        m = len(job.mus)
+        self.codes = sv.codes.reshape(n_blocks, m, -1)
+        letters = sv.letters
+        self.j_mode = letters.index(mode) if mode in letters else None
+        feasible = self.codes == 0
+        self.feasible = feasible
+        self.planned = feasible[..., self.j_mode] if self.j_mode is not None else np.zeros((n_blocks, m), dtype=bool)
+        degenerate_codes = [Status.ORDER.index(s) for s in sorted(Status.DEGENERATE)]
+        self.degenerate_codes = degenerate_codes
+        self.degenerate = np.isin(self.codes, degenerate_codes)
+        deg_any = self.degenerate.any(axis=-1)
+        singular = self.degenerate & (self.codes == Status.ORDER.index(Status.EQUILIBRIUM_SINGULAR))
+        self.by_mu = singular.any(axis=-1)  # mode_checks' cache key: the friction vector itself
+        kinematic = deg_any & ~self.by_mu  # ... or "kinematic": the first such vector's answer serves them all
+        self.kin_first = _first(kinematic)
+        # the second look (EXACT_TOLERANCES) each block needs: (block, vector), in order
+        self.looks = [(b, int(i)) for b in range(n_blocks) for i in sorted(
+            set(np.flatnonzero(self.by_mu[b])) | ({int(self.kin_first[b])} if self.kin_first[b] < m else set()))]
+
+    def verdicts(self, tight, force_margin, y_workpiece, wrenches):
+        """``(found, excluded)`` as :func:`mode_checks` then :func:`disturbance_checks` give them; ``tight``: the
+        codes of :attr:`looks`, shape (len(looks), n_modes)."""
+        from qsplan.mechanics import Status
+
+        names, letters, mode, mus = Status.ORDER, self.sv.letters, self.mode, self.job.mus
+        B, m = self.codes.shape[:2]
+        at = {key: r for r, key in enumerate(self.looks)}
+        which = np.full((B, m), len(self.looks))  # each vector's second look (its row of tight), or none
+        for b in range(B):
+            which[b, self.degenerate[b].any(axis=-1) & ~self.by_mu[b]] = at.get((b, int(self.kin_first[b])), len(at))
+            for i in np.flatnonzero(self.by_mu[b]):
+                which[b, i] = at[(b, int(i))]
+        tight = np.vstack([tight, np.zeros((1, self.codes.shape[-1]), dtype=tight.dtype)])  # none: nothing degenerate
+        still = np.isin(tight, self.degenerate_codes)[which]  # degenerate at machine precision too
+        undecided = self.degenerate & ~still
+        excluded = (self.degenerate[0] & still[0]).any(axis=0)
+        competitor = self.feasible.sum(axis=-1) > self.planned
+        first = {"mode": _first(competitor), "planned": _first(~self.planned), "undecided": _first(undecided.any(-1))}
+        held = np.array([i for i, letter in enumerate(mode) if letter != "B"], dtype=int)
+        if self.j_mode is not None:
+            c_n = self.sv.c_n.reshape(B, m, len(letters), -1)[:, :, self.j_mode]
+            qdot = self.sv.qdot.reshape(B, m, len(letters), 3)[:, :, self.j_mode]
+            if force_margin > 0 and held.size:
+                first["force margin"] = _first(self.planned & (c_n[..., held].min(axis=-1) < force_margin))
+            xdot = qdot[..., 0] - qdot[..., 2] * y_workpiece  # qdot is the world origin's velocity
+            x_rows = self.job.xdot_rows
+            if np.isfinite(x_rows):
+                off = (np.sign(xdot[0]) != np.sign(x_rows)) | (np.abs(xdot[0] - x_rows) > MOTION_RTOL * abs(x_rows))
+                first["motion"] = np.concatenate([_first(self.planned[0] & off)[None], np.full(B - 1, m)])
+        order = ("mode", "planned", "undecided", "force margin", "motion")  # mode_checks' order at one vector
+        kinds = {"planned": "mode"}
+        blocks = []
+        for b in range(B):
+            found = []
+            for i, _, kind in sorted((int(first[kind][b]), r, kind) for r, kind in enumerate(order) if kind in first):
+                if i == m:
+                    continue
+                mu, row = mus[i], self.codes[b, i]
+                if kind == "mode":
+                    others = [letters[j] for j in np.flatnonzero(self.feasible[b, i]) if letters[j] != mode]
+                    msg = _competitor_msg(others, mu, mode)
+                elif kind == "planned":
+                    msg = _planned_msg(mode, mu, "not tested" if self.j_mode is None else names[row[self.j_mode]])
+                elif kind == "undecided":
+                    j = int(np.flatnonzero(undecided[b, i])[0])
+                    msg = _undecided_msg(letters[j], names[row[j]], mu, names[tight[which[b, i], j]])
+                elif kind == "force margin":
+                    loaded = c_n[b, i, held]
+                    i_c = int(held[np.argmin(loaded)])
+                    msg = _force_msg(c_n[b, i, i_c], i_c, force_margin, mu)
+                else:
+                    msg = _motion_msg(xdot[b, i], self.job.xdot_rows, mu)
+                found.append((kinds.get(kind, kind), msg))
+            blocks.append(found)
+        out, disturbed = list(blocks[0]), {}
+        for w, found in zip(wrenches, blocks[1:]):
+            for kind, msg in found:
+                disturbed.setdefault(kind, _under_msg(msg, w))
+        set_aside = tuple(sorted(letters[j] for j in np.flatnonzero(excluded)))
+        return out + list(disturbed.items()), set_aside
+
+
+def plan_mode_checks(task, cols, jobs, force_margin=0.0) -> dict:
+    """:func:`mode_checks` (with the job's ``xdot_rows``) then, with a task's disturbance, :func:`disturbance_checks`
+    at every row of ``jobs`` at once: the same verdicts and messages.
+
+    Every row x block (the undisturbed scene, then each vertex of ``task.disturbance``) x friction vector is solved in
+    one call of :func:`qsplan.mechanics.solver.many.solve_many_scenes` (a block's load, ``g_obj`` plus its wrench,
+    as :func:`disturbance_checks` builds it; a long plan's rows in several, :data:`FORCES_PER_CALL`), the vectors
+    whose degenerate modes need a second look at :data:`EXACT_TOLERANCES` in one more.
+
+    Parameters
+    ----------
+    jobs : sequence of ModeJob
+    force_margin : float
+        N (:func:`mode_checks`).
+
+    Returns
+    -------
+    dict of int to (list of (kind, message), tuple of str)
+        Per row: its failures (the mode check's, then the disturbance check's) and the modes set aside as degenerate
+        to machine precision (the undisturbed scene's, as :func:`mode_checks` returns them).
+    """
+    from qsplan.mechanics.modes.counting import count_modes
+
+    wrenches = [] if task.disturbance is None else [np.asarray(w, dtype=float) for w in task.disturbance.vertices()]
+    out, part, size = {}, [], 0
+    for job in jobs:
+        n_c = job.scene.n_contacts
+        need = (1 + len(wrenches)) * len(job.mus) * count_modes(n_c, job.scene.dof) * (n_c + 3)
+        if part and size + need > FORCES_PER_CALL:
+            out.update(_mode_checks_call(cols, part, force_margin, wrenches))
+            part, size = [], 0
+        part.append(job)
+        size += need
+    if part:
+        out.update(_mode_checks_call(cols, part, force_margin, wrenches))
+    return out
+
+
+def _mode_checks_call(cols, jobs, force_margin, wrenches) -> dict:
+    """:func:`plan_mode_checks` of ``jobs`` in one call of the solver (and one for the second looks)."""
+    from qsplan.mechanics.solver.many import solve_many_scenes
+
+    B = 1 + len(wrenches)
+
+    def block_loads(scene, m):  # (B m, 3): the scene's g_obj, then g_obj + w for each vertex, m vectors each
+        return np.concatenate([np.broadcast_to(g, (m, 3)) for g in [scene.g_obj] + [scene.g_obj + w for w in wrenches]])
+
+    scenes = [job.scene for job in jobs]
+    answers = solve_many_scenes(scenes, [np.tile(job.mus, (B, 1)) for job in jobs], DEFAULT_TOLERANCES,
+                                loads=[block_loads(job.scene, len(job.mus)) for job in jobs])  # fmt: skip
+    judges = [_RowJudge(job, str(cols["mode"][job.row]), sv, B) for job, sv in zip(jobs, answers)]
+    loads = [block_loads(job.scene, 1) for job in jobs]
+    tight = solve_many_scenes(scenes, [job.mus[[i for _, i in judge.looks]].reshape(-1, job.mus.shape[1])
+                                       for job, judge in zip(jobs, judges)], EXACT_TOLERANCES,
+                              loads=[g[[b for b, _ in judge.looks]].reshape(-1, 3) for g, judge in zip(loads, judges)],
+                              forces=False)  # fmt: skip
+    return {job.row: judge.verdicts(t.codes, force_margin, float(cols["y_workpiece"][job.row]), wrenches)
+            for job, judge, t in zip(jobs, judges, tight)}

@@ -309,6 +309,79 @@ def test_flush_hold_at_50_nm_agrees_with_bsss_vanishing_with_the_left_finger():
     assert still.no_feasible_mode and not still.jammed
 
 
+# --- HiGHS directly against scipy.optimize.linprog -----------------------------------------------------------------
+
+def _scipy_lp(c, A_ub=None, b_ub=None, A_eq=None, b_eq=None, bounds=None):
+    """The programmes as they were solved before (``scipy.optimize.linprog``, the same HiGHS behind scipy's wrapper)."""
+    from scipy.optimize import linprog
+
+    return linprog(c, A_ub=A_ub, b_ub=b_ub, A_eq=A_eq, b_eq=b_eq, bounds=bounds, method="highs")
+
+
+def _edge_cases():
+    """Every proved and refused case, and torques around each interval end: 1e-3 N m to 1e-9 N m either side of
+    where the certified margin crosses MARGIN_TOL (found by the interval at that margin)."""
+    cases = [(name, scene, tau, None) for name, scene, tau in _proved_cases() + _refused_cases()]
+    box = _task().dynamics.disturbance
+    for name, scene, w in (("slide end", _slide_end()[1], None), ("slide end, box", _slide_end()[1], box),
+                           ("pusher", _block(pusher=True), None), ("flush", _flush_scene(), None)):  # fmt: skip
+        for end in hold_torque_interval(scene, w, margin=2 * MARGIN_TOL):
+            if np.isfinite(end):
+                cases += [(f"{name} {end:+.6g}{d:+.0e}", scene, [end + d], w)
+                          for d in (-1e-3, -1e-6, -1e-9, 0.0, 1e-9, 1e-6, 1e-3)]  # fmt: skip
+    return cases
+
+
+def test_highs_directly_gives_linprogs_verdicts_at_the_edges(monkeypatch):
+    """prove_hold on HiGHS directly (no scipy.optimize import) against the same programmes through linprog: the same
+    verdict everywhere, near the interval ends too, and the same certified margins to the programmes' rounding."""
+    import qsplan.mechanics.bands.hold as hold
+
+    cases = _edge_cases()
+    highs = [prove_hold(scene, tau, w) for _, scene, tau, w in cases]
+    monkeypatch.setattr(hold, "_lp", _scipy_lp)
+    for (name, scene, tau, w), a in zip(cases, highs):
+        b = prove_hold(scene, tau, w)
+        assert a.proved == b.proved, name
+        np.testing.assert_allclose(a.margins, b.margins, rtol=1e-9, atol=1e-10, err_msg=name)
+        if not a.proved and a.rank == b.rank == hold_matrix(scene).shape[1]:  # the witnesses: the dual's optimum
+            assert a.witness_power == pytest.approx(b.witness_power, rel=1e-9, abs=1e-10), name
+    near = [a.margins.min() - MARGIN_TOL for (name, *_), a in zip(cases, highs) if "e-09" in name]
+    assert near and min(abs(m) for m in near) < 1e-8  # the scan reaches the edge: margins within 1e-8 N of it
+
+
+@pytest.mark.parametrize("margin", [INTERVAL_MARGIN, 0.05])
+def test_highs_directly_gives_linprogs_intervals(monkeypatch, margin):
+    import qsplan.mechanics.bands.hold as hold
+
+    box = _task().dynamics.disturbance
+    scenes = [(_slide_end()[1], None), (_slide_end()[1], box), (_block(pusher=True), None), (_flush_scene(), None),
+              (_flush_scene(), box)]  # fmt: skip
+    highs = [hold_torque_interval(scene, w, margin) for scene, w in scenes]
+    monkeypatch.setattr(hold, "_lp", _scipy_lp)
+    for (scene, w), a in zip(scenes, highs):
+        np.testing.assert_allclose(a, hold_torque_interval(scene, w, margin), rtol=1e-9, atol=1e-10)
+
+
+def test_the_hold_imports_no_scipy_optimize():
+    """Both programmes of prove_hold and hold_torque_interval's run without importing scipy.optimize (~0.5 s)."""
+    import inspect
+    import subprocess
+    import sys
+
+    code = "\n".join([
+        "import sys", "import numpy as np",
+        "from qsplan.mechanics import make_scene, point_wrench, wrench_matrices",
+        "from qsplan.mechanics.bands.hold import hold_torque_interval, prove_hold",
+        f"G, MASS, A_HALF, WALL_HEIGHT, PUSHER_WEIGHT = {G}, {MASS}, {A_HALF}, {WALL_HEIGHT}, {PUSHER_WEIGHT}",
+        inspect.getsource(_block),
+        "assert prove_hold(_block()).proved and not prove_hold(_block(weight=0.0)).proved",
+        "assert np.isfinite(hold_torque_interval(_block(pusher=True))[1])",
+        "print('scipy.optimize' in sys.modules)"])  # fmt: skip
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert out.stdout.strip() == "False"
+
+
 # --- validation -------------------------------------------------------------------------------------------------
 
 def test_scene_must_be_a_scene():
