@@ -26,7 +26,7 @@ import numpy as np
 
 from qsplan.mechanics import DEFAULT_TOLERANCES, Tolerances, solve_many, solve_many_reference
 
-__all__ = ["MOTION_RTOL", "EXACT_TOLERANCES", "FORCES_PER_CALL", "SLIP_SIGN_TOL", "ModeJob", "disturbance_checks", "mode_checks",
+__all__ = ["MOTION_RTOL", "EXACT_TOLERANCES", "FORCES_PER_CALL", "PARALLEL_TOL", "SLIP_SIGN_TOL", "ModeJob", "disturbance_checks", "mode_checks", "rigid_pairs", "structural_degeneracy",
            "mode_misfit", "plan_mode_checks", "row_scene", "slip_velocities", "slip_reversals"]
 
 #: Relative difference tolerated between the workpiece speed the solver computes from
@@ -53,6 +53,35 @@ FORCES_PER_CALL = 1 << 22
 #: positions are written to full precision, so a finite difference over a 0.05 s step is exact to ~1e-15 m/s;
 #: a sliding direction that reverses between two rows shows speeds of 1e-4 m/s on either side.
 SLIP_SIGN_TOL = 1e-12
+
+
+#: Sine of the angle within which two contact normals are parallel (a flush pair): the manifold and the polygon
+#: search give a flush pair's normals parallel to ~1e-15, and contacts meeting at an angle differ by far more.
+PARALLEL_TOL = 1e-9
+
+
+def rigid_pairs(scene) -> tuple:
+    """Pairs ``(i, j)`` of the scene's contacts between the workpiece and one body (the body their names give:
+    ``palm``, ``left``, ``right``) with parallel normals at distinct points along them (the workpiece's bottom edge
+    on the palm, a finger flush on an edge).  While both contacts hold, the relative motion of the two bodies cannot
+    turn (each normal velocity zero at two points off one normal line), so their sliding speeds are equal (eq. 6):
+    a mode that rolls one and slides the other slides it at zero speed, degenerate by the contacts' geometry alone
+    (:func:`structural_degeneracy`)."""
+    names = [str(n).partition(":")[0] for n in scene.contact_names]
+    normals, moments = scene.Wn[:2].T, scene.Wn[2]
+    out = []
+    for i in range(len(names)):
+        for j in range(i + 1, len(names)):
+            parallel = abs(normals[i, 0] * normals[j, 1] - normals[i, 1] * normals[j, 0]) <= PARALLEL_TOL
+            if names[i] == names[j] and parallel and normals[i] @ normals[j] > 0 and abs(moments[i] - moments[j]) > PARALLEL_TOL:
+                out.append((i, j))
+    return tuple(out)
+
+
+def structural_degeneracy(letters, pairs) -> np.ndarray:
+    """For each mode of ``letters`` (sequence of str), whether it rolls one contact of a rigid pair
+    (:func:`rigid_pairs`) and slides the other: degenerate exactly, whatever the numbers (bool, shape (n_modes,))."""
+    return np.array([any({m[i], m[j]} == {"R", "S"} for i, j in pairs) for m in letters], dtype=bool)
 
 
 def _fmt_mu(mu) -> str:
@@ -223,6 +252,7 @@ def mode_checks(task, cols, k, mus, force_margin=0.0, xdot_rows=np.nan, batched=
     planned = feasible[:, j_mode] if j_mode is not None else np.zeros(len(mus), dtype=bool)
     degenerate = np.isin(sv.codes, degenerate_codes)
     excluded = np.zeros(len(letters), dtype=bool)
+    structural = structural_degeneracy(letters, rigid_pairs(scene))
     held = np.array([i for i, letter in enumerate(mode) if letter != "B"], dtype=int)
     for i, mu in enumerate(mus):
         row = sv.codes[i]
@@ -238,6 +268,7 @@ def mode_checks(task, cols, k, mus, force_margin=0.0, xdot_rows=np.nan, batched=
                 tight = solve_at(scene, mu[None, :], EXACT_TOLERANCES).codes[0]
                 exact_cache[key] = tight, np.isin(tight, degenerate_codes)
             tight, still = exact_cache[key]
+            still = still | structural  # a rigid pair rolled and slid: degenerate by geometry, not by numbers
             excluded |= degenerate[i] & still
             undecided = np.flatnonzero(degenerate[i] & ~still)
             if undecided.size and "undecided" not in found:
@@ -321,6 +352,7 @@ class _RowJudge:
         degenerate_codes = [Status.ORDER.index(s) for s in sorted(Status.DEGENERATE)]
         self.degenerate_codes = degenerate_codes
         self.degenerate = np.isin(self.codes, degenerate_codes)
+        self.structural = structural_degeneracy(letters, rigid_pairs(job.scene))
         deg_any = self.degenerate.any(axis=-1)
         singular = self.degenerate & (self.codes == Status.ORDER.index(Status.EQUILIBRIUM_SINGULAR))
         self.by_mu = singular.any(axis=-1)  # mode_checks' cache key: the friction vector itself
@@ -344,7 +376,7 @@ class _RowJudge:
             for i in np.flatnonzero(self.by_mu[b]):
                 which[b, i] = at[(b, int(i))]
         tight = np.vstack([tight, np.zeros((1, self.codes.shape[-1]), dtype=tight.dtype)])  # none: nothing degenerate
-        still = np.isin(tight, self.degenerate_codes)[which]  # degenerate at machine precision too
+        still = np.isin(tight, self.degenerate_codes)[which] | self.structural  # degenerate at machine precision too
         undecided = self.degenerate & ~still
         excluded = (self.degenerate[0] & still[0]).any(axis=0)
         competitor = self.feasible.sum(axis=-1) > self.planned
