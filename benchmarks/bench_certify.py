@@ -21,8 +21,10 @@ table: command, before s, after s, ratio.  By default the processes run with the
 ``PYTHONDONTWRITEBYTECODE=1``: every module compiled at every start); ``--bytecode`` lets both sides cache their
 compiled modules (in temporary folders, one warm-up run each), as an ordinary installation does.
 
-Run: ``python3 benchmarks/bench_certify.py [--repeat N] [--compare REV | --baseline PYTHON] [--bytecode]
-[--no-inprocess]`` (default 3 runs).
+``--after REV`` puts a revision on the after side too (default: this tree, with its uncommitted changes).
+
+Run: ``python3 benchmarks/bench_certify.py [--repeat N] [--compare REV | --baseline PYTHON] [--after REV]
+[--bytecode] [--no-inprocess]`` (default 3 runs).
 """
 
 import argparse
@@ -166,6 +168,8 @@ def main(argv=None):
     which = ap.add_mutually_exclusive_group()
     which.add_argument("--compare", metavar="REV", help="time the whole commands at this git revision too (before)")
     which.add_argument("--baseline", metavar="PYTHON", help="another installation's interpreter (before)")
+    ap.add_argument("--after", metavar="REV", help="the after side at this git revision too (default: this tree, "
+                                                   "uncommitted changes included)")
     ap.add_argument("--bytecode", action="store_true", help="let both sides cache their compiled modules")
     ap.add_argument("--no-inprocess", action="store_true", help="only the whole commands")
     args = ap.parse_args(argv)
@@ -176,12 +180,17 @@ def main(argv=None):
     with tempfile.TemporaryDirectory() as tmp:
         work = Path(tmp)
         if args.compare is not None:
-            before = (sys.executable, {"PYTHONPATH": str(shadow_tree(args.compare, work))})
+            (work / "before").mkdir()
+            before = (sys.executable, {"PYTHONPATH": str(shadow_tree(args.compare, work / "before"))})
             said = f"git {args.compare}"
         else:
             before, said = (args.baseline, {}), args.baseline
-        rows = whole_commands(args.repeat, before, (sys.executable, {}), args.bytecode, work)
-    print(f"\nwhole commands, best of {args.repeat} (interleaved), before = {said}, after = this tree"
+        after, now = (sys.executable, {}), "this tree"
+        if args.after is not None:
+            (work / "after").mkdir()
+            after, now = (sys.executable, {"PYTHONPATH": str(shadow_tree(args.after, work / "after"))}), f"git {args.after}"
+        rows = whole_commands(args.repeat, before, after, args.bytecode, work)
+    print(f"\nwhole commands, best of {args.repeat} (interleaved), before = {said}, after = {now}"
           f"{', bytecode cached' if args.bytecode else ', as the environment runs them'}")  # fmt: skip
     print(f"{'command':<36} {'before s':>9} {'after s':>9} {'ratio':>7}  exit codes")
     for label, a, b, codes in rows:
