@@ -192,7 +192,7 @@ def fidelity(demo):
 
     from qsplan.planner.plan.pivot import pivot_geometry
     from qsplan.planner.plan.results import PlanFailure
-    from qsplan.planner.plan.turning import _pieces
+    from qsplan.planner.plan.turning import pivot_pieces
     from qsplan.hands.pivots import pivot_formations
     from qsplan.planner.task.goal import Goal
 
@@ -206,7 +206,7 @@ def fidelity(demo):
             end = geo.end.theta if geo.end is not None else far
             last = float(geo.path.theta[max((geo.end.row if geo.end else geo.path.theta.size) - 1, 1)])
             try:
-                pieces = _pieces(task, pivot, start, last, pivot_geometry(task, pivot, start, last), None)
+                pieces = pivot_pieces(task, pivot, start, last, pivot_geometry(task, pivot, start, last), None)
                 reach, why = last, geo.end.words if geo.end else "-"
                 n = len(pieces)
             except PlanFailure as exc:

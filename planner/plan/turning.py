@@ -28,7 +28,7 @@ from qsplan.planner.plan.results import Plan, PlanFailure
 from qsplan.planner.task.goal import Goal, GoalNotServedError
 
 __all__ = ["FLUSH_APPROACH", "FormationOutcome", "SEARCHED_FORMATIONS", "Surveyed", "TurnReport", "goal_angle",
-           "plan_turn", "slide_task", "survey"]
+           "pivot_pieces", "plan_turn", "slide_task", "survey"]
 
 #: How far (m) short of the flush instant the slide's band tables end: five times the contact tolerance (1 um), so
 #: the polygons show the four contacts of the palm edge there; the slide then reaches the flush instant itself in
@@ -186,8 +186,10 @@ def _outcome(pivot, hand, status, theta, why, pose=None, q=None, band=None) -> F
                             None if q is None else tuple(float(v) for v in q))  # fmt: skip
 
 
-def _pieces(task, pivot, start, theta_goal, geometry, progress):
-    """The pivot's pieces (planned phases, times from 0), cut at ``geometry.cuts``; raises PlanFailure."""
+def pivot_pieces(task, pivot, start, theta_goal, geometry, progress):
+    """The pivot's pieces (planned phases, times from 0), from its flush instant ``start`` to ``theta_goal`` (rad),
+    cut at ``geometry.cuts`` (:func:`qsplan.planner.plan.pivot.pivot_geometry`); raises PlanFailure naming the first
+    row without a band."""
     from qsplan.hands.pivots import pivot_path
     from qsplan.planner.plan.pivot import pivot_thetas, widest_piece
 
@@ -312,7 +314,7 @@ def survey(task, progress=None) -> tuple:
             progress(f"  {o.line()}")
             continue
         try:
-            pieces = tuple(_pieces(task, pivot, start, theta_goal, geometry, progress))
+            pieces = tuple(pivot_pieces(task, pivot, start, theta_goal, geometry, progress))
         except PlanFailure as exc:
             r = exc.report
             o = _outcome(pivot, hand, "no band", r.pose[2], r.reason, r.pose, r.q)
