@@ -309,15 +309,16 @@ def pivot_formations(hand, free=None) -> tuple:
 
 
 def _touches_only(hand, pivot: Pivot, c) -> bool:
-    """Whether at ``c`` the polygons show exactly the flush instant's five contacts, no body overlapping the
-    workpiece (the other finger really closes on its feature, nothing else)."""
+    """Whether at ``c`` the polygons show exactly the flush instant's five contacts and no two bodies overlap (the
+    other finger really closes on its feature, nothing else, and no finger passes through the palm or the other)."""
     from qsplan.hands.found_contacts import ordered_contacts
     from qsplan.mechanics.errors import SceneError
 
     try:
-        return len(ordered_contacts(hand, c[:3], c[3:])) == 5
+        five = len(ordered_contacts(hand, c[:3], c[3:])) == 5
     except SceneError:  # a body in the workpiece
         return False
+    return five and not hand.collisions(c[:3], c[3:], first=True)
 
 
 @dataclass(frozen=True, slots=True, eq=False)
