@@ -107,8 +107,8 @@ def chunk_count(n_units: int, min_units: int, *, workers=None, scheduler=None) -
 _MISSING = object()
 
 
-def _worker_start():
-    """Pool initializer: Ctrl-C ignored, one BLAS thread per worker process.
+def _worker_start(parent: int | None = None):
+    """Pool initializer: Ctrl-C ignored, one BLAS thread per worker process, ended with ``parent`` (its pid).
 
     Ctrl-C at a terminal signals the whole foreground process group, the workers too: each would
     print a ``KeyboardInterrupt`` traceback (37 lines for ``qsplan sweep`` on two workers).  The parent
@@ -127,7 +127,7 @@ def _worker_start():
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     if hasattr(signal, "pthread_sigmask"):
         signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGINT})
-    _die_with_parent()
+    _die_with_parent(parent)
     threadpool_limits(limits=1)
 
 
@@ -135,12 +135,14 @@ def _worker_start():
 _PR_SET_PDEATHSIG = 1
 
 
-def _die_with_parent() -> None:
+def _die_with_parent(parent: int | None = None) -> None:
     """Linux: this worker gets SIGTERM when the process that started it dies.
 
     A parent killed (SIGTERM, SIGKILL: not a Ctrl-C, which :func:`_stop_pool` answers) never shuts its pool down, and
-    its workers, blocked reading their next task, would live on forever.  Elsewhere nothing is done (the workers end
-    when their pipe to the parent breaks at their next task)."""
+    its workers, blocked reading their next task, would live on forever.  A parent that died between the fork and
+    this request sends no signal (the worker has already been handed to another parent): with ``parent``, the pid
+    that forked this worker, that is seen and the worker ends here.  Elsewhere nothing is done (the workers end when
+    their pipe to the parent breaks at their next task)."""
     import sys
 
     if not sys.platform.startswith("linux"):
@@ -151,7 +153,9 @@ def _die_with_parent() -> None:
     try:
         ctypes.CDLL(None, use_errno=True).prctl(_PR_SET_PDEATHSIG, int(signal.SIGTERM), 0, 0, 0)
     except (OSError, AttributeError):  # no libc prctl: the old behaviour
-        pass
+        return
+    if parent is not None and os.getppid() != parent:  # the parent died before the request: as if signalled
+        os.kill(os.getpid(), signal.SIGTERM)
 
 
 @contextmanager
@@ -254,8 +258,11 @@ def _in_pool(fn, items: list, n: int, progress=None) -> list:
         ex, futures = None, []
         try:
             with _sigint_held():  # the workers start inside: none sees a Ctrl-C before it ignores them
-                ex = ProcessPoolExecutor(max_workers=min(n, len(todo)), mp_context=_pool_context(),
-                                         initializer=_worker_start)  # fmt: skip
+                context = _pool_context()
+                # the pid that starts each worker: this process, but the forkserver's own under forkserver
+                parent = None if context.get_start_method() == "forkserver" else os.getpid()
+                ex = ProcessPoolExecutor(max_workers=min(n, len(todo)), mp_context=context,
+                                         initializer=_worker_start, initargs=(parent,))  # fmt: skip
                 futures = [(i, ex.submit(fn, items[i])) for i in todo]
             for i, f in futures:  # in order: the first exception of fn propagates, as in a loop
                 results[i] = f.result()
