@@ -12,7 +12,8 @@ from enum import IntEnum
 
 import numpy as np
 
-__all__ = ["Tolerances", "DEFAULT_TOLERANCES", "hadamard_ratio", "rcond", "Status", "StatusCode", "conditioning_verdict"]
+__all__ = ["Tolerances", "DEFAULT_TOLERANCES", "hadamard_ratio", "rcond", "singular_matrices", "Status", "StatusCode",
+           "conditioning_verdict"]
 
 
 @dataclass(frozen=True, slots=True)
@@ -169,6 +170,30 @@ def hadamard_ratio(A, *, signed: bool = False, log_row_norms=None):
             h = sign * h
         h = np.where((sign == 0) | ~np.isfinite(lognorm), 0.0, h)
     return h
+
+
+def singular_matrices(A, det, tol: Tolerances = DEFAULT_TOLERANCES):
+    """Which square matrices count as singular (:attr:`Tolerances.singular`), from their determinants already
+    computed: :func:`hadamard_ratio`'s test, ``|det A| < singular * prod_i ||a_i||``, or ``det`` not finite.
+
+    A determinant within rounding of zero has no sign: the band paths (:func:`qsplan.mechanics.bands.effort.band_rows`)
+    treat such a ``Q_AI`` as the solver does, singular and undecided, never by the sign its rounding happens to take.
+
+    Parameters
+    ----------
+    A : array-like, shape (..., k, k)
+    det : array-like, shape (...)
+        ``det A``.
+    tol : Tolerances
+
+    Returns
+    -------
+    ndarray of bool, shape (...)
+    """
+    A, det = np.asarray(A, dtype=float), np.asarray(det, dtype=float)
+    with np.errstate(over="ignore", invalid="ignore"):
+        scale = np.prod(np.linalg.norm(A, axis=-1), axis=-1)
+        return ~np.isfinite(det) | (det == 0) | (np.abs(det) < tol.singular * scale)
 
 
 def rcond(A):

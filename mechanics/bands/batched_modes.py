@@ -29,7 +29,7 @@ from qsplan.mechanics.bands.effort import coulomb_columns, coulomb_rows, row_mar
 from qsplan.mechanics.modes.contact_mode import ContactMode, letters_to_codes
 from qsplan.mechanics.modes.equilibrium import equilibrium_columns
 from qsplan.mechanics.modes.kinematics import applicable_rows, check_mode_fits, kinematic_tests, sliding_directions
-from qsplan.mechanics.numerics import DEFAULT_TOLERANCES, Status, StatusCode, Tolerances
+from qsplan.mechanics.numerics import DEFAULT_TOLERANCES, Status, StatusCode, Tolerances, singular_matrices
 
 __all__ = ["BatchKinematics", "PairRows", "batch_equations", "batch_kinematics", "batch_rows_many", "modes_kinematics"]
 
@@ -190,7 +190,8 @@ def batch_rows_many(jobs, force_margin=None, loads: bool = False) -> list:
     # Q_AI comes transposed in memory (equilibrium_columns builds its columns as rows): stacked so, a plain copy
     Q = np.concatenate([q.swapaxes(-1, -2).reshape(-1, k, k) for q, _ in eqs]).swapaxes(-1, -2)
     det = np.linalg.det(Q)
-    bad = ~np.isfinite(det) | (det == 0)
+    bad = singular_matrices(Q, det)  # as band_rows: a det within rounding of 0 has no sign
+    det = np.where(bad & np.isfinite(det), 0.0, det)
     Q[bad] = np.eye(k)  # a singular Q_AI: any solve, its rows are NaN below
     n = 5 if loads else 2
     rhs = np.concatenate([np.broadcast_to(load_columns(b.r0, loads)[:, None], q.shape[:2] + (k, n)).reshape(-1, k, n)

@@ -28,7 +28,7 @@ from qsplan.mechanics.bands.disturbance import (
 )
 from qsplan.mechanics.errors import QsplanError, SceneError
 from qsplan.mechanics.modes.contact_mode import ContactMode
-from qsplan.mechanics.numerics import DEFAULT_TOLERANCES, Status, Tolerances
+from qsplan.mechanics.numerics import DEFAULT_TOLERANCES, Status, Tolerances, singular_matrices
 from qsplan.mechanics.model.scene import Scene
 from qsplan.mechanics.modes.equilibrium import coulomb_slacks, equilibrium_matrix
 from qsplan.mechanics.modes.kinematics import ScenePool, check_mode_fits, single_mode_kinematics
@@ -233,7 +233,9 @@ def band_rows(scene: Scene, mk: ModeKinematics, mu_rows, force_margin=None, *, l
         ``mu c_n - c_t`` and ``c_n`` per rolling contact, ``c_n`` per sliding contact
         (minus their margins with ``force_margin``).
     det : ndarray, shape (N,)
-        ``det Q_AI`` (sign and size tell singularity).
+        ``det Q_AI``; exactly 0 where ``Q_AI`` counts as singular (its Hadamard ratio below
+        ``Tolerances.singular``, :func:`qsplan.mechanics.numerics.singular_matrices`: a determinant within
+        rounding of zero has no sign), and there ``s0``, ``s1`` (and ``s2``) are NaN.
     scale : ndarray, shape (N,)
         Force scale of each row set (N), for tolerances.
     s2 : ndarray, shape (N, r, 3)
@@ -246,7 +248,8 @@ def band_rows(scene: Scene, mk: ModeKinematics, mu_rows, force_margin=None, *, l
     det = np.linalg.det(Q)
     E = mk.pool.E
     r0 = np.concatenate([-scene.g_obj, -scene.g_man[E]])
-    bad = ~np.isfinite(det) | (det == 0)
+    bad = singular_matrices(Q, det)  # the solver's singularity test: a det within rounding of 0 has no sign
+    det = np.where(bad & np.isfinite(det), 0.0, det)
     Qs = Q.copy()
     Qs[bad] = np.eye(Q.shape[1])
     rhs = load_columns(r0, loads)

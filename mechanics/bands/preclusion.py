@@ -192,15 +192,22 @@ def _search(cells: FrictionCells, lo_, hi_, flip, atol, budget, tol):
     """Smallest effort of ``[lo_, hi_]`` possibly feasible; with ``flip`` the efforts are negated
     (pass ``-hi, -lo`` to find the largest).
 
-    Returns ``(value, exact, cells used, met a singular cell)`` with ``value`` (in the unflipped
-    sign) ``+inf`` (``-inf`` with ``flip``) when no effort of the interval is possible: nothing
+    Returns ``(value, exact, cells used, met a singular cell, met a singular point)`` with ``value`` (in the
+    unflipped sign) ``+inf`` (``-inf`` with ``flip``) when no effort of the interval is possible: nothing
     feasible; ``-inf`` (``+inf`` with ``flip``) when the possible efforts reach the interval's
     unbounded end, proved (a friction point whose band is unbounded there: ``exact``) or not
     excluded (``exact`` False).  A cell whose bound is ``-inf`` is a safe answer and is kept, never dropped.
+
+    A cell left open with a control value that is not a number (``Q_AI`` singular at a vertex:
+    :func:`qsplan.mechanics.bands.effort.band_rows`; or in the fit of a shared coefficient's polynomials)
+    can never be resolved: its bound is the interval's start, and every cell bisected from it keeps that
+    vertex (the shared path: those coefficients).  The search then ends at once with the answer it would
+    give when its budget ran out, the interval's start, conservative (``exact`` False).
     """
     sign = -1.0 if flip else 1.0
     clo, chi = cells.root
     incumbent, floor, used, exact, straddling, proofs = np.inf, np.inf, 0, True, False, 0
+    singular = False
     while clo.shape[0]:
         det, N0, N1, pl, pu, pok, spread = cells.evaluate(clo, chi)
         used += clo.shape[0]
@@ -223,6 +230,12 @@ def _search(cells: FrictionCells, lo_, hi_, flip, atol, budget, tol):
         done = possible & (lb >= min(incumbent, hi_) - atol)
         floor = min(floor, float(np.min(lb[done], initial=np.inf)))
         keep = possible & ~done
+        undecided = ~(np.all(np.isfinite(det), axis=1) & np.all(np.isfinite(N0), axis=(1, 2))
+                      & np.all(np.isfinite(N1), axis=(1, 2)))  # fmt: skip
+        if np.any(keep & undecided):  # never resolved (the docstring): the answer the budget would give, now
+            floor = min(floor, float(np.min(lb[keep])))
+            exact, singular = False, True
+            break
         clo, chi, spread = clo[keep], chi[keep], spread[keep]
         if not clo.shape[0]:
             break
@@ -232,7 +245,7 @@ def _search(cells: FrictionCells, lo_, hi_, flip, atol, budget, tol):
             break
         clo, chi = cells.split(clo, chi, spread)
     value = min(incumbent, floor)
-    return sign * value, exact, used, straddling
+    return sign * value, exact, used, straddling, singular
 
 
 def friction_set(lo, hi, n_c: int, shared: bool):
@@ -286,15 +299,18 @@ def competitor_torques(scene, mode, lo, hi, g_lo, g_hi, shared=False, tol: Toler
     cells = FrictionCells(scene, mk, lo_a, hi_a, shared, tol, box)
     finite = [abs(x) for x in (g_lo, g_hi) if np.isfinite(x)]
     atol = rtol * max(finite + [1.0])
-    low, ex1, n1, st1 = _search(cells, g_lo, g_hi, False, atol, max_cells, tol)
+    low, ex1, n1, st1, sg1 = _search(cells, g_lo, g_hi, False, atol, max_cells, tol)
     if low == np.inf:  # proved: no cell admits an effort of the interval
         return CompetitorTorques(mode.letters, np.nan, np.nan, True, True, None, n1)
     # the largest possibly-feasible effort, searched above the smallest one only
-    up, ex2, n2, st2 = _search(cells, -g_hi, -low, True, atol, max_cells, tol)
+    up, ex2, n2, st2, sg2 = _search(cells, -g_hi, -low, True, atol, max_cells, tol)
     if up == -np.inf:  # nothing above low within atol: the set is (numerically) the point low
         up = low
     exact = ex1 and ex2
     reason = None
-    if not exact:
+    if sg1 or sg2:
+        reason = ("the mode is singular (Q_AI's Hadamard ratio below Tolerances.singular) at a point of the friction "
+                  "set: its feasibility there is not decided")  # fmt: skip
+    elif not exact:
         reason = "cell budget exhausted" + ("; the mode is singular (det Q_AI changes sign) inside the friction set" if st1 or st2 else "")
     return CompetitorTorques(mode.letters, float(low), float(max(up, low)), False, exact, reason, n1 + n2)
