@@ -14,7 +14,8 @@ On the palm edge this is the order of every earlier plan (``palm:0, palm:1, left
 ``palm:0, palm:1, left:base, left:tip, right``; on a pivot ``palm:1, left:base, left:tip, right``: the registered
 formations' orders (:mod:`qsplan.hands.formations`).  :func:`row_contact_scene` builds the row's scene from them
 (:func:`qsplan.hands.point_scene.points_scene`), and :func:`made_contacts` says which contacts a motion makes at its last row (a contact
-open along the motion that reaches it is not part of that motion).  Paper-form hands (fingers of one link).
+open along the motion that reaches it is not part of that motion).  A hold at rest is proved in :func:`hold_scene`:
+every contact present, the one made at that instant included.  Paper-form hands (fingers of one link).
 Units SI (m, rad).
 """
 
@@ -25,7 +26,8 @@ import numpy as np
 from qsplan.mechanics.errors import QsplanError
 from qsplan.mechanics.model.geometry import CONTACT_TOL
 
-__all__ = ["contact_names", "drawable_contacts", "made_contacts", "ordered_contacts", "row_contact_scene", "slot_of"]
+__all__ = ["contact_names", "drawable_contacts", "hold_scene", "made_contacts", "ordered_contacts", "row_contact_scene",
+           "slot_of"]
 
 
 def ordered_contacts(hand, pose, q, tol: float = CONTACT_TOL) -> list:
@@ -111,6 +113,32 @@ def row_contact_scene(hand, pose, q, effort_controlled, velocity, effort=None, m
     names = [n for n, k in zip(names, keep) if k]
     return points_scene(hand, pose, q, [c.point for c in found], [c.normal for c in found],
                         [c.body for c in found], names, effort_controlled, velocity, effort, mu)  # fmt: skip
+
+
+def hold_scene(hand, pose, q, effort_controlled, effort=None, method: str = "auto"):
+    """The scene a hold at rest is proved in (:func:`qsplan.mechanics.bands.hold.prove_hold`): the one rule of the
+    planner's holds and the certifier's.
+
+    At rest every contact present can push: a hold's admissible motions must keep every one of them closed or
+    opening.  A hand that reorients (:attr:`qsplan.hands.protocol.Hand.reorients`, any formation) therefore has every
+    contact the polygons show at ``pose``, ``q`` (:func:`ordered_contacts`), a contact made at this instant included:
+    the mode of the motion that reaches a phase's last row leaves such a contact out (:func:`made_contacts`; it opens
+    along that motion), a hold at the same instant does not.  Any other hand has its formation's four contacts
+    (:func:`qsplan.hands.interface.scene_at` by ``method``).  The velocity-controlled joints are held (velocity 0);
+    ``effort``: the effort-controlled joints' efforts (N m or N; a proof takes its torques apart).
+
+    Raises
+    ------
+    SceneError
+        As :func:`ordered_contacts` or :func:`~qsplan.hands.interface.scene_at`; QsplanError when no contact is found.
+    """
+    from qsplan.hands.interface import scene_at
+
+    e = np.asarray(effort_controlled, dtype=bool)
+    held = np.zeros(e.size)  # the velocity-controlled joints still; an effort-controlled joint's velocity is not used
+    if hand.reorients:
+        return row_contact_scene(hand, pose, q, e, held, effort=effort)
+    return scene_at(hand, pose, q, e, held, effort=effort, method=method)
 
 
 def drawable_contacts(hand, pose, q) -> list:

@@ -7,7 +7,8 @@ Which contacts those are is decided here from the row's geometry alone:
 * a moving row, or a row at rest that starts its phase: every contact the polygon search finds (a contact that opens
   toward the next row is judged as breaking, ``B``);
 * a row at rest that ends its phase: the same, without the contacts its motion makes only there (open at the previous
-  row: :func:`qsplan.hands.found_contacts.made_contacts`), e.g. the slide's last row at the flush instant;
+  row: :func:`qsplan.hands.found_contacts.made_contacts`), e.g. the slide's last row at the flush instant (its hold,
+  :func:`qsplan.planner.certify.timing.hold_checks`, is proved with them: at rest every contact present pushes);
 * a **hold row** (every letter ``R``, at rest, its phase not moving): every contact found; nothing moves, and the hold
   proof (:mod:`qsplan.mechanics.bands.hold`), not the mode check, decides it.
 

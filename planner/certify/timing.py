@@ -22,7 +22,8 @@ homogeneous in the velocity input: its modes and bands are those of any positive
 row at rest is therefore judged for the motion that leaves it (a phase's first row) or reaches it (its last): the
 straight line to the adjacent row, as the controller moves (:func:`row_velocity`).  And at the instant of rest
 itself :func:`hold_checks` proves that nothing moves, the velocity-controlled joints held and the effort joint at
-its command, for every friction and every wrench of the box (kind ``hold``;
+its command, with every contact present there (a contact the reaching motion makes included: at rest it pushes as
+well as any other), for every friction and every wrench of the box (kind ``hold``;
 :func:`qsplan.mechanics.bands.hold.prove_hold`: a frictionless equilibrium with every contact strictly loaded);
 the certificate records each proof.  Units SI.
 """
@@ -168,13 +169,24 @@ HOLD_PROOF = ("frictionless equilibrium with every contact strictly loaded, at t
 
 
 def hold_checks(task, cols, scenes) -> tuple:
-    """Every in-contact row at rest (``speed_scale`` 0; ``scenes``: ``{row: Scene}``) holds: ``(violations [(row,
-    kind, message)], records [{row, t_s, proved, margin_N, proof}])``."""
+    """Every in-contact row at rest (``speed_scale`` 0; ``scenes``: ``{row: Scene}``, the rows judged) holds:
+    ``(violations [(row, kind, message)], records [{row, t_s, proved, margin_N, proof}])``.
+
+    The hold is proved with every contact present at the row (:func:`qsplan.hands.found_contacts.hold_scene`, the
+    contacts found in the polygons), not only the contacts the row's mode judges: at a phase's last row the mode
+    leaves out a contact the motion makes there (it opens along that motion), and at rest that contact pushes as
+    well as any other."""
+    from qsplan.hands.found_contacts import hold_scene
+    from qsplan.hands.interface import joint_names
     from qsplan.mechanics.bands.hold import prove_hold
+    from qsplan.mechanics.errors import QsplanError
+
+    from qsplan.planner.certify.rows import row_pose, row_q
 
     if "speed_scale" not in cols:
         return [], []
     found, records = [], []
+    names = joint_names(task.hand)
     for k in sorted(scenes):
         if cols["speed_scale"][k] != 0.0:
             continue
@@ -182,7 +194,16 @@ def hold_checks(task, cols, scenes) -> tuple:
         tau = float(cols[f"tau_{e}"][k]) if f"tau_{e}" in cols else float("nan")
         if not np.isfinite(tau):
             continue  # no command: the torque check names it
-        proof = prove_hold(scenes[k], torques=[tau], disturbance=task.disturbance)
+        scene = scenes[k]
+        if task.hand.reorients:  # any formation: every contact the polygons show (the reference search)
+            effort = np.array(names) == e
+            try:
+                scene = hold_scene(task.hand, row_pose(cols, k), row_q(cols, k, names), effort,
+                                   np.where(effort, tau, 0.0), method="generic")  # fmt: skip
+            except QsplanError as exc:
+                found.append((int(k), "hold", f"at rest, the row's contacts cannot be found: {exc}"))
+                continue
+        proof = prove_hold(scene, torques=[tau], disturbance=task.disturbance)
         records.append({"row": int(k), "t_s": float(cols["t"][k]), "proved": bool(proof.proved),
                         "margin_N": float(proof.margin), "proof": HOLD_PROOF})  # fmt: skip
         if not proof.proved:

@@ -164,13 +164,14 @@ def _pivot_thetas(theta_goal: float) -> np.ndarray:
 
 
 def _held_interval(task, pose, q, effort):
-    """``(scene, (lo, hi))``: every contact the polygons show at ``pose``, ``q``, the ``effort`` joints (bool)
-    torque-controlled and the others held, and the torques at which the hold is proved with every contact loaded by
-    the task's force margin at every vertex of its disturbance box (N m; nan when none)."""
-    from qsplan.hands.found_contacts import row_contact_scene
+    """``(scene, (lo, hi))``: every contact the polygons show at ``pose``, ``q`` (:func:`qsplan.hands.found_contacts.
+    hold_scene`, as certified), the ``effort`` joints (bool) torque-controlled and the others held, and the torques
+    at which the hold is proved with every contact loaded by the task's force margin at every vertex of its
+    disturbance box (N m; nan when none)."""
+    from qsplan.hands.found_contacts import hold_scene
     from qsplan.mechanics.bands.hold import hold_torque_interval
 
-    scene = row_contact_scene(task.hand, pose, q, effort, np.zeros(effort.size))
+    scene = hold_scene(task.hand, pose, q, effort)
     return scene, hold_torque_interval(scene, task.disturbance, margin=task.force_margin.normal)
 
 

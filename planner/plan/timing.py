@@ -34,7 +34,8 @@ import numpy as np
 
 from qsplan.planner.task.dynamics import task_dynamics
 
-__all__ = ["PhaseTiming", "SCALE_ITERATIONS", "path_covered", "piece_scale", "quasistatic_rows", "scale_rate", "time_scale"]
+__all__ = ["PhaseTiming", "SCALE_ITERATIONS", "path_covered", "piece_scale", "quasistatic_rows", "rest_scene",
+           "scale_rate", "time_scale"]
 
 #: Rounds of cutting ``α`` and the peak when a slide's curvature makes a joint's command change faster than the
 #: trapezoid alone predicts (each round cuts by the measured excess; the bundled plans need at most one).
@@ -130,7 +131,8 @@ def _rest_bands(task, ph):
     controller makes there (:func:`qsplan.planner.certify.timing.row_velocity`).  The planner's band at that row is
     for the path's tangent; both motions pass the row, so the band kept is their intersection, and the commands
     are chosen again by the slide's rule (:func:`qsplan.planner.torque.command.plan_command`).  With one
-    velocity-controlled joint the two directions agree (same sign): nothing changes.
+    velocity-controlled joint the two directions agree (same sign): nothing changes.  At the instant of rest itself
+    the command must hold the workpiece still (:func:`_rest_holds`).
     """
     from qsplan.mechanics.bands.batched_robust import robust_bands
     from qsplan.mechanics.errors import QsplanError
@@ -142,7 +144,7 @@ def _rest_bands(task, ph):
     scenes = []
     for k, (a, b) in ((0, (0, 1)), (ph.t.size - 1, (ph.t.size - 2, ph.t.size - 1))):
         chord = (ph.q[b] - ph.q[a]) / (ph.t[b] - ph.t[a])  # the rows' quasistatic times: a velocity at speed scale 1
-        scenes.append((k, _rest_scene(task, ph, k, a if k == b else b, effort, np.where(effort, 0.0, chord))))
+        scenes.append((k, rest_scene(task, ph, k, a if k == b else b, effort, np.where(effort, 0.0, chord))))
     bands = robust_bands([sc for _, sc in scenes], ph.mode, task.mu_range, shared=task.shared_mu,
                          force_margin=task.force_margin, disturbance=task.disturbance)  # fmt: skip
     for (k, _), rb in zip(scenes, bands):
@@ -151,11 +153,49 @@ def _rest_bands(task, ph):
                               f"leaving or reaching it ({rb.reason})")  # fmt: skip
         lower[k], upper[k] = max(lower[k], rb.lower), min(upper[k], rb.upper)
     if np.array_equal(lower, ph.lower) and np.array_equal(upper, ph.upper):
-        return ph.lower, ph.upper, ph.command, ph.margin
+        out = ph.lower, ph.upper, ph.command, ph.margin
+    else:
+        out = (lower, upper, *plan_command(lower, upper, task.torque_resolution))
+    return _rest_holds(task, ph, *out)
+
+
+def _rest_holds(task, ph, lower, upper, command, margin):
+    """``(lower, upper, command, margin)`` with each row at rest's command proved to hold there, as the certifier
+    proves it (:func:`qsplan.planner.certify.timing.hold_checks`: every contact present, the other joints held,
+    :func:`qsplan.hands.found_contacts.hold_scene`).  A command the hold is not proved at narrows that row's band to
+    the proved interval (:func:`qsplan.mechanics.bands.hold.hold_torque_interval`, with the task's force margin) and
+    the commands are chosen again; the rows whose holds are proved keep everything.
+
+    Raises
+    ------
+    QsplanError
+        No hold at least the torque resolution wide at a row at rest.
+    """
+    from qsplan.hands.found_contacts import hold_scene
+    from qsplan.mechanics.bands.hold import hold_torque_interval, prove_hold
+    from qsplan.mechanics.errors import QsplanError
+    from qsplan.planner.torque.command import plan_command
+
+    effort = np.array(task.hand.joint_names) == ph.effort_joint
+    pose = ph.poses(task.hand.rest_height)
+    narrowed = False
+    for k in (0, ph.t.size - 1):
+        scene = hold_scene(task.hand, pose[k], ph.q[k], effort)
+        if prove_hold(scene, torques=[command[k]], disturbance=task.disturbance).proved:
+            continue
+        lo, hi = hold_torque_interval(scene, task.disturbance, margin=task.force_margin.normal)
+        lower, upper = lower.copy(), upper.copy()
+        lower[k], upper[k] = np.maximum(lower[k], lo), np.minimum(upper[k], hi)  # nan (no hold) stays: refused below
+        if not upper[k] - lower[k] >= task.torque_resolution:
+            raise QsplanError(f"plan: {ph.name}: at rest at x = {ph.x[k]:.6g} m no hold is proved inside the band "
+                              f"(the hold's interval [{lo:.4g}, {hi:.4g}], every contact loaded by the force margin)")
+        narrowed = True
+    if not narrowed:
+        return lower, upper, command, margin
     return (lower, upper, *plan_command(lower, upper, task.torque_resolution))
 
 
-def _rest_scene(task, ph, k, other, effort, velocity):
+def rest_scene(task, ph, k, other, effort, velocity):
     """The scene of ``ph``'s row ``k`` at rest for the motion to or from row ``other``: the formation's closed form,
     or where the polygons show another contact set there (a slide's last row at the flush instant), every contact
     found but those the motion makes only at ``k`` (:func:`qsplan.hands.found_contacts.made_contacts`)."""
