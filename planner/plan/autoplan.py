@@ -33,6 +33,7 @@ import numpy as np
 from qsplan.hands.interface import JOINT_UNITS
 from qsplan.mechanics.errors import QsplanError
 
+from qsplan.planner.plan.release import release_holds
 from qsplan.planner.plan.results import ContactSegmentPlan, Plan, PlanFailure
 from qsplan.planner.plan.steps import RegraspStep, SearchSummary, SlideStep, realised_steps
 from qsplan.planner.plan.timing import time_scale
@@ -343,6 +344,7 @@ def plan_automatic(task, options=None, progress=None, planner: str = "widest", t
         return plan
     plan = time_scale(plan)
     plan = replace(plan, sequence=realised_steps(plan.sequence, plan.phases))  # the steps as the rows are timed
+    plan = release_holds(plan)  # every release from an unloaded hold (qsplan.planner.plan.release)
     plan.check()
     if not any(isinstance(p, ContactSegmentPlan) for p in plan.phases):
         raise QsplanError("goal: reached by regrasps alone; the plan has no in-contact segment to export")

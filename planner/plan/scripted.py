@@ -56,6 +56,7 @@ from qsplan.planner.plan.failure import configuration_report, failure_report
 from qsplan.planner.plan.phases import (DEFAULT_OPTIONS, REGRASP_OPENING, SWEEP_STEP, regrasp_phase, slide_phase,
                                         sweep_contact_segment)
 from qsplan.planner.plan.results import ContactSegmentPlan, Plan, PlanFailure, RegraspPlan
+from qsplan.planner.plan.release import release_holds
 from qsplan.planner.plan.timing import time_scale
 from qsplan.planner.task.goal import check_goal_served
 from qsplan.planner.search.ompl_bridge import PlannerOptions
@@ -296,5 +297,6 @@ def plan_task(task: Task, options: PlannerOptions | None = None, progress=None, 
         phases.append(seg)
         t0 = float(seg.t[-1])
     plan = time_scale(Plan(task, tuple(phases), time.perf_counter() - t_start, counters[0], counters[1], options))
+    plan = release_holds(plan)  # every release from an unloaded hold (qsplan.planner.plan.release)
     plan.check()
     return plan

@@ -341,9 +341,11 @@ def _snapshot_row(sub, plan, shots, letters, rows) -> set:
     column = 72.0 * _SNAPSHOT_ROW_WIDTH / cols - 6.0  # points: a title's room
     axes = sub.subplots(rows, cols, squeeze=False).ravel()
     drawn = set()
+    # the scale bar on the first snapshot without an effort's marker (a regrasp's), where no marker crowds its label
+    bar = next((i for i, s in enumerate(shots) if not s.effort_joint), 0)
     for i, (ax, s, letter) in enumerate(zip(axes, shots, letters)):
         plot_hand(plan.task.hand, s.pose, s.q, ax=ax, contacts=s.touching, effort_joint=s.effort_joint, limits=lim,
-                  scale_bar=i == 0, effort_sign=s.effort if s.effort_joint else None)  # fmt: skip
+                  scale_bar=i == bar, effort_sign=s.effort if s.effort_joint else None)  # fmt: skip
         drawn |= ({"contacts"} if s.touching else set()) | ({"effort"} if s.effort_joint else set())
         role = {"start": ", start", "end": ", end"}.get(s.role, "")
         state = state_words(plan, s.phase, s.state)
@@ -395,10 +397,14 @@ def _torque_panel(ax, plan, joint, segs, res, parts: int) -> set:
         ax.axhline(0.0, color="0.6", lw=0.5)
     symbol = "\\tau" if word == "torque" else "f"
     plus = "counter-clockwise" if word == "torque" else "along +q"
-    ax.set_ylabel(f"${symbol}_{{{joint_math(joint)}}}$ ({unit})\n+: {plus}", fontsize=FONT["label"])
+    # one line (a second outgrew a short panel: a regrasp plan's release holds add a joint's panel); a described
+    # hand's long name stays in the title, as the velocity panels'; the sign there too
+    name = f"_{{{joint_math(joint)}}}" if joint in ("left", "right") else ""
+    ax.set_ylabel(f"${symbol}{name}$ ({unit})", fontsize=FONT["label"])
     number = {id(p): i for i, p in enumerate(plan.phases)}
     which = f", {_phases_text([number[id(m)] for m in segs])}" if parts > 1 else ""
     which += " (log scale)" if log else ""
+    which += f"; +: {plus}"
     ax.set_title(f"{joint_title(joint)}: {word} command inside its guaranteed band{which}", fontsize=FONT["label"],
                  loc="left")  # fmt: skip
     return drawn
@@ -501,9 +507,7 @@ def plan_card(plan, certificate=None, replays=(), snapshots: int = MAX_SNAPSHOTS
             drawn.add("hatch")
         ax.axhline(0.0, color="0.6", lw=0.5)
         joint = group[0]
-        short = len(group) == 1 and joint in ("left", "right")  # a described hand's long names stay in the title
-        ax.set_ylabel(f"$\\dot q_{{{joint}}}$ ({units[joint]})" if short else f"$\\dot q$ ({units[joint]})",
-                      fontsize=FONT["label"])  # fmt: skip
+        ax.set_ylabel(f"$\\dot q$ ({units[joint]})", fontsize=FONT["label"])  # the joint named in the title
         what = (f"{joint_title(joint)}: velocity command" if len(group) == 1 else
                 f"{_joints_title(group)}: velocity command, each in its colour while velocity-controlled")
         ax.set_title(what, fontsize=FONT["label"], loc="left")

@@ -290,7 +290,7 @@ def band_tables(task, grasps, x, progress=None) -> BandTables:
                     at += idx.size
                     lower[g, e, d, idx], upper[g, e, d, idx] = b.lower[part], b.upper[part]
     width = np.where(np.isnan(lower) | np.isnan(upper), -np.inf, upper - lower)
-    graph = SearchGraph(valid, touched, width, float(task.torque_resolution))
+    graph = SearchGraph(valid, touched, width, float(task.torque_resolution), lower, upper)
     return BandTables(rows, x, graph, q, lower, upper, why, G * n, band_states, time.perf_counter() - t0, efforts)
 
 

@@ -36,7 +36,9 @@ def test_frames_follow_the_rows(name):
     for f in frames:
         ph = plan.phases[f.phase]
         assert ph.t[f.row] <= f.t and (f.row == ph.t.size - 1 or f.t < ph.t[f.row + 1])
-        if isinstance(ph, ContactSegmentPlan):  # drawn at its rows, the workpiece sliding along x on the palm
+        if isinstance(ph, ContactSegmentPlan) and ph.kind == "hold":  # a release hold: drawn still, held
+            assert f.t == ph.t[f.row] and f.state == "holding" and not any(np.any(d) for _, d in f.contacts)
+        elif isinstance(ph, ContactSegmentPlan):  # drawn at its rows, the workpiece sliding along x on the palm
             assert f.t == ph.t[f.row] and np.array_equal(f.q, ph.q[f.row]) and f.state == "sliding"
             dx = np.sign(ph.x[-1] - ph.x[0])
             for _, d in f.contacts[:2]:  # the palm's contacts (the scene's first two)
@@ -48,7 +50,8 @@ def test_frames_follow_the_rows(name):
 @pytest.mark.ompl
 def test_a_regrasp_is_animated_open_and_closing():
     plan = planned("two_link_regrasp_task")
-    states = [f.state for f in animation_frames(plan, MAX_FRAMES) if f.phase == 1]
+    regrasp = next(i for i, p in enumerate(plan.phases) if not p.in_contact)  # after the slide and its release hold
+    states = [f.state for f in animation_frames(plan, MAX_FRAMES) if f.phase == regrasp]
     assert states[0] == "holding" and states[-1] == "holding"  # released from, and closed onto, a grasp
     assert "open" in states and "closing" in states and states.index("open") < states.index("closing")
 
@@ -101,7 +104,7 @@ def test_gif_and_page(tmp_path, capsys):
     png.write_bytes(base64.b64decode(pngs[-1]))
     with Image.open(png) as im:
         assert im.size == Image.open(tmp_path / "plan_animation.gif").size
-    assert f"phase 1, t = {plan.duration:.2f} s, holding" in page
+    assert f"phase {len(plan.phases) - 1}, t = {plan.duration:.2f} s, holding" in page
 
 
 @pytest.mark.parametrize("kwargs, match", [

@@ -350,10 +350,11 @@ def test_plots_draw_every_link_and_a_row_per_velocity_controlled_joint(two_link,
     titles = [a.get_title(loc="left") for a in plan_card(plan).axes]
     for joint in plan.task.hand.joint_names:
         assert f"{joint} joint: velocity command" in titles
-    assert "left_distal joint: torque command inside its guaranteed band" in titles
+    assert "left_distal joint: torque command inside its guaranteed band; +: counter-clockwise" in titles
     jplan, _ = jaws
     card = plan_card(jplan)
-    assert "left_jaw joint: force command inside its guaranteed band" in [a.get_title(loc="left") for a in card.axes]
+    assert "left_jaw joint: force command inside its guaranteed band; +: along +q" in [a.get_title(loc="left")
+                                                                                     for a in card.axes]
     assert any(a.get_ylabel() == "$\\dot q$ (m/s)" for a in card.axes)
     assert plot_plan_bands(jplan)[0].get_ylabel() == "$f_{left\\_jaw}$ (N)"
 

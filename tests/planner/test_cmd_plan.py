@@ -23,13 +23,13 @@ def test_plan_writes_the_trajectory_and_its_resimulation(tmp_path, capsys):
     out = tmp_path / "out"
     code, stdout, err = run(["plan", str(task), "--out", str(out), "--no-plots", "--verify", "2", "--quiet"], capsys)
     assert code == 0 and err == ""
-    assert "planned 2 in-contact segments and 1 regrasps" in stdout
-    assert stdout.count("re-simulated at mu = ") == 2 and "followed SSSS SSSS" in stdout
+    assert "planned 3 in-contact segments and 1 regrasps" in stdout  # two slides and the hold before the release
+    assert stdout.count("re-simulated at mu = ") == 2 and "followed SSSS RRRR SSSS" in stdout
     d = read_plan_csv(out / "plan.csv")
-    assert set(d["mode"]) == {"SSSS", "free"}
+    assert set(d["mode"]) == {"SSSS", "RRRR", "free"}
     replays = json.loads((out / "replay.json").read_text())
     assert [r["mu"] for r in replays] == [[0.0] * 4, [0.2] * 4] and all(r["followed"] for r in replays)
-    assert {s["planned_mode"] for r in replays for s in r["segments"]} == {"SSSS"}
+    assert {s["planned_mode"] for r in replays for s in r["segments"]} == {"SSSS", "RRRR"}
     # a second run refuses to overwrite a file qsplan did not write (here: edited), in one line, before planning
     (out / "plan.csv").write_bytes((out / "plan.csv").read_bytes() + b"\n")
     before = (out / "plan.csv").read_bytes()

@@ -52,15 +52,15 @@ def test_phase_is_an_integer_index(small_run):
     header, *rows = (small_run.out_dir / "plan.csv").read_text().splitlines()
     j = header.split(",").index("phase")
     cells = [r.split(",")[j] for r in rows]
-    assert set(cells) == {"0", "1", "2"}  # segment, regrasp, segment
+    assert set(cells) == {"0", "1", "2", "3"}  # segment, release hold, regrasp, segment
     doc = json.loads((small_run.out_dir / "plan.json").read_text())
     assert all(type(p) is int for p in doc["data"]["phase"])
-    assert [p["index"] for p in doc["metadata"]["phases"]] == [0, 1, 2]
+    assert [p["index"] for p in doc["metadata"]["phases"]] == [0, 1, 2, 3]
     cols = read_plan_csv(small_run.out_dir / "plan.csv")
     segs = replay_segments(cols)
-    assert [s["phase"] for s in segs] == [0, 2]
+    assert [s["phase"] for s in segs] == [0, 1, 3]  # the slides and the release hold
     legacy = dict(cols, phase=np.array([f"{p:.1f}" for p in cols["phase"]]))  # files before issue 16
-    assert [s["phase"] for s in replay_segments(legacy)] == [0, 2]
+    assert [s["phase"] for s in replay_segments(legacy)] == [0, 1, 3]
     with pytest.raises(ValueError, match="phase"):
         replay_segments(dict(cols, phase=cols["phase"] + 0.5))
 

@@ -297,11 +297,14 @@ def test_issue_hexagon_slides_where_its_slip_slows_and_mujoco_says_so(tmp_path, 
 
 @pytest.mark.slow
 def test_issue_pentagon_s_error_is_the_servos_deflection(tmp_path, capsys):
+    """Its plan squeezed 57 N per finger at the start (the held right servo deflected: 0.12-0.19 mm against the former
+    judge's round 0.1 mm).  Since the route's last key (the peak squeeze, ``qsplan.planner.search.widest``) the slide
+    torque-controls the finger whose command stays near zero: no squeeze, and the error that is left is still the
+    servos' deflection, the soft contacts' share a tenth of it."""
     pytest.importorskip("mujoco")
     rc, doc, _ = _plan_and_replay(tmp_path, "pentagon", capsys)
     assert rc == 0 and doc["ok"] and len(doc["runs"]) == 16
-    assert doc["max_position_error_m"] > 1e-4  # what the former judge held against its round 0.1 mm ...
-    assert max(run["max_servo_error_m"] for run in doc["runs"]) > 1e-4  # ... is the servos' deflection,
-    assert doc["max_path_error_m"] <= doc["pose_tolerance_m"]  # and what it leaves is the soft contacts'
-    squeezed = [run["rows"][0] for run in doc["runs"] if min(run["rows"][0]["normal_force_N"]) > 20]  # 57 N at mu 0
-    assert squeezed and all(r["path_error_m"] < 0.01 * r["position_error_m"] for r in squeezed)
+    force = max(max(r["normal_force_N"]) for run in doc["runs"] for r in run["rows"] if r.get("normal_force_N"))
+    assert force < 20.0  # was 57 N per finger at mu = 0
+    assert max(run["max_servo_error_m"] for run in doc["runs"]) >= 0.9 * doc["max_position_error_m"]
+    assert doc["max_path_error_m"] <= min(doc["pose_tolerance_m"], 0.2 * doc["max_position_error_m"])

@@ -202,7 +202,7 @@ def test_chain_hand_runs_waypoints(tmp_path):
     task = _chain_task(tmp_path, "waypoints", "waypoints = [-0.01, 0.0]")
     assert not task.hand.accelerated
     plan = plan_task(task)
-    slides = [p for p in plan.phases if type(p).__name__ == "ContactSegmentPlan"]
+    slides = [p for p in plan.phases if type(p).__name__ == "ContactSegmentPlan" and p.kind == "slide"]
     assert len(slides) == 2
     assert [float(np.ravel(p.x)[-1]) for p in slides] == pytest.approx([-0.01, 0.0], abs=1e-9)
     assert float(np.ravel(slides[0].x)[0]) == pytest.approx(0.0, abs=1e-12)

@@ -46,8 +46,8 @@ def test_task_validation_names_the_field(tmp_path, text, match):
 
 @pytest.fixture(scope="module")
 def demo_files(tmp_path_factory):
-    """The bundled scripted task (the demo before automatic planning: three segments, two regrasps) planned once,
-    exported, and read back from the file."""
+    """The bundled scripted task (the demo before automatic planning: three segments, two regrasps, each release
+    after a hold: qsplan.planner.plan.release) planned once, exported, and read back from the file."""
     from qsplan.planner.plan.scripted import plan_task
 
     plan = plan_task(load_task(task_paths()["scripted_regrasp_task"]))
@@ -57,8 +57,8 @@ def demo_files(tmp_path_factory):
 
 
 def _rows(d):
-    """In-contact rows of an exported plan: index, pose (3,), q (2,), effort joint, velocity joint."""
-    for k in np.flatnonzero(d["mode"] != "free"):
+    """Slide rows of an exported plan: index, pose (3,), q (2,), effort joint, velocity joint."""
+    for k in np.flatnonzero(d["mode"] == "SSSS"):
         e = str(d["effort_joint"][k])
         pose = np.array([d["x_workpiece"][k], d["y_workpiece"][k], d["theta_workpiece"][k]])
         yield k, pose, np.array([d["q_left"][k], d["q_right"][k]]), e, ("left" if e == "right" else "right")
@@ -71,7 +71,7 @@ def test_demo_export_keeps_every_command_inside_the_desired_modes_exact_band(dem
         export_plan(plan, out)  # nothing a user has is overwritten
     hand, task = plan.task.hand, plan.task
     lo, hi = task.mu_range
-    assert set(d["mode"]) == {"SSSS", "free"} and np.sum(d["mode"] == "SSSS") > 200
+    assert set(d["mode"]) == {"SSSS", "RRRR", "free"} and np.sum(d["mode"] == "SSSS") > 200
     for k, pose, q, e, v in _rows(d):
         assert np.allclose(q, finger_angles(hand, pose)[0], atol=1e-9)  # the grasp is the tangency
         scene = hand_scene(hand, pose, q, e, velocity=moving_velocity(d, k, v))
@@ -115,7 +115,7 @@ def test_demo_export_resimulated_follows_the_planned_modes(demo_files):
     for mu in friction_samples(plan.task.mu_range, 3, seed=3):
         r = replay_plan(d, plan.task.hand, mu)
         assert r.followed, r.summary()
-        assert [s.labels for s in r.segments] == [("SSSS",)] * 3
+        assert [s.labels for s in r.segments] == [("SSSS",), ("RRRR",)] * 2 + [("SSSS",)]  # a hold before each release
         assert r.x_error < 1e-6  # the 4S motion is fixed by the kinematics: the planned path, to integration error
 
 
@@ -134,17 +134,19 @@ def test_resimulation_catches_commands_outside_the_band(demo_files):
 def test_plan_counts_and_checks(demo_files):
     plan = demo_files[0]
     plan.check()
-    assert len(plan.segments) == 3 and len(plan.phases) == 5
+    slides = [p for p in plan.segments if p.kind == "slide"]
+    assert len(slides) == 3 and len(plan.phases) == 7  # and a release hold before each of the two regrasps
+    assert [p.kind for p in plan.segments if p.kind != "slide"] == ["hold", "hold"]
     assert plan.validity_checks > 0 and plan.checks_per_second > 0
-    assert plan.segments[0].effort_joint == "right"  # the trailing (pushing) finger when sliding left
+    assert slides[0].effort_joint == "right"  # the trailing (pushing) finger when sliding left
     from qsplan.planner.torque.command import MAX_MARGIN_RESOLUTIONS
 
     cap = MAX_MARGIN_RESOLUTIONS * plan.task.torque_resolution
-    for seg in plan.segments:  # each command keeps half the narrowest band, at most the cap, from both edges
+    for seg in slides:  # each command keeps half the narrowest band, at most the cap, from both edges
         keep = min(0.5 * np.min(seg.width), cap)
         assert np.all(seg.margin >= keep * (1 - 1e-12)) and np.all(seg.command - seg.lower >= keep * (1 - 1e-12))
         assert np.all(seg.upper - seg.command >= keep * (1 - 1e-12))
-    for ph in plan.phases[1::2]:  # regrasps: collision-free, the fingers end where they started
+    for ph in [p for p in plan.phases if not p.in_contact]:  # regrasps: collision-free, back where they started
         assert all(check_free_state(plan.task, ph.x, q) for q in ph.q[1:-1])
         assert np.allclose(ph.q[0], ph.q[-1])
 

@@ -43,7 +43,7 @@ def test_every_phase_starts_and_ends_at_rest_within_the_limits(small_run):
     task = small_run.plan.task
     d = read_plan_csv(small_run.out_dir / "plan.csv")
     names = task.hand.joint_names
-    assert len(set(d["phase"])) == 3
+    assert len(set(d["phase"])) == 4  # slide, release hold, regrasp, slide
     dyn = task.dynamics
     box_lo, box_hi = np.asarray(task.disturbance.lo), np.asarray(task.disturbance.hi)
     worst_accel, worst_load = 0.0, 0.0
@@ -59,6 +59,8 @@ def test_every_phase_starts_and_ends_at_rest_within_the_limits(small_run):
             ok = np.isfinite(qd[:-1]) & np.isfinite(qd[1:])
             acc = np.abs(np.diff(qd))[ok] / np.diff(t)[ok]
             worst_accel = max(worst_accel, float(np.max(acc / dyn.joint_accelerations[j], initial=0.0)))
+        if not np.any(u > 0):
+            continue  # the release hold: nothing moves
         # the workpiece's acceleration between rows by the rule (the speed scale linear in time)
         dx, dt = np.diff(d["x_workpiece"][rows]), np.diff(t)
         ax = dx * (u[1:] - u[:-1]) / dt / (0.5 * (u[:-1] + u[1:]) * dt)
@@ -92,8 +94,12 @@ def test_metadata_records_the_time_scaling(small_run):
     for ph in meta["phases"]:
         t = ph["time_scaling"]
         assert t["duration_s"] == pytest.approx(ph["t_end_s"] - ph["t_start_s"])
+        if ph.get("phase_kind") == "hold":  # the release hold: nothing moves (qsplan.planner.plan.release)
+            assert t["peak_speed_scale"] == 0 and t["binding"].startswith("none")
+            continue
         assert t["duration_s"] > t["quasistatic_duration_s"] and 0 < t["peak_speed_scale"] <= 1
-    assert meta["phases"][1]["time_scaling"]["binding"].startswith("release_acceleration")
+    assert [ph.get("phase_kind", ph["kind"]) for ph in meta["phases"]] == ["slide", "hold", "regrasp", "slide"]
+    assert meta["phases"][2]["time_scaling"]["binding"].startswith("release_acceleration")
 
 
 def test_the_inertial_box_holds_the_load_and_a_given_box_cuts_the_acceleration(tmp_path):
@@ -161,7 +167,9 @@ def test_every_rest_in_contact_is_a_proved_hold(small_run):
     cert = small_run.certificate
     d = read_plan_csv(small_run.out_dir / "plan.csv")
     rest = [int(k) for k in np.flatnonzero((d["speed_scale"] == 0.0) & (d["mode"] != "free"))]
-    assert [h["row"] for h in cert.holds] == rest and len(rest) == 4  # two slides, each starting and ending at rest
+    holds = int(np.sum(d["mode"] == "RRRR"))  # the release hold's rows (qsplan.planner.plan.release)
+    assert [h["row"] for h in cert.holds] == rest and holds > 0
+    assert len(rest) == 4 + holds  # two slides, each starting and ending at rest, and the hold before the release
     assert all(h["proved"] and h["margin_N"] > 0.05 and "frictionless equilibrium" in h["proof"] for h in cert.holds)
     task = small_run.plan.task
     k = rest[-1]
