@@ -275,18 +275,19 @@ def test_paper_hand_start_with_crossed_fingers_names_them(tmp_path):
 
 
 def test_turning_goal_preview_figure_is_laid_out():
-    """Issue 31: a turning goal's check.png draws the start and the end of the slide it previews (the route's first
-    step), says under it that the turn is not previewed, and marks no goal x on the bars (the turn has none)."""
+    """Issues 31-32: a turning goal's check.png draws the start and the end of the slide to the flush instant of the
+    formation the search prefers (the route's first step), says under it which formations the search sees, and marks
+    no goal x on the bars (the turn has none)."""
     from qsplan.planner.plotting.preview import preview_figure
     from qsplan.planner.reports.preview import preview_task
 
     task = load_task(task_paths()["reorient_edge_task"])
     preview = preview_task(task)
-    assert preview.slide_end is not None and preview.slide_end.ok and preview.route and not preview.ok
-    assert not preview.goal.previewed and "not previewed by check" in preview.goal.message
+    assert preview.slide_end is not None and preview.slide_end.ok and preview.route and preview.ok
+    assert not preview.goal.previewed and "the formations searched: " in preview.goal.message
     fig = preview_figure(task, preview)
     assert overlapping_texts(fig) == [] and legends_over_axes(fig) == []
     text = all_text(fig)
-    assert "slide's end: x = " in text and "not previewed by check" in text and "not valid" not in text
+    assert "slide's end: x = " in text and "the formations searched" in text and "not valid" not in text
     marks = [t.get_text() for ax in fig.axes for top in ax.child_axes for t in top.get_xticklabels()]  # the bars' marks
     assert "slide's end" in marks and "goal" not in marks
