@@ -2,17 +2,17 @@
 
 ::
 
-    qsplan demo [--out DIR] [--seed S] [--planner NAME] [--force] [--quiet] [--no-plots]
+    qsplan demo [--out DIR] [--seed S] [--planner NAME] [--force] [--quiet] [--plots card|all|none | --no-plots]
 
 Plans :func:`qsplan.planner.task.task.demo_task_path` exactly as ``qsplan plan`` does (:data:`DEMO_PLAN`
 says what it plans; a test holds the plan to it), and writes the torque trajectory, its certificate, the
-re-simulation and the plots into DIR (default ``out/demo``).
+re-simulation and the plan card (``--plots all``: every plot and the animation) into DIR (default ``out/demo``).
 """
 
 from __future__ import annotations
 
 from qsplan.planner.cli.options import add_plan_options
-from qsplan.planner.cli.plan import FLAGS, run_task
+from qsplan.planner.cli.plan import FLAGS, plots_asked, run_task
 
 __all__ = ["DEMO_PLAN", "FLAGS", "add_parser", "run"]
 
@@ -29,6 +29,12 @@ def add_parser(subparsers):
 
 
 def run(args, out) -> int:
-    from qsplan.planner.task.task import demo_task_path, load_task
+    from qsplan.planner.pipeline.worker import start_early, stop_early
 
-    return run_task(load_task(demo_task_path()), args, out, inputs=(demo_task_path(),))
+    start_early(plots_asked(args))  # the drawing process loads matplotlib while this one loads the planner
+    try:
+        from qsplan.planner.task.task import demo_task_path, load_task
+
+        return run_task(load_task(demo_task_path()), args, out, inputs=(demo_task_path(),))
+    finally:
+        stop_early()

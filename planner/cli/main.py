@@ -70,12 +70,16 @@ class _Version(argparse.Action):
         raise _VersionShown(f"qsplan {__version__}")
 
 
-def build_parser() -> argparse.ArgumentParser:
+def build_parser(command: str | None = None) -> argparse.ArgumentParser:
+    """The ``qsplan`` parser; with ``command`` (a name of :data:`COMMANDS`), that subcommand's alone: what running it
+    reads (its help, usage and errors the same), without building the others' (``qsplan modes`` then never imports
+    the planner's options)."""
     p = Parser(prog="qsplan", description="Quasistatic planar contact-mode prediction (Trinkle & Zeng 1995).")
     p.add_argument("--version", action=_Version)
     sub = p.add_subparsers(dest="command", required=True, parser_class=Parser)
-    for module in COMMANDS.values():
-        module.add_parser(sub)
+    for name, module in COMMANDS.items():
+        if command is None or name == command:
+            module.add_parser(sub)
     return p
 
 
@@ -100,11 +104,10 @@ def _say(message: str) -> None:
 def _dispatch(argv) -> int:
     from qsplan.mechanics.errors import NoAnswerError, ParallelError, QsplanError
 
-    from qsplan.planner.export.files import OutputExistsError
-
     flags = {}
+    argv = sys.argv[1:] if argv is None else list(argv)
     try:
-        args = build_parser().parse_args(argv)
+        args = build_parser(argv[0] if argv and argv[0] in COMMANDS else None).parse_args(argv)
         check_counts(args)
         module = COMMANDS[args.command]
         flags = getattr(module, "FLAGS", {})
@@ -115,11 +118,11 @@ def _dispatch(argv) -> int:
     except UsageError as exc:
         _say(str(exc))
         return EXIT_USAGE
-    except OutputExistsError as exc:
-        _say(f"qsplan: error: {overwrite_message(exc)}")
-        return EXIT_USAGE
     except QsplanError as exc:
-        _say(f"qsplan: error: {cli_message(str(exc), flags)}")
+        from qsplan.planner.export.files import OutputExistsError  # loaded when needed: not by every command
+
+        message = overwrite_message(exc) if isinstance(exc, OutputExistsError) else cli_message(str(exc), flags)
+        _say(f"qsplan: error: {message}")
         return EXIT_USAGE
     except ParallelError as exc:  # the processes computing failed: say so in one line, exit 2
         _say(f"qsplan: error: {cli_message(str(exc), flags)}")

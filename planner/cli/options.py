@@ -142,7 +142,11 @@ def add_plan_options(p, default_out):
     p.add_argument("--force", action="store_true",
                    help="replace existing outputs in DIR (never an input, never through a symbolic link)")  # fmt: skip
     p.add_argument("--quiet", action="store_true", help="no progress lines on stderr")
-    p.add_argument("--no-plots", action="store_true", help="write the torque trajectory only")
+    plots = p.add_mutually_exclusive_group()
+    plots.add_argument("--plots", choices=("card", "all", "none"), default="card",
+                       help="card (default): the plan card; all: also the bands, the mode timeline, the hand snapshots "
+                            "and the animation; none: as --no-plots")  # fmt: skip
+    plots.add_argument("--no-plots", action="store_true", help="write the torque trajectory only")
     p.add_argument("--verify", type=int, default=3, metavar="N",
                    help="re-simulate the exported plan at N friction vectors from the interval (the two uniform "
                         "extremes, then seeded random ones; 0: skip; default 3)")  # fmt: skip

@@ -3,7 +3,7 @@
 ::
 
     qsplan plan TASK.toml|BUNDLED_TASK [--out DIR] [--seed S] [--planner NAME] [--sequence-planner NAME] [--time-limit SECONDS]
-                          [--force] [--quiet] [--no-plots] [--verify N]
+                          [--force] [--quiet] [--plots card|all|none | --no-plots] [--verify N]
 
 Reads the task (:mod:`qsplan.planner.task.task`; a bundled task by its name, e.g. ``two_link_task``)
 and runs the pipeline
@@ -13,9 +13,11 @@ automatically: band tables of every grasp and the widest route through them, sea
 judged by their dense sweeps, regrasps planned in joint space by OMPL), and writes
 into DIR (default ``out/plan``) ``plan.csv`` and ``plan.json`` (the torque
 trajectory), ``replay.json`` (the exported file re-simulated at ``--verify``
-friction vectors of the interval; exit 1 if any run leaves the planned modes) and,
-unless ``--no-plots``, ``plan_bands.png``, ``mode_timeline.png`` and
-``hand_snapshots.png``.  Existing files are not overwritten without ``--force``
+friction vectors of the interval; exit 1 if any run leaves the planned modes) and
+``plan_card.png`` (drawn in a second process while the plan is certified; with ``--plots all`` also
+``plan_bands.png``, ``mode_timeline.png``, ``hand_snapshots.png`` and the animation; none with
+``--no-plots``; a plot that could not be drawn is said on stderr, the certified plan published without
+it).  Existing files are not overwritten without ``--force``
 (checked first; the task file never, even with it).  The files appear in DIR only once the plan
 is certified (written into a staging directory inside DIR, then renamed into place); a second run
 into a DIR that a run is writing fails at once (exit 2).  Progress lines go to stderr unless
@@ -32,10 +34,10 @@ import sys
 
 from qsplan.planner.cli.options import EXIT_FAILED, add_plan_options
 
-__all__ = ["FLAGS", "add_parser", "run", "run_task"]
+__all__ = ["FLAGS", "add_parser", "plots_asked", "run", "run_task"]
 
 #: Library fields of :func:`qsplan.planner.pipeline.run.run_plan` and this command's options.
-FLAGS = {"verify": "--verify", "time_limit": "--time-limit"}
+FLAGS = {"verify": "--verify", "time_limit": "--time-limit", "plots": "--plots"}
 
 
 def add_parser(subparsers):
@@ -44,6 +46,11 @@ def add_parser(subparsers):
                                 "(demo_task, two_link_task, ...: qsplan.planner.task_paths())")
     add_plan_options(p, "out/plan")
     return p
+
+
+def plots_asked(args) -> str:
+    """The plots ``args`` ask for: ``--plots``, or ``"none"`` with ``--no-plots``."""
+    return "none" if args.no_plots else args.plots
 
 
 def run_task(task, args, out, inputs=()) -> int:
@@ -60,8 +67,8 @@ def run_task(task, args, out, inputs=()) -> int:
             err.flush()
 
     result = run_plan(task, args.out, seed=args.seed, planner=args.planner, time_limit=args.time_limit,
-                      verify=args.verify, force=args.force, plots=not args.no_plots, progress=progress,
-                      sequence_planner=args.sequence_planner, inputs=inputs)  # fmt: skip
+                      verify=args.verify, force=args.force, plots=plots_asked(args),
+                      progress=progress, sequence_planner=args.sequence_planner, inputs=inputs)  # fmt: skip
     plan = result.plan
     name, t, w = plan.narrowest()
     out.write(f"{task.name}: planned {len(plan.segments)} in-contact segments and {len(plan.phases) - len(plan.segments)} "
@@ -84,6 +91,8 @@ def run_task(task, args, out, inputs=()) -> int:
         out.write(f"re-simulated at {r.summary()}\n")
     for f in result.files:
         out.write(f"wrote {f}\n")
+    for name, why in result.undrawn:  # said even with --quiet: a file asked for is missing
+        sys.stderr.write(f"qsplan: warning: {name} not drawn ({why}); the certified plan is published without it\n")
     if not result.followed:
         sys.stderr.write("qsplan: error: the exported plan left its planned modes in re-simulation (see replay.json)\n")
         return EXIT_FAILED
@@ -93,8 +102,14 @@ def run_task(task, args, out, inputs=()) -> int:
 def run(args, out) -> int:
     from pathlib import Path
 
-    from qsplan.planner.task.task import load_task, task_paths
+    from qsplan.planner.pipeline.worker import start_early, stop_early
 
-    bundled = task_paths()
-    path = bundled[args.task] if args.task in bundled and not Path(args.task).exists() else args.task
-    return run_task(load_task(path), args, out, inputs=(path,))
+    start_early(plots_asked(args))  # the drawing process loads matplotlib while this one loads the planner
+    try:
+        from qsplan.planner.task.task import load_task, task_paths
+
+        bundled = task_paths()
+        path = bundled[args.task] if args.task in bundled and not Path(args.task).exists() else args.task
+        return run_task(load_task(path), args, out, inputs=(path,))
+    finally:
+        stop_early()

@@ -10,9 +10,12 @@ inside DIR (:func:`qsplan.planner.export.files.staging_dir`) ``plan.csv`` and ``
 (:func:`qsplan.planner.export.plan_files.export_plan`), ``certificate.json``: the exported file
 certified row by row from the task alone (:func:`qsplan.planner.certify.certify.certify_plan`),
 ``replay.json``: the exported file re-simulated (:func:`qsplan.planner.replay.replay.replay_plan`)
-at ``verify`` friction vectors of the interval, ``scene.xml`` (the task's scene for MuJoCo), and the operator
-plots with the plan card (:func:`qsplan.planner.plotting.plan.plan_figures`) and the animation
-(``plan_animation.gif`` and ``.html``; a failure: ``failure.png``).  Only then are the files published into DIR,
+at ``verify`` friction vectors of the interval, ``scene.xml`` (the task's scene for MuJoCo), and the plots: by
+default the plan card (:func:`qsplan.planner.plotting.card.plan_card`), with ``plots="all"`` the other plots and the
+animation too (``plan_animation.gif`` and ``.html``), drawn meanwhile in a second process that also re-simulates
+the plan when it is free first (:class:`qsplan.planner.pipeline.worker.Worker`: a figure it could not draw is said, in
+:attr:`PlanRun.undrawn`, and the certified plan published without it; a failure: ``failure.png``, drawn here).
+Only then are the files published into DIR,
 by renames, the plan files last (:func:`qsplan.planner.export.manifest.publish_outputs`): a plan
 file never appears in DIR before it is certified, and a run interrupted at any point (Ctrl-C
 while certifying included) leaves no plan of its own there.  Outputs are recorded in
@@ -37,12 +40,14 @@ from qsplan.mechanics.errors import QsplanError
 from qsplan.planner.export.files import (atomic_write, check_out_dir, check_output_path, check_outputs, locked_out_dir,
                                          staging_dir)  # fmt: skip
 from qsplan.planner.export.manifest import MANIFEST, own_outputs, publish_outputs
+from qsplan.planner.pipeline.worker import ANIMATION_FILES, PLAN_PLOTS, Worker, plot_choice, plot_files
 from qsplan.planner.plan.failure import GoalReport
 from qsplan.planner.plan.results import Plan, PlanFailure
 from qsplan.planner.plan.scripted import DEFAULT_OPTIONS, plan_task
 from qsplan.planner.task.goal import GoalNotServedError
 
-__all__ = ["ANIMATION_FILES", "FAILURE_FILES", "PLAN_FILES", "PLAN_PLOTS", "CertificationReport", "PlanRun", "plan_outputs", "run_plan"]
+__all__ = ["ANIMATION_FILES", "FAILURE_FILES", "PLAN_FILES", "PLAN_PLOTS", "CertificationReport", "PlanRun", "plan_outputs",
+           "run_plan"]
 
 #: Files :func:`run_plan` writes into its directory (``replay.json`` only when ``verify`` > 0; ``scene.xml``: the
 #: task's scene for MuJoCo).
@@ -80,13 +85,6 @@ class CertificationReport:
         return {"kind": "certification", "planner_status": CERTIFICATE_REFUSED, "message": self.message,
                 "certificate": self.certificate.to_dict()}  # fmt: skip
 
-#: The animation it writes with the plots (:func:`qsplan.planner.plotting.animation.plan_animation`): a GIF and a
-#: self-contained HTML page with a slider.
-ANIMATION_FILES = ("plan_animation.gif", "plan_animation.html")
-
-#: Plots it writes (``<name>.png``) unless ``plots=False``; ``plan_card`` is the one page for the operator.
-PLAN_PLOTS = ("plan_bands", "mode_timeline", "hand_snapshots", "plan_card")
-
 
 @dataclass(frozen=True, slots=True, eq=False)
 class PlanRun:
@@ -103,6 +101,9 @@ class PlanRun:
     certificate : qsplan.planner.certify.certify.Certificate
         The exported plan checked row by row from the task alone (always certified: a plan
         that is not is never returned).
+    undrawn : tuple of (str, str)
+        Each plot asked for but not drawn (an error while drawing it), with the reason; the plan and every other
+        output published all the same.
     """
 
     plan: Plan
@@ -110,6 +111,7 @@ class PlanRun:
     files: tuple
     replays: tuple
     certificate: object = None
+    undrawn: tuple = ()
 
     @property
     def followed(self) -> bool:
@@ -117,15 +119,15 @@ class PlanRun:
         return all(r.followed for r in self.replays)
 
 
-def plan_outputs(out_dir, plots: bool = True) -> list:
-    """The paths :func:`run_plan` may write into ``out_dir`` (checked before planning)."""
+def plan_outputs(out_dir, plots=True) -> list:
+    """The paths :func:`run_plan` may write into ``out_dir`` (checked before planning) with ``plots`` (as there;
+    True: every plot)."""
     out = Path(out_dir)
-    return [out / f for f in PLAN_FILES] + ([out / f"{n}.png" for n in PLAN_PLOTS] + [out / f for f in ANIMATION_FILES]
-                                            if plots else [])  # fmt: skip
+    return [out / f for f in PLAN_FILES] + [out / f for f in plot_files(plots)]
 
 
 def run_plan(task, out_dir, *, seed: int = 1, planner: str = "RRTConnect", time_limit: float | None = None,
-             verify: int = 3, force: bool = False, plots: bool = True, progress=None,
+             verify: int = 3, force: bool = False, plots="card", progress=None,
              sequence_planner: str = "widest", inputs=()) -> PlanRun:  # fmt: skip
     """Plan ``task``, export it into ``out_dir``, draw it and re-simulate the exported file.
 
@@ -150,9 +152,11 @@ def run_plan(task, out_dir, *, seed: int = 1, planner: str = "RRTConnect", time_
         run publishes, so the directory never mixes two runs.  Without it, outputs an earlier run wrote and
         nobody changed since (recorded in ``.qsplan-outputs.json``: :mod:`qsplan.planner.export.manifest`)
         are replaced all the same, and any other existing output is refused.
-    plots : bool
-        Draw ``plan_card.png`` (:func:`qsplan.planner.plotting.card.plan_card`), ``plan_bands.png``,
-        ``mode_timeline.png`` and ``hand_snapshots.png``.
+    plots : {"card", "all", "none"} or bool
+        ``"card"`` (default): draw ``plan_card.png`` (:func:`qsplan.planner.plotting.card.plan_card`); ``"all"`` (or
+        True): also ``plan_bands.png``, ``mode_timeline.png``, ``hand_snapshots.png`` and the animation
+        (:data:`ANIMATION_FILES`); ``"none"`` (or False): no plot.  Drawn in a second process while the plan is
+        certified (:class:`qsplan.planner.pipeline.worker.Worker`).
     progress : callable, optional
         ``progress(line)`` for progress messages.
     inputs : sequence of paths
@@ -161,7 +165,8 @@ def run_plan(task, out_dir, *, seed: int = 1, planner: str = "RRTConnect", time_
     Returns
     -------
     PlanRun
-        Check :attr:`PlanRun.followed`: False when a re-simulation left the planned modes.
+        Check :attr:`PlanRun.followed`: False when a re-simulation left the planned modes; and
+        :attr:`PlanRun.undrawn`: the plots that could not be drawn.
 
     Raises
     ------
@@ -179,39 +184,53 @@ def run_plan(task, out_dir, *, seed: int = 1, planner: str = "RRTConnect", time_
         raise QsplanError(f"time_limit: expected a positive number of seconds; got {time_limit}")
     progress = progress or (lambda line: None)
     options = replace(DEFAULT_OPTIONS, seed=seed, planner=planner, time_limit=limit)
+    which = plot_choice(plots)
+    draws = which != "none"
     out = check_out_dir(out_dir)
-    with locked_out_dir(out, inputs) as out, staging_dir(out) as stage:
-        _check_outputs(out, plots, force, inputs)  # before planning: nothing is planned that cannot be written
-
-        def publish(names):  # checked again: the directory is ours, but a user may have written into it since
-            return publish_outputs(out, stage, names, _check_outputs(out, plots, force, inputs), last=PLAN_DATA)
-
-        what = f"goal {task.goal.describe()}" if task.goal is not None else f"{len(task.waypoints)} in-contact segments"
-        progress(f"task {task.name!r}: {what}, mu in {list(task.mu_range)}, "
-                 f"torque resolution {task.torque_resolution:g} N m")  # fmt: skip
+    # the second process first: it imports matplotlib while the plan is searched, and holds no descriptor of the lock
+    with Worker(which) as worker, locked_out_dir(out, inputs) as out, staging_dir(out) as stage:
         try:
-            plan = plan_task(task, options, progress, sequence_planner=sequence_planner)
-        except (PlanFailure, GoalNotServedError) as exc:  # every failure writes its report (and draws it)
-            report = exc.report if isinstance(exc, PlanFailure) else GoalReport.from_error(exc)
-            raise PlanFailure(report, report_path=publish(_failure_files(task, report, stage, plots))[0]) from None
-        from qsplan.planner.export.plan_files import export_plan
+            _check_outputs(out, which, force, inputs)  # before planning: nothing is planned that cannot be written
 
-        staged = [p.name for p in export_plan(plan, stage, force=True)]
-        certificate = _certify(plan, out, stage, progress)
-        staged.append("certificate.json")
-        if not certificate.ok:  # never published where it looks like a plan
-            report = CertificationReport(certificate)
-            names = ["certificate.json", *_failure_files(task, report, stage, plots)]
-            raise PlanFailure(report, report_path=publish(names)[1])
-        replays = _verify(plan, stage / "plan.csv", int(verify), seed, progress)
-        if replays:
-            atomic_write(stage / "replay.json", json.dumps([r.as_dict() for r in replays], indent=1))
-            staged.append("replay.json")
-        staged.append(_scene(plan, stage))
-        if plots:  # after the re-simulation: the plan card states its verdict
-            staged += _draw(plan, certificate, replays, stage, progress)
-        files = publish(staged)
-    return PlanRun(plan, out, tuple(str(p) for p in files), tuple(replays), certificate)
+            def publish(names):  # checked again: the directory is ours, but a user may have written into it since
+                return publish_outputs(out, stage, names, _check_outputs(out, which, force, inputs), last=PLAN_DATA)
+
+            what = f"goal {task.goal.describe()}" if task.goal is not None else f"{len(task.waypoints)} in-contact segments"
+            progress(f"task {task.name!r}: {what}, mu in {list(task.mu_range)}, "
+                     f"torque resolution {task.torque_resolution:g} N m")  # fmt: skip
+            try:
+                plan = plan_task(task, options, progress, sequence_planner=sequence_planner)
+            except (PlanFailure, GoalNotServedError) as exc:  # every failure writes its report (and draws it)
+                worker.stop()
+                report = exc.report if isinstance(exc, PlanFailure) else GoalReport.from_error(exc)
+                raise PlanFailure(report, report_path=publish(_failure_files(task, report, stage, draws))[0]) from None
+            from qsplan.planner.export.plan_files import export_plan
+
+            staged = [p.name for p in export_plan(plan, stage, force=True)]
+            worker.start(plan, stage, int(verify), seed)  # meanwhile: everything but the card's verdict line
+            if draws:
+                progress(f"drawing {'the plan card' if which == 'card' else 'the plots and the animation'} "
+                         f"{'in a second process, meanwhile' if worker.in_parallel else 'once certified'}")
+            certificate = _certify(plan, out, stage, progress)
+            staged.append("certificate.json")
+            if not certificate.ok:  # never published where it looks like a plan
+                worker.stop()
+                report = CertificationReport(certificate)
+                names = ["certificate.json", *_failure_files(task, report, stage, draws)]
+                raise PlanFailure(report, report_path=publish(names)[1])
+            replays = worker.replays(progress)
+            if replays:
+                atomic_write(stage / "replay.json", json.dumps([r.as_dict() for r in replays], indent=1))
+                staged.append("replay.json")
+            staged.append(_scene(plan, stage))
+            undrawn = []
+            if draws:  # the plan card states the verdict
+                drawn, undrawn = _draw(worker, certificate, replays, progress)
+                staged += drawn
+            files = publish(staged)
+        finally:
+            worker.stop()  # before the staging directory is removed: nothing writes into it any more
+    return PlanRun(plan, out, tuple(str(p) for p in files), tuple(replays), certificate, tuple(undrawn))
 
 
 def _failure_files(task, report, stage, plots: bool) -> list:
@@ -257,23 +276,14 @@ def _check_outputs(out, plots, force, inputs) -> list:
     return names if force else [n for n in names if n in own]
 
 
-def _draw(plan, certificate, replays, stage, progress) -> list:
-    """Draw the plots into ``stage``; returns their file names."""
-    from qsplan.planner.plotting.card import CARD_DPI
-    from qsplan.planner.plotting.plan import plan_figures
-    from qsplan.planner.plotting.style import save_figure
-
-    progress("drawing the plots")
-    names = []
-    for name, fig in plan_figures(plan, certificate, replays).items():
-        card = name == "plan_card"  # an A4 page: kept at its size
-        save_figure(fig, stage / f"{name}.png", option="out_dir", dpi=CARD_DPI if card else 110, tight=not card)
-        names.append(f"{name}.png")
-    from qsplan.planner.plotting.animation import plan_animation
-
-    progress("drawing the animation")
-    plan_animation(plan, stage / ANIMATION_FILES[0], stage / ANIMATION_FILES[1])
-    return names + list(ANIMATION_FILES)
+def _draw(worker, certificate, replays, progress) -> tuple:
+    """The plots drawn (:meth:`qsplan.planner.pipeline.worker.Worker.finish`), the plan card with the verdict of
+    ``certificate`` and ``replays``: ``(file names, undrawn)``, each plot not drawn said in a progress line."""
+    progress("finishing the plots")
+    drawn, undrawn = worker.finish(certificate, [r.followed for r in replays])
+    for name, why in undrawn:
+        progress(f"{name} not drawn ({why}); the certified plan is published without it")
+    return drawn, undrawn
 
 
 def _certify(plan, out, stage, progress):
@@ -288,18 +298,3 @@ def _certify(plan, out, stage, progress):
     atomic_write(stage / "certificate.json", json.dumps(certificate.to_dict(), indent=1))
     progress(certificate.summary())
     return certificate
-
-
-def _verify(plan, csv_path, n, seed, progress) -> list:
-    """Re-simulate the exported file at ``n`` friction vectors of the task's interval."""
-    from qsplan.planner.export.plan_files import read_plan_csv
-    from qsplan.planner.replay.replay import friction_samples, replay_plan
-
-    mus = friction_samples(plan.task.mu_range, n, seed, shared=plan.task.shared_mu,
-                           n_contacts=plan.task.formation.n_contacts)
-    columns = read_plan_csv(csv_path)
-    out, scenes = [], {}  # the scenes along the plan do not depend on friction: built once for all replays
-    for mu in mus:
-        progress(f"re-simulating the exported plan at mu = {[round(float(m), 4) for m in mu]}")
-        out.append(replay_plan(columns, plan.task.hand, mu, scenes=scenes, formation=plan.task.formation))
-    return out

@@ -21,10 +21,10 @@ never velocity-controlled at once share a panel).  The legend lists what is draw
 from __future__ import annotations
 
 import textwrap
+from dataclasses import dataclass
 
 import numpy as np
 
-from qsplan.planner.certify.scope import SCOPE_SHORT
 from qsplan.planner.plan.sampling import tick_times
 from qsplan.planner.plotting.hands import plan_snapshots, pivot_vertex, state_words
 from qsplan.planner.plotting.plan_panels import (
@@ -47,9 +47,10 @@ from qsplan.planner.plotting.plan_panels import (
     torque_scale,
 )
 from qsplan.planner.plotting.style import A4_PORTRAIT, FONT, NARROWEST, joint_colour, text_width, torque_text
+from qsplan.planner.plotting.verdict import expected_verdict, verdict
 
 __all__ = ["CARD_DPI", "LEGEND_LABEL_CHARS", "MAX_SNAPSHOTS", "MIN_SNAPSHOT_WIDTH", "VELOCITY_RATE", "VELOCITY_TICKS",
-           "card_snapshots", "phase_rows", "plan_card", "verdict"]
+           "CardDraft", "card_snapshots", "draft_card", "finish_card", "phase_rows", "plan_card", "verdict", "warm_up"]
 
 #: Resolution (dots per inch) the card is written at: 150 keeps 7.5 pt text sharp on an A4 print.
 CARD_DPI = 150
@@ -83,39 +84,9 @@ _SNAPSHOT_TITLE, _SNAPSHOT_ROW_WIDTH, _SNAPSHOT_MAX_WIDTH = 0.4, 7.9, 2.0
 _LEGEND_LINE, _BODY_MARGIN = 0.16, 0.6
 
 _OK, _BAD = "#1a7f37", "#b42318"
+#: Characters per line of the verdict in the header (bold, 9 pt: the page's width).
+_VERDICT_CHARS = 100
 _COLUMNS = ("phase", "t (s)", "what the hand does", "commanded", "command, its direction", "slack", "narrowest band")
-
-
-def verdict(certificate=None, replays=()) -> tuple:
-    """``(line, ok)``: the certificate and the re-simulations in one line, and whether both passed.
-
-    Parameters
-    ----------
-    certificate : qsplan.planner.certify.certify.Certificate, optional
-    replays : sequence of qsplan.planner.replay.replay.Replay
-    """
-    parts, ok = [], True
-    if certificate is None:
-        parts.append("not certified (no certificate)")
-        ok = False
-    else:
-        pts = max((r.friction_points for r in certificate.rows), default=0)
-        what = f"{len(certificate.rows)} rows checked from the task alone, {pts} friction vectors per contact row"
-        if certificate.ok:
-            parts.append(f"CERTIFIED ({what}, no violation): {SCOPE_SHORT}")
-        else:
-            parts.append(f"NOT CERTIFIED ({len(certificate.violations)} violations; {what})")
-            ok = False
-    if replays:
-        left = sum(not r.followed for r in replays)
-        n = len(replays)
-        parts.append(f"re-simulated at {n} friction vector{'s' if n != 1 else ''}: "
-                     + ("every run followed the planned modes" if not left else f"{left} LEFT the planned modes"))
-        ok &= not left
-    else:
-        parts.append("not re-simulated")
-        ok = False
-    return "; ".join(parts), ok
 
 
 def card_snapshots(plan, limit: int = MAX_SNAPSHOTS) -> list:
@@ -263,15 +234,18 @@ def _facts(plan) -> str:
     return text
 
 
-def _header(head, lines, xs) -> None:
-    """The header's ``lines`` (:func:`_header_lines`) top down, in points, so that no two lines meet."""
-    y = -4.0
+def _header(head, lines, xs) -> list:
+    """The header's ``lines`` (:func:`_header_lines`) top down, in points, so that no two lines meet; the text
+    artists, in order."""
+    y, out = -4.0, []
     for i, (text, size, colour, bold) in enumerate(lines):
         cells = text if isinstance(text, tuple) else (text,)  # a table row: cells at the measured columns
         for x, cell in zip(xs if isinstance(text, tuple) else (0.0,), cells):
-            head.text(0.01, 1.0, cell, fontsize=size, color=colour, va="top", weight="bold" if bold else "normal",
-                      linespacing=1.15, transform=_offset(head, y, x))  # fmt: skip
+            out.append(head.text(0.01, 1.0, cell, fontsize=size, color=colour, va="top",
+                                 weight="bold" if bold else "normal", linespacing=1.15,
+                                 transform=_offset(head, y, x)))  # fmt: skip
         y -= _height(text, size) + (4 if i == 0 else 0)
+    return out
 
 
 def _height(text, size) -> float:
@@ -297,8 +271,13 @@ def _header_lines(plan, verdict_line, ok) -> tuple:
             text = f"phase {cells[0]} ({cells[1]} s): {cells[2]}; "
             text += "; ".join(f"{h} {v}" for h, v in zip(_COLUMNS[3:], cells[3:]))
             lines += [(s, size, "k", False) for s in textwrap.wrap(text, 130)]
-    lines += [(s, FONT["label"], _OK if ok else _BAD, True) for s in textwrap.wrap(verdict_line, 100)]
+    lines += [(s, FONT["label"], _OK if ok else _BAD, True) for s in _verdict_lines(verdict_line)]
     return lines, xs
+
+
+def _verdict_lines(line) -> list:
+    """The verdict ``line`` as the header's lines (the last ones)."""
+    return textwrap.wrap(line, _VERDICT_CHARS)
 
 
 def _offset(sub, points, x_points=0.0):
@@ -445,7 +424,7 @@ def _legend_handles(plan, drawn, torque_joints) -> list:
     return handles + [h for key, h in entries if key in drawn]
 
 
-def plan_card(plan, certificate=None, replays=(), snapshots: int = MAX_SNAPSHOTS):
+def plan_card(plan, certificate=None, replays=(), snapshots: int = MAX_SNAPSHOTS, stated=None):
     """The plan card of ``plan`` as an A4 portrait figure.
 
     Parameters
@@ -457,11 +436,21 @@ def plan_card(plan, certificate=None, replays=(), snapshots: int = MAX_SNAPSHOTS
         The exported plan re-simulated.
     snapshots : int
         Hand snapshots, at most (at least 2: the start and the end).
+    stated : tuple, optional
+        The verdict ``(line, ok)`` as :func:`~qsplan.planner.plotting.verdict.verdict` gives it (``certificate`` and
+        ``replays`` are then not read).
 
     Returns
     -------
     matplotlib.figure.Figure
+        Laid out once and kept so (its layout engine ``"none"`` after it): saved at any dpi without another layout
+        pass, the labels where :func:`~qsplan.planner.plotting.plan_panels.place_labels` put them.
     """
+    return _card(plan, stated or verdict(certificate, replays), snapshots)[0]
+
+
+def _card(plan, stated, snapshots) -> tuple:
+    """``(figure, the verdict's text artists)`` of :func:`plan_card` with the verdict ``stated`` = ``(line, ok)``."""
     from matplotlib.figure import Figure
 
     from qsplan.hands.interface import joint_names, joint_units
@@ -473,11 +462,11 @@ def plan_card(plan, certificate=None, replays=(), snapshots: int = MAX_SNAPSHOTS
     torque_joints = [j for j in names if any(is_contact(p) and p.effort_joint == j for p in plan.phases)]
     velocity_joints = [j for k, j in enumerate(names) if any(np.isfinite(p.qd[:, k]).any() for p in plan.phases)]
     velocity_panels = _velocity_panels(plan, velocity_joints, units)
-    fig = Figure(figsize=A4_PORTRAIT, layout="constrained")
-    lines, xs = _header_lines(plan, *verdict(certificate, replays))
+    fig = Figure(figsize=A4_PORTRAIT, layout="constrained", dpi=CARD_DPI)  # laid out as it is written
+    lines, xs = _header_lines(plan, *stated)
     head_in = (8.0 + sum(_height(text, size) for text, size, _, _ in lines) + 4.0) / 72.0
     head, body = fig.subfigures(2, 1, height_ratios=[head_in, A4_PORTRAIT[1] - head_in])
-    _header(head, lines, xs)
+    texts = _header(head, lines, xs)
     res = plan.task.torque_resolution
     panels = [(joint, segs, len(groups)) for joint in torque_joints
               for groups in [scale_groups([p for p in plan.phases if is_contact(p) and p.effort_joint == joint], res)]
@@ -525,5 +514,94 @@ def plan_card(plan, certificate=None, replays=(), snapshots: int = MAX_SNAPSHOTS
     handles = _legend_handles(plan, drawn, torque_joints)
     ncol = 3 if max(len(h.get_label()) for h in handles) <= LEGEND_LABEL_CHARS else 2
     body.legend(handles=handles, loc="outside lower center", ncol=ncol, fontsize=FONT["legend"], frameon=False)
-    place_labels(fig)  # once the layout is known: the marks' labels where they cover no data
-    return fig
+    if not place_labels(fig):  # once the layout is known: the marks' labels where they cover no data
+        fig.draw_without_rendering()  # no label to place: laid out all the same
+    fig.set_layout_engine("none")  # one layout pass: drawn as measured at any dpi
+    return fig, texts[len(texts) - len(_verdict_lines(stated[0])):]
+
+
+def warm_up() -> None:
+    """Load what the first card of a process would load while drawing (matplotlib's figure and axes modules, the
+    fonts, the mathtext parser) by drawing a small figure with the same kinds of artists: a drawing process does this
+    while the plan is searched, and drafts its card at full speed once the plan comes."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+    from matplotlib.lines import Line2D
+
+    fig = Figure(figsize=(2.0, 2.0), layout="constrained", dpi=20)
+    head, body = fig.subfigures(2, 1)
+    head.text(0.0, 1.0, "qsplan", weight="bold", fontsize=FONT["label"], va="top")
+    ax = body.add_subplot()
+    ax.plot([0.0, 1.0], [1.0, 2.0], marker="^", mfc="white")
+    ax.fill_between([0.0, 1.0], [0.0, 0.0], [1.0, 1.0], alpha=0.2)
+    ax.annotate("$\\tau$", (0.5, 1.5), xytext=(4, 0), textcoords="offset points", fontsize=FONT["note"],
+                bbox={"boxstyle": "round,pad=0.15", "fc": "white", "ec": "none"}, arrowprops={"arrowstyle": "-"})
+    ax.set_ylabel("$\\dot q_{left}$ (rad/s)", fontsize=FONT["label"])
+    ax.set_title("qsplan", fontsize=FONT["label"], loc="left")
+    body.legend(handles=[Line2D([], [], marker="$\\updownarrow$", ls="none", label="band")], loc="outside lower center")
+    text_width("qsplan", FONT["note"], bold=True)
+    text_width("qsplan", FONT["note"])
+    FigureCanvasAgg(fig).draw()
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class CardDraft:
+    """A plan card drawn at :data:`CARD_DPI` but for its verdict (:func:`draft_card`; :func:`finish_card` writes it).
+
+    Attributes
+    ----------
+    plan : qsplan.planner.plan.results.Plan
+    snapshots : int
+    figure : matplotlib.figure.Figure
+        Drawn on its Agg canvas, the verdict's lines hidden.
+    verdict : tuple of matplotlib.text.Text
+        The verdict's lines, in order.
+    """
+
+    plan: object
+    snapshots: int
+    figure: object
+    verdict: tuple
+
+
+def draft_card(plan, replays: int, snapshots: int = MAX_SNAPSHOTS) -> CardDraft:
+    """The plan card drawn before its verdict is known, at :data:`CARD_DPI`, with room for the verdict
+    :func:`expected_verdict` wraps to (a plan certified and re-simulated ``replays`` times without fault); the
+    verdict's lines are left blank for :func:`finish_card`.
+
+    The card's only part that depends on the certificate and the re-simulations is that line: the rest is drawn
+    while they run (``qsplan plan``'s drawing process).
+    """
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+
+    fig, texts = _card(plan, expected_verdict(plan, replays), snapshots)
+    for t in texts:
+        t.set_visible(False)
+    canvas = fig.canvas if isinstance(fig.canvas, FigureCanvasAgg) else FigureCanvasAgg(fig)
+    canvas.draw()  # at CARD_DPI, the figure's
+    return CardDraft(plan, int(snapshots), fig, tuple(texts))
+
+
+def finish_card(draft: CardDraft, stated, path, option: str = "path", force: bool = True, inputs=()) -> None:
+    """Write the card of ``draft`` (:func:`draft_card`) with its verdict ``stated`` = ``(line, ok)``
+    (:func:`~qsplan.planner.plotting.verdict.verdict`) to the PNG ``path``, as
+    :func:`~qsplan.planner.plotting.style.save_figure` writes :func:`plan_card`'s.
+
+    When the verdict takes as many lines as the draft left for it, only those lines are drawn, onto the draft's
+    pixels (the layout is the same); else the card is drawn again whole with it.
+    """
+    from qsplan.planner.plotting.style import save_figure, save_rendered
+
+    line, ok = stated
+    lines = _verdict_lines(line)
+    if len(lines) != len(draft.verdict):
+        fig = plan_card(draft.plan, stated=stated, snapshots=draft.snapshots)
+        save_figure(fig, path, option=option, dpi=CARD_DPI, force=force, inputs=inputs, tight=False)
+        return
+    renderer = draft.figure.canvas.get_renderer()
+    for text, s in zip(draft.verdict, lines):
+        text.set_text(s)
+        text.set_color(_OK if ok else _BAD)
+        text.set_visible(True)
+        text.draw(renderer)
+    save_rendered(draft.figure, path, option=option, force=force, inputs=inputs)

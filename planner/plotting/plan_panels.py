@@ -347,62 +347,86 @@ def _data_shapes(ax):
 
 
 def _hits(box, shapes) -> int:
-    """How many data items of ``shapes`` (:func:`_data_shapes`) the display box ``box`` covers."""
+    """How many data items of ``shapes`` (:func:`_data_shapes`) the display box ``box`` = ``(x0, y0, x1, y1)``
+    covers."""
+    from matplotlib.transforms import Bbox
+
+    x0, y0, x1, y1 = box
     lines, extents, points = shapes
-    near = np.flatnonzero((extents[:, 0] <= box.x1) & (extents[:, 2] >= box.x0) & (extents[:, 1] <= box.y1)
-                          & (extents[:, 3] >= box.y0))  # fmt: skip
-    n = sum(lines[k].intersects_bbox(box, filled=False) for k in near)
+    near = np.flatnonzero((extents[:, 0] <= x1) & (extents[:, 2] >= x0) & (extents[:, 1] <= y1) & (extents[:, 3] >= y0))
+    n = 0
+    if near.size:
+        bbox = Bbox.from_extents(x0, y0, x1, y1)
+        n = sum(lines[k].intersects_bbox(bbox, filled=False) for k in near)
     r = points[:, 2]
-    n += int(np.sum((points[:, 0] >= box.x0 - r) & (points[:, 0] <= box.x1 + r) & (points[:, 1] >= box.y0 - r)
-                    & (points[:, 1] <= box.y1 + r)))  # fmt: skip
+    n += int(np.sum((points[:, 0] >= x0 - r) & (points[:, 0] <= x1 + r) & (points[:, 1] >= y0 - r)
+                    & (points[:, 1] <= y1 + r)))  # fmt: skip
     return int(n)
 
 
-def place_labels(fig) -> None:
+def _extents(bbox) -> tuple:
+    """``(x0, y0, x1, y1)`` of a matplotlib Bbox, the smaller coordinate first."""
+    (ax, ay), (bx, by) = bbox.get_points()
+    return min(ax, bx), min(ay, by), max(ax, bx), max(ay, by)
+
+
+def _overlap(a, b) -> bool:
+    """Whether the boxes ``a`` and ``b`` (:func:`_extents`) meet (touching counts, as ``Bbox.overlaps``)."""
+    return a[0] <= b[2] and b[0] <= a[2] and a[1] <= b[3] and b[1] <= a[3]
+
+
+def place_labels(fig) -> bool:
     """Move every movable label (:data:`MOVABLE`) of ``fig`` where it covers no data line or mark and no other text,
     nearest its mark first: beside it, then above or below it, then farther along the time axis (a thin leader to its
     mark).
 
     Lays ``fig`` out first (constrained layout): the labels are placed in display pixels of the final page, and are
-    left out of the layout so that it stays as measured.  Where no place is free, the one covering least.
+    left out of the layout so that it stays as measured.  Where no place is free, the one covering least.  Returns
+    whether it laid ``fig`` out (False: no label to place, nothing done).
     """
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.text import Text
-    from matplotlib.transforms import Bbox
 
     def axes(f):  # every axes of the figure and its subfigures
         return list(f.axes) + [ax for sub in f.subfigs for ax in axes(sub)]
 
     labels = [t for ax in axes(fig) for t in ax.texts if t.get_gid() == MOVABLE and t.get_visible()]
     if not labels:
-        return
+        return False
     canvas = fig.canvas if isinstance(fig.canvas, FigureCanvasAgg) else FigureCanvasAgg(fig)
-    fig.draw_without_rendering()
     renderer = canvas.get_renderer()
+    if fig.get_layout_engine() is not None:  # the layout a draw would do, without drawing (the axes' limits, titles
+        fig.get_layout_engine().execute(fig)  # and aspect settled on the way: their tight boxes are measured)
     taken = {}  # per axes: the boxes of its texts and marks' arrows (pixels)
     for ann in labels:
         ax = ann.axes
         if ax not in taken:
-            boxes = [t.get_window_extent(renderer) for t in ax.texts if t.get_gid() != MOVABLE and t.get_text().strip()]
-            boxes += [t.arrow_patch.get_window_extent(renderer) for t in ax.texts
+            for t in ax.texts:  # an annotation's text and arrow where a draw would put them
+                if hasattr(t, "update_positions") and t.get_gid() != MOVABLE:
+                    t.update_positions(renderer)
+            boxes = [_extents(t.get_window_extent(renderer)) for t in ax.texts
+                     if t.get_gid() != MOVABLE and t.get_text().strip()]  # fmt: skip
+            boxes += [_extents(t.arrow_patch.get_window_extent(renderer)) for t in ax.texts
                       if getattr(t, "arrow_patch", None) is not None and t.get_gid() != MOVABLE]  # fmt: skip
             taken[ax] = (boxes, _data_shapes(ax))
         boxes, shapes = taken[ax]
         frame = ax.get_window_extent(renderer)
-        anchor = ax.transData.transform(ann.xy)
+        fx0, fy0, fx1, fy1 = (float(v) for v in (frame.x0, frame.y0, frame.x1, frame.y1))
+        anchor = [float(v) for v in ax.transData.transform(ann.xy)]
         gap, side = abs(float(ann.xyann[0])), 1.0 if ann.get_horizontalalignment() == "left" else -1.0
         ann.update_positions(renderer)
         size = Text.get_window_extent(ann, renderer)  # the label's box: the same wherever it goes
         w, h, px = size.width, size.height, fig.dpi / 72.0
         best = None
-        for dx, dy, ha, va in _label_offsets(gap, side):
+        for dx, dy, ha, va in _label_offsets(gap, side):  # in pixels, as floats: ~1500 boxes tried per card
             x0 = anchor[0] + dx * px - {"left": 0.0, "right": w, "center": 0.5 * w}[ha]
             y0 = anchor[1] + dy * px - {"bottom": 0.0, "top": h, "center": 0.5 * h}[va]
-            box = Bbox.from_extents(x0, y0, x0 + w, y0 + h).padded(_LABEL_PAD)
-            if not (frame.x0 <= box.x0 and box.x1 <= frame.x1 and frame.y0 <= box.y0 and box.y1 <= frame.y1):
+            box = (x0 - _LABEL_PAD, y0 - _LABEL_PAD, (x0 + w) + _LABEL_PAD, (y0 + h) + _LABEL_PAD)
+            if not (fx0 <= box[0] and box[2] <= fx1 and fy0 <= box[1] and box[3] <= fy1):
                 continue
-            reach = Bbox.union([box, Bbox.from_extents(*anchor, *anchor)])  # with its leader
-            cost = 4 * sum(b.overlaps(reach) for b in boxes) + _hits(box, shapes)
+            reach = (min(box[0], anchor[0]), min(box[1], anchor[1]), max(box[2], anchor[0]),
+                     max(box[3], anchor[1]))  # with its leader  # fmt: skip
+            cost = 4 * sum(_overlap(b, reach) for b in boxes) + _hits(box, shapes)
             if best is None or cost < best[0]:
                 best = (cost, dx, dy, ha, va, box, reach)
             if cost == 0:
@@ -415,6 +439,7 @@ def place_labels(fig) -> None:
         ann.set_verticalalignment(va)
         ann.arrow_patch.set_visible(abs(dy) > 0 or abs(dx) > gap)
         boxes.append(reach if ann.arrow_patch.get_visible() else box)
+    return True
 
 
 def _label_offsets(gap, side) -> list:

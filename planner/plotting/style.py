@@ -43,11 +43,13 @@ __all__ = [
     "finger_colour",
     "joint_colour",
     "legend_below",
+    "lay_out_once",
     "legend_right",
     "mode_set_colour",
     "new_axes",
     "plot_mu_slice",
     "save_figure",
+    "save_rendered",
     "step_colour",
     "text_width",
     "torque_text",
@@ -230,16 +232,53 @@ def save_figure(fig, path, option: str = "path", dpi: int = 110, force: bool = T
     """
     from pathlib import Path
 
+    fmt = Path(path).suffix.lstrip(".").lower() or "png"
+    meta = _png_metadata() if fmt == "png" else None
+    _write(path, lambda f: fig.savefig(f, format=fmt, dpi=dpi, bbox_inches="tight" if tight else None, metadata=meta),
+           option, force, inputs)
+
+
+def lay_out_once(fig, dpi: float) -> None:
+    """Lay ``fig`` out at ``dpi`` (its layout engine, once) and keep that layout: a figure saved with
+    ``bbox_inches="tight"`` is otherwise laid out twice more (once to measure its extent, once to draw), to the same
+    positions."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+
+    engine = fig.get_layout_engine()
+    if engine is None:
+        return
+    if not isinstance(fig.canvas, FigureCanvasAgg):
+        FigureCanvasAgg(fig)
+    fig.set_dpi(dpi)
+    engine.execute(fig)
+    fig.set_layout_engine("none")
+
+
+def save_rendered(fig, path, option: str = "path", force: bool = True, inputs=()) -> None:
+    """Write what ``fig``'s Agg canvas last drew (``canvas.draw()``, at the figure's dpi) to the PNG ``path``, as
+    :func:`save_figure` writes a PNG (``savefig``'s own last step), without drawing it again; the arguments as there.
+    """
+    from matplotlib.image import imsave
+
+    _write(path, lambda f: imsave(f, fig.canvas.buffer_rgba(), format="png", origin="upper", dpi=fig.dpi,
+                                  metadata=_png_metadata()), option, force, inputs)  # fmt: skip
+
+
+def _png_metadata() -> dict:
+    """The PNG text chunks qsplan writes: ``Software: qsplan <version>``."""
     from qsplan import __version__
+
+    return {"Software": f"qsplan {__version__}"}
+
+
+def _write(path, write, option, force, inputs) -> None:
+    """``write(file)`` into ``path`` by :func:`qsplan.planner.export.files.atomic_write` (binary); an OS error as a
+    :class:`~qsplan.mechanics.QsplanError` naming ``option``."""
     from qsplan.mechanics import QsplanError
     from qsplan.planner.export.files import atomic_write
 
-    fmt = Path(path).suffix.lstrip(".").lower() or "png"
-    meta = {"Software": f"qsplan {__version__}"} if fmt == "png" else None
     try:
-        atomic_write(path, lambda f: fig.savefig(f, format=fmt, dpi=dpi, bbox_inches="tight" if tight else None,
-                                                 metadata=meta),
-                     binary=True, force=force, inputs=inputs, field=option)  # fmt: skip
+        atomic_write(path, write, binary=True, force=force, inputs=inputs, field=option)
     except OSError as exc:
         raise QsplanError(f"{option}: cannot write {str(path)!r}: {exc.strerror or exc}") from None
 
