@@ -56,7 +56,6 @@ class ChainHand:
     mu: float
     vertex_order: tuple
     vertex_of_user: tuple
-    reorients = False  # :attr:`qsplan.hands.protocol.Hand.reorients` (a class constant, not a field)
 
     @property
     def manipulator(self):

@@ -137,13 +137,6 @@ class DescribedHand:
         return self.paper is not None
 
     @property
-    def reorients(self) -> bool:
-        """Whether the hand serves the formations beyond the palm edge (:mod:`qsplan.hands.reorient`: the flush
-        instant, the pivot) and every contact of a row is found in the polygons of its fingers' single links
-        (:mod:`qsplan.hands.found_contacts`): the paper's form."""
-        return self.paper is not None
-
-    @property
     def palm_range(self) -> tuple:
         """The workpiece x (m) over which its bottom edge lies on the palm's top: ``(lo, hi)``."""
         lo, hi = self.description.palm_top

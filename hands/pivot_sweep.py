@@ -24,7 +24,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from qsplan.hands.contact_sets import BODIES, ContactSet, body_ring, finger_link, locate_contacts
+from qsplan.hands.contact_sets import ContactSet, locate_contacts
+from qsplan.hands.found_contacts import polygon_contacts
 from qsplan.hands.formations import formation
 from qsplan.hands.reorient import PIVOT_FORMATION, THETA_RATE, paper_form, pivot_configurations, pivot_contacts, pivot_scene
 from qsplan.mechanics.errors import QsplanError, SceneError
@@ -103,26 +104,6 @@ class PivotSweep:
     bands: dict
     events: tuple
     seconds: dict
-
-
-def polygon_contacts(hand, pose, q, tol: float = CONTACT_TOL) -> list:
-    """The contacts the mechanics' polygon search (:func:`qsplan.mechanics.find_contacts`, the reference) finds
-    between the workpiece and the palm and each finger's last link at ``pose``, ``q``: FoundContact, body -1 for
-    the palm, else the link (:func:`qsplan.hands.contact_sets.finger_link`).
-
-    Raises
-    ------
-    SceneError
-        A body penetrating the workpiece deeper than ``tol`` (naming it), or a corner on a corner.
-    """
-    from shapely.geometry import Polygon
-
-    from qsplan.hands.workpiece import workpiece_world
-    from qsplan.mechanics.model.geometry import find_contacts
-
-    bodies = [(finger_link(hand, b), Polygon(body_ring(hand, b, q))) for b in BODIES]
-    names = {link: b for (link, _), b in zip(bodies, BODIES)}
-    return find_contacts(Polygon(workpiece_world(hand, pose)), bodies, tol=tol, body_names=names)
 
 
 def same_contacts(found: ContactSet, reference, tol: float = CONTACT_TOL) -> bool:

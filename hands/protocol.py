@@ -329,9 +329,6 @@ class Hand(Protocol):
         The hand's joint ranges (rad or m) and speeds (rad/s or m/s); None for the paper's hand given by its parameters.
     accelerated : bool
         Whether the paper's closed forms answer (decided once at construction).
-    reorients : bool
-        Whether the hand serves goals that turn the workpiece (formations beyond the palm edge) and any row's contacts
-        are found in its polygons (:mod:`qsplan.hands.found_contacts`); today the paper's form.
     """
 
     name: str
@@ -352,7 +349,6 @@ class Hand(Protocol):
     palm: np.ndarray
     own_limits: tuple | None
     accelerated: bool
-    reorients: bool
 
     def pose(self, x) -> np.ndarray:
         """Workpiece pose ``(x, rest_height, 0)`` (m, m, rad), shape (3,)."""

@@ -93,7 +93,6 @@ class TwoFingerHand:
     mu: float
     vertex_order: tuple | None = None
     vertex_of_user: tuple | None = None
-    reorients = True  # the paper's form: :attr:`qsplan.hands.protocol.Hand.reorients` (a class constant, not a field)
 
     @property
     def rest_height(self) -> float:

@@ -54,7 +54,6 @@ from qsplan.planner.certify.rows import (
     LIMIT_TOL,
     OVERLAP_DEPTH_TOL,
     SPEED_RTOL,
-    contact_checks,
     friction_points,
     joint_housings,
     limit_checks,
@@ -313,7 +312,6 @@ def certify_plan(plan, task, *, n_random: int = 8, seed: int = 0, force_margin: 
     verdict_info, slip, ends = [], None, {}  # slip: (row, phase, sliding velocities) of the last in-contact row
     scenes = {}  # in-contact rows' scenes: their bands recomputed in one batch per mode
     named = {}  # in-contact rows' contacts, as their mode letters follow them (the metadata's contact sets)
-    general = task.hand.reorients  # any formation: the row's contacts found in the polygons
     jobs, mode_at = [], {}  # batched: the rows' mode checks, solved together after the loop; where their answers go
     for k in range(n):
         mode = str(cols["mode"][k])
@@ -334,16 +332,13 @@ def certify_plan(plan, task, *, n_random: int = 8, seed: int = 0, force_margin: 
                 if k + 1 < n and str(cols["mode"][k + 1]) == "free" and phase[k + 1] == phase[k]:
                     found += free_path_checks(task, cols, k, roots)
         elif not any(kind == "input" for kind, _ in found):
-            judged = None
-            if general:  # any formation: the contacts the polygons show, in the canonical order
-                try:
-                    judged = judged_contacts(task, cols, k)
-                except QsplanError as exc:
-                    contact = [("contact", f"the row's contacts cannot be found: {exc}")]
-                else:
-                    contact = judged_contact_checks(task, cols, k, judged)
+            judged = None  # any formation: the contacts the polygons show, in the canonical order
+            try:
+                judged = judged_contacts(task, cols, k)
+            except QsplanError as exc:
+                contact = [("contact", f"the row's contacts cannot be found: {exc}")]
             else:
-                contact = contact_checks(task, cols, k, bodies)
+                contact = judged_contact_checks(task, cols, k, judged)
             found += contact
             if not contact:
                 named[k] = row_contact_names(task, cols, k, judged)

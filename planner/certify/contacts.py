@@ -12,8 +12,7 @@ Which contacts those are is decided here from the row's geometry alone:
 * a **hold row** (every letter ``R``, at rest, its phase not moving): every contact found; nothing moves, and the hold
   proof (:mod:`qsplan.mechanics.bands.hold`), not the mode check, decides it.
 
-A hand that reorients (:attr:`qsplan.hands.protocol.Hand.reorients`) is judged so; any other hand's rows keep the four
-contacts of the palm edge (:func:`qsplan.planner.certify.rows.contact_checks`).  Units SI.
+Every hand's rows are judged so, whatever the formation: one path.  Units SI.
 """
 
 from __future__ import annotations

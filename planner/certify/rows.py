@@ -31,7 +31,6 @@ __all__ = [
     "bodies_at",
     "body_overlaps",
     "overlap_checks",
-    "contact_checks",
     "limit_checks",
     "step_checks",
     "command_step_checks",
@@ -114,7 +113,7 @@ def joint_housings(hand) -> dict:
 def row_bodies(task, cols, k, roots=None) -> dict:
     """The bodies of row ``k`` as shapely geometry: ``{"polys": {name: Polygon}, "roots": {link: (carrier, disk)}}``.
 
-    Built once per row and passed to :func:`overlap_checks` and :func:`contact_checks`;
+    Built once per row and passed to :func:`overlap_checks` and :func:`rest_checks`;
     ``roots``: :func:`joint_housings` of the task's hand, when already built (a joint on a moving link gets its
     disk about its axis at the row's joint positions).
     """
@@ -201,29 +200,6 @@ def body_overlaps(task, bodies) -> list:
             out.append(("overlap", f"{_label(a)} / {_label(c)} overlap {inter.area * 1e6:.3g} mm^2, "
                                    f"{depth * 1e3:.3g} mm deep"))  # fmt: skip
     return out
-
-
-def contact_checks(task, cols, k, bodies=None) -> list:
-    """Check 3: every contact of the row's mode is present (palm:0, palm:1, left finger, right finger; a finger's
-    contact on any of its links).
-
-    ``bodies``: :func:`row_bodies` of the row, when already built.
-    """
-    from shapely.geometry import Point
-
-    from qsplan.hands.interface import finger_joint_names
-
-    polys = (row_bodies(task, cols, k) if bodies is None else bodies)["polys"]
-    mode = str(cols["mode"][k])
-    if len(mode) != 4 or set(mode) - set("RSB"):
-        return [("contact", f"mode {mode!r}: expected four letters of R, S, B (palm:0, palm:1, left, right)")]
-    V = np.asarray(polys["workpiece"].exterior.coords)[:-1]
-    left, right = (min(polys[n].distance(polys["workpiece"]) for n in names) for names in finger_joint_names(task.hand))
-    gaps = [("palm:0 (workpiece's bottom-left vertex on the palm)", Point(V[0]).distance(polys["palm"])),
-            ("palm:1 (workpiece's bottom-right vertex on the palm)", Point(V[1]).distance(polys["palm"])),
-            ("left finger on the workpiece", left), ("right finger on the workpiece", right)]  # fmt: skip
-    return [("contact", f"contact {name} of mode {mode} is missing: gap {gap * 1e3:.3g} mm")
-            for name, gap in gaps if gap > CONTACT_GAP_TOL]  # fmt: skip
 
 
 def limit_checks(task, cols, k) -> list:

@@ -194,15 +194,12 @@ def hold_checks(task, cols, scenes) -> tuple:
         tau = float(cols[f"tau_{e}"][k]) if f"tau_{e}" in cols else float("nan")
         if not np.isfinite(tau):
             continue  # no command: the torque check names it
-        scene = scenes[k]
-        if task.hand.reorients:  # any formation: every contact the polygons show (the reference search)
-            effort = np.array(names) == e
-            try:
-                scene = hold_scene(task.hand, row_pose(cols, k), row_q(cols, k, names), effort,
-                                   np.where(effort, tau, 0.0), method="generic")  # fmt: skip
-            except QsplanError as exc:
-                found.append((int(k), "hold", f"at rest, the row's contacts cannot be found: {exc}"))
-                continue
+        effort = np.array(names) == e  # every contact the polygons show (the reference search), made ones too
+        try:
+            scene = hold_scene(task.hand, row_pose(cols, k), row_q(cols, k, names), effort, np.where(effort, tau, 0.0))
+        except QsplanError as exc:
+            found.append((int(k), "hold", f"at rest, the row's contacts cannot be found: {exc}"))
+            continue
         proof = prove_hold(scene, torques=[tau], disturbance=task.disturbance)
         records.append({"row": int(k), "t_s": float(cols["t"][k]), "proved": bool(proof.proved),
                         "margin_N": float(proof.margin), "proof": HOLD_PROOF})  # fmt: skip

@@ -260,7 +260,7 @@ def plan_automatic(task, options=None, progress=None, planner: str = "widest", t
         Precomputed tables (benchmarks reuse them across planners).
     timed : bool
         Time-scale the plan (:func:`qsplan.planner.plan.timing.time_scale`); False: the quasistatic phases, for a
-        route that continues them (:mod:`qsplan.planner.plan.reorient`).
+        route that continues them (:mod:`qsplan.planner.plan.turning`).
 
     Returns
     -------

@@ -61,7 +61,7 @@ class ContactSegmentPlan:
     kind : str
         ``"slide"`` (the workpiece slides on its palm edge, the paper's Fig. 9), ``"hold"`` (nothing moves while the
         effort joint's torque ramps: a certified hold) or ``"pivot"`` (the workpiece turns on a palm vertex), the
-        phase kinds of :mod:`qsplan.planner.plan.reorient`.
+        phase kinds of :mod:`qsplan.planner.plan.turning`.
     pose : ndarray, shape (n, 3), or None
         The workpiece's pose ``(x, y, theta)`` at each row (m, m, rad); None: on its palm edge at ``x``.
     row_modes : tuple of str, or None

@@ -81,7 +81,7 @@ class RegraspStep:
 
 @dataclass(frozen=True, slots=True)
 class HoldStep:
-    """A certified hold of the route (:mod:`qsplan.planner.plan.reorient`): nothing moves at workpiece ``x`` (m) and
+    """A certified hold of the route (:mod:`qsplan.planner.plan.turning`): nothing moves at workpiece ``x`` (m) and
     angle ``theta`` (rad) while ``effort_joint``'s torque ramps ``torque_from`` -> ``torque_to`` inside the proved
     interval ``[proved_lower, proved_upper]`` (N m; inf: unbounded)."""
 

@@ -1,7 +1,7 @@
 """The replay of phases in any formation: holds, the contact a slide makes at its end, pivots (issue 23).
 
 :func:`qsplan.planner.replay.replay.replay_plan` re-simulates each in-contact phase with the finite-motion simulator.
-A plan that turns the workpiece (:mod:`qsplan.planner.plan.reorient`) has phases the palm edge's closed form does not
+A plan that turns the workpiece (:mod:`qsplan.planner.plan.turning`) has phases the palm edge's closed form does not
 describe; this module says how each is replayed, from the rows and the task alone:
 
 * a **hold** (every letter ``R``): nothing moves and nothing is simulated: the certificate proves it
@@ -11,8 +11,8 @@ describe; this module says how each is replayed, from the rows and the task alon
 * a phase whose **first row has more contacts** than the rest (the pivot's transition row: vertex 0 lifts): the all-modes
   solver at that row with all its contacts must find the planned mode alone (the replay's start check), then the
   phase is simulated from its second row with the contacts of the rest;
-* scenes of a turning phase come from the contacts the polygons show (:func:`qsplan.hands.found_contacts.
-  row_contact_scene`), their count checked against the phase's.
+* every phase's scenes come from the contacts the polygons show (:func:`qsplan.hands.found_contacts.
+  row_contact_scene`), their count checked against the phase's: one path for every hand and formation.
 
 Friction: the replay's vector gives one coefficient per body of the palm-edge formation (``palm:0``, ``palm:1``,
 ``left``, ``right``); a contact of another formation takes its body's (:func:`body_friction`).  Units SI.
@@ -25,17 +25,16 @@ import numpy as np
 from qsplan.mechanics.errors import QsplanError
 
 __all__ = ["HOLD_NOTE", "body_friction", "formation_of", "found_scene", "phase_rows", "replay_segments",
-           "rows_pose", "transition_modes", "uses_found_contacts"]
+           "rows_pose", "transition_modes", "turns"]
 
 #: What a hold's replay records: it is not simulated; the certificate proves it.
 HOLD_NOTE = "a hold: nothing moves; proved by the certificate (frictionless equilibrium, every contact loaded)"
 
 
-def uses_found_contacts(hand, columns, rows) -> bool:
-    """Whether the phase's rows need the found contacts: the workpiece turns (theta not 0), or a row's mode has other
-    than four letters; only for a hand that reorients (:attr:`qsplan.hands.protocol.Hand.reorients`)."""
-    if not hand.reorients:
-        return False
+def turns(columns, rows) -> bool:
+    """Whether the phase's rows leave the palm edge: the workpiece turns (theta not 0), or a row's mode has other than
+    four letters.  Such a phase starts where its rows say (the hold before it moves nothing); a slide on the palm
+    edge starts where the simulation left the workpiece (its fingers closed on it again)."""
     theta = np.asarray(columns["theta_workpiece"], float)[rows]
     return bool(np.any(theta != 0.0) or any(len(str(columns["mode"][k])) != 4 for k in rows))
 
@@ -78,33 +77,33 @@ def body_friction(names, mu) -> np.ndarray:
     return np.asarray([mu[j] if (j := slot_of(n, slots)) is not None else mu[0] for n in names], float)
 
 
-def found_scene(hand, x, effort_controlled, velocity, effort, n_contacts):
-    """The scene at replay state ``x`` (pose, joints, clock) from the contacts the polygons show.
+def found_scene(hand, x, effort_controlled, velocity, effort, tracked):
+    """The scene at replay state ``x`` (pose, joints, clock) of the contacts the polygons showed at the phase's
+    start, followed by their features (``tracked``: :func:`qsplan.hands.found_contacts.track_contacts`).
 
     Raises
     ------
     QsplanError
-        The polygons show another number of contacts than the phase's (the geometry left its formation).
+        A contact's feature no longer touches (the geometry left its formation).
     """
-    from qsplan.hands.found_contacts import row_contact_scene
-
-    scene = row_contact_scene(hand, x[:3], x[3:-1], effort_controlled, velocity, effort)
-    if len(scene.contact_names) != n_contacts:
-        raise QsplanError(f"contacts: the phase has {n_contacts}; the polygons show {len(scene.contact_names)} "
-                          f"({', '.join(scene.contact_names)}) at pose {np.round(x[:3], 6).tolist()}")  # fmt: skip
-    return scene
+    return tracked.scene(hand, x[:3], x[3:-1], effort_controlled, velocity, effort)
 
 
 def formation_of(hand, columns, k, mode):
-    """A formation of the contacts the polygons show at row ``k`` (their canonical names), ``mode`` its letters: the
-    simulator's contacts of a turning phase."""
+    """``(formation, tracked contacts)``: a formation of the contacts the polygons show at row ``k`` (their canonical
+    names), ``mode`` its letters, the simulator's contacts of the phase; and those contacts as features to follow
+    (:func:`qsplan.hands.found_contacts.track_contacts`)."""
     from qsplan.hands.formations import ContactSlot, Formation
-    from qsplan.hands.found_contacts import contact_names, ordered_contacts
+    from qsplan.hands.found_contacts import track_contacts
 
     pose, q = _configuration(hand, columns, k)
-    names = contact_names(hand, pose, ordered_contacts(hand, pose, q))
-    slots = tuple(ContactSlot(n, n.partition(":")[0], "any", None, f"{n}, found in the polygons") for n in names)
-    return Formation("found", slots, mode, "last", "the contacts the polygons show")
+    tracked = track_contacts(hand, pose, q)
+    if len(tracked.names) != len(mode):
+        raise QsplanError(f"plan: row {k}'s mode {mode} has {len(mode)} letters, and the polygons show "
+                          f"{len(tracked.names)} contacts there ({', '.join(tracked.names) or 'none'}): the rows do not "
+                          "touch the workpiece as their mode says")  # fmt: skip
+    slots = tuple(ContactSlot(n, n.partition(":")[0], "any", None, f"{n}, found in the polygons") for n in tracked.names)
+    return Formation("found", slots, mode, "last", "the contacts the polygons show"), tracked
 
 
 def transition_modes(hand, columns, k, effort_controlled, mu) -> tuple:

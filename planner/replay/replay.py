@@ -91,6 +91,8 @@ class ReplaySystem:
         Of the formation's contacts, in its order.
     formation : qsplan.hands.formations.Formation
         The contacts the replay keeps (their names and order).
+    tracked : qsplan.hands.found_contacts.TrackedContacts
+        Those contacts as the polygons showed them at the phase's start, followed by their features.
     scenes : dict
         Scenes already built, by the state's bytes (a scene depends on the state alone): the
         integrator asks again for the scene at the end of every step (its event functions, then
@@ -106,8 +108,8 @@ class ReplaySystem:
     effort: np.ndarray
     friction: object
     formation: object
+    tracked: object
     scenes: dict = field(default_factory=dict, repr=False)
-    found: bool = False  # scenes from the contacts the polygons show (qsplan.planner.replay.phases)
 
     @property
     def contact_names(self) -> tuple:
@@ -127,7 +129,7 @@ class ReplaySystem:
         return velocity, effort
 
     def scene(self, x, contacts):
-        from qsplan.hands.interface import scene_at
+        from qsplan.planner.replay.phases import found_scene
 
         if tuple(contacts) != tuple(range(self.formation.n_contacts)):
             raise QsplanError(f"contacts: the replay keeps all {self.formation.n_contacts} contacts of the formation; "
@@ -136,12 +138,7 @@ class ReplaySystem:
         scene = self.scenes.get(key)
         if scene is None:
             velocity, effort = self.commands(x[-1])
-            if self.found:
-                from qsplan.planner.replay.phases import found_scene
-
-                scene = found_scene(self.hand, x, self.effort_controlled, velocity, effort, self.formation.n_contacts)
-            else:
-                scene = scene_at(self.hand, x[:3], x[3:-1], self.effort_controlled, velocity, effort=effort)
+            scene = found_scene(self.hand, x, self.effort_controlled, velocity, effort, self.tracked)
             if len(self.scenes) >= MAX_CACHED_SCENES:
                 self.scenes.clear()
             self.scenes[key] = scene
@@ -283,8 +280,7 @@ def replay_plan(columns, hand, mu, options=None, scenes=None, formation=None) ->
     from qsplan.mechanics.motion.simulator import simulate
     from qsplan.mechanics.motion.system import make_friction
     from qsplan.planner.plan.timing import quasistatic_rows
-    from qsplan.planner.replay.phases import (HOLD_NOTE, body_friction, formation_of, phase_rows, transition_modes,
-                                              uses_found_contacts)  # fmt: skip
+    from qsplan.planner.replay.phases import HOLD_NOTE, body_friction, formation_of, phase_rows, transition_modes, turns
 
     hand = as_hand(hand)
     names = hand.joint_names
@@ -301,7 +297,6 @@ def replay_plan(columns, hand, mu, options=None, scenes=None, formation=None) ->
         raise QsplanError(f"mu: expected one friction coefficient or {n_c} (one per contact); got {np.shape(mu)}") from None
     if np.any(~np.isfinite(mu)) or np.any(mu < 0):
         raise QsplanError(f"mu: expected {n_c} nonnegative friction coefficients; got {mu.tolist()}")
-    friction = make_friction(mu, mu)
     scenes = {} if scenes is None else scenes
     out, x_prev = [], None
     for seg in replay_segments(columns):
@@ -310,14 +305,13 @@ def replay_plan(columns, hand, mu, options=None, scenes=None, formation=None) ->
             out.append(SegmentReplay(seg["phase"], seg["mode"], (seg["mode"],), None, 0.0,
                                      float(columns["x_workpiece"][rows[-1]]), None, HOLD_NOTE))  # fmt: skip
             continue
-        found, first, note, seg_mu, seg_formation = False, None, None, mu, formation
-        if hand.reorients:  # the contacts a phase makes or leaves at its ends (qsplan.planner.replay.phases)
-            rows, first, mode, note = phase_rows(hand, columns, rows)
-            seg = dict(seg, mode=mode)
-        if uses_found_contacts(hand, columns, rows):
-            found = True
-            seg_formation = formation_of(hand, columns, rows[0], mode)
-            seg_mu = body_friction(seg_formation.contact_names, mu)
+        turning = turns(columns, rows)
+        # the contacts a phase makes or leaves at its ends; every scene from the contacts the polygons show
+        rows, first, mode, note = phase_rows(hand, columns, rows)
+        seg = dict(seg, mode=mode)
+        seg_formation, tracked = formation_of(hand, columns, rows[0], mode)
+        seg_mu = body_friction(seg_formation.contact_names, mu)
+        if turning:
             x_prev = None  # a turning phase starts where its rows say (the hold before it moves nothing)
         if e not in names:
             raise QsplanError(f"plan: effort_joint {e!r} in phase {seg['phase']} is no joint of the hand {names}")
@@ -329,15 +323,14 @@ def replay_plan(columns, hand, mu, options=None, scenes=None, formation=None) ->
         qd_rows = np.column_stack([np.asarray(columns[f"qd_{n}"], float)[rows] for n in names])
         s, velocity = quasistatic_rows(np.asarray(columns["t"], float)[rows], u, q_rows, qd_rows)
         t = float(columns["t"][rows[0]]) + s  # the replay's clock: the plan's start time plus the path parameter
-        seg_friction = friction if not found else make_friction(seg_mu, seg_mu)
-        system = ReplaySystem(hand, effort, t, velocity, tau, seg_friction, seg_formation,
-                              scenes.setdefault(seg["phase"], {}), found)  # fmt: skip
+        system = ReplaySystem(hand, effort, t, velocity, tau, make_friction(seg_mu, seg_mu), seg_formation, tracked,
+                              scenes.setdefault(seg["phase"], {}))  # fmt: skip
         k = rows[0]
         pose = rows_pose(columns, k)
         if x_prev is not None:
             pose = x_prev[:3]  # the regrasp leaves the workpiece where the simulation put it
         q_planned = np.array([columns[f"q_{n}"][k] for n in names], float)
-        q = q_planned if found else hand.reclose(pose, q_planned, rows_pose(columns, k))
+        q = q_planned if turning else hand.reclose(pose, q_planned, rows_pose(columns, k))
         x0 = np.concatenate([pose, q, [t[0]]])
         if hand.simulation_travel is not None and given is None:
             x_rows = np.asarray(columns["x_workpiece"], float)[rows]

@@ -167,7 +167,7 @@ def reorients(task) -> bool:
 
 def goal_turns(goal, hand) -> bool:
     """Whether ``goal`` asks another orientation than the start's: ``theta`` beyond :data:`THETA_TOL` of 0, or
-    ``palm`` naming another feature than ``hand``'s resting edge (the route of :mod:`qsplan.planner.plan.reorient`)."""
+    ``palm`` naming another feature than ``hand``'s resting edge (the formation search of :mod:`qsplan.planner.plan.turning`)."""
     if goal is None:
         return False
     resting = int(hand.user_edges[0])
@@ -179,11 +179,11 @@ def goal_refusal(task) -> GoalNotServedError | None:
     """Why the planner refuses ``task``'s goal before planning (a :class:`GoalNotServedError`, not raised), or None.
 
     A goal that turns the workpiece (:func:`reorients`) goes to the reorientation route, which refuses what it
-    cannot serve by name (:mod:`qsplan.planner.plan.reorient`); a goal that keeps the start's orientation is placed
+    cannot serve by name (:mod:`qsplan.planner.plan.turning`); a goal that keeps the start's orientation is placed
     by its x, so one without ``x`` is refused here.
     """
     goal = task.goal
-    if goal is None or reorients(task):  # the reorientation route decides (qsplan.planner.plan.reorient)
+    if goal is None or reorients(task):  # the formation search decides (qsplan.planner.plan.turning)
         return None
     resting = int(task.hand.user_edges[0])  # the edge the workpiece rests on, as the task's polygon numbers it
     if goal.x is None:

@@ -56,7 +56,7 @@ def _jobs(task, cols, rows, n_random, seed=0):
     rng = np.random.default_rng(seed)
     jobs = []
     for k in rows:
-        scene = row_scene(task, cols, k, judged_contacts(task, cols, k) if task.hand.reorients else None)
+        scene = row_scene(task, cols, k, judged_contacts(task, cols, k))
         mus = friction_points(task, n_random, rng, scene.n_contacts)
         jobs.append(ModeJob(k, scene, mus, _xdot_rows(cols, k, ["left", "right"])))
     return jobs

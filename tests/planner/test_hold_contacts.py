@@ -109,7 +109,7 @@ def test_the_flush_instant_holds_with_the_contact_it_makes(flush_row):
     found, drop = judged_contacts(task, cols, k)
     assert len(found) == 5 and int(np.sum(drop)) == 1  # the mode's four, and the contact the motion makes
     four = row_contact_scene(task.hand, pose, q, effort, np.zeros(len(names)), drop=drop, found=found)
-    five = hold_scene(task.hand, pose, q, effort, method="generic")
+    five = hold_scene(task.hand, pose, q, effort)
     assert five.n_contacts == 5 and four.n_contacts == 4
     box = task.disturbance
     assert not prove_hold(four, torques=[tau], disturbance=box).proved
@@ -144,21 +144,21 @@ def test_the_hold_interval_ends_where_a_ray_turns(flush_row):
         assert _worst_power(five, end - inward * 1e-6, task.disturbance) >= -1e-9
 
 
-def test_a_hand_that_does_not_reorient_holds_with_its_formation():
-    """The two-link hand (not of the paper's form): a hold's scene is its formation's four contacts (as the certifier
-    judges its rows, :func:`qsplan.hands.interface.scene_at`), every joint but the effort joint held."""
+def test_a_chain_hand_holds_with_the_contacts_the_polygons_show():
+    """The two-link hand: a hold's scene is the contacts the polygons show, in the canonical order (one path for
+    every hand), the same points and normals as its grasp's closed contacts, every joint but the effort joint held."""
     from qsplan.hands.found_contacts import hold_scene
     from qsplan.hands.interface import scene_at
     from qsplan.planner.states.contact import contact_samples
     from qsplan.planner.task.task import load_task, task_paths
 
     task = load_task(task_paths()["two_link_task"])
-    assert not task.hand.reorients
     joint = task.hand.joint_names[0]
     effort = np.array(task.hand.joint_names) == joint
     s = contact_samples(task, [task.start_x], joint, -0.01)
     scene = hold_scene(task.hand, s.pose[0], s.q[0], effort)
     grasp = scene_at(task.hand, s.pose[0], s.q[0], effort, s.qd[0])
-    assert scene.n_contacts == 4 and scene.contact_names == grasp.contact_names
-    np.testing.assert_array_equal(scene.Wn, grasp.Wn)
+    assert scene.contact_names == ("palm:0", "palm:1", "left", "right") and grasp.n_contacts == 4
+    np.testing.assert_allclose(scene.Wn, grasp.Wn, atol=1e-12)
+    np.testing.assert_allclose(scene.Jn, grasp.Jn, atol=1e-12)
     assert np.all(scene.joint_velocity[~effort] == 0.0)

@@ -180,7 +180,7 @@ def test_the_release_is_unloaded_by_the_joint_that_bears_the_load(two_link_right
             peak = np.maximum(peak, np.abs(sol.tau))
     assert hold.effort_joint == names[int(np.argmax(peak))] != slide.effort_joint
     effort = np.array(names) == hold.effort_joint
-    held = hold_scene(task.hand, row_pose(cols, k), row_q(cols, k, names), effort, method="generic")
+    held = hold_scene(task.hand, row_pose(cols, k), row_q(cols, k, names), effort)
     lo, hi = hold_torque_interval(held, task.disturbance, margin=task.force_margin.normal)
     assert np.all(hold.command == pytest.approx(release_torque(lo, hi, task.torque_resolution), abs=1e-12))
     assert np.all(np.abs(hold.command) <= min(abs(lo), abs(hi)) + task.torque_resolution + 1e-12)

@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from qsplan.hands.found_contacts import ordered_contacts, row_contact_scene
-from qsplan.hands.reorient import flush_instant
+from qsplan.hands.pivots import pivot_formations
 from qsplan.mechanics import solve_many
 from qsplan.mechanics.bands.hold import hold_torque_interval, prove_hold
 from qsplan.planner.certify.rows import friction_points
@@ -40,8 +40,8 @@ def _contacts(task, ph, k):
 def test_the_route_is_slide_hold_pivot(task, plan):
     assert [p.kind for p in plan.phases] == ["slide", "hold", "pivot"]
     slide, hold, pivot = plan.phases
-    fi = flush_instant(task.hand)
-    assert slide.x[-1] == fi.x and np.array_equal(slide.q[-1], fi.q)  # the slide ends at the flush instant itself
+    start = pivot_formations(task.hand)[0][1]  # the clockwise pivot's flush instant (x, y, 0, q)
+    assert slide.x[-1] == start[0] and np.array_equal(slide.q[-1], start[3:])  # the slide ends at the flush instant
     assert len(_contacts(task, slide, slide.t.size - 1)) == 5 and len(_contacts(task, slide, slide.t.size - 2)) == 4
     assert set(slide.modes()) == {"SSSS"}  # its last row judged for the motion that reaches it: four contacts
     assert np.ptp(hold.q, axis=0).max() == 0 and np.ptp(hold.poses(0.0), axis=0).max() == 0  # nothing moves
@@ -111,14 +111,16 @@ def test_export_names_each_phases_contacts_and_fills_the_pose(tmp_path, plan):
 
 
 @pytest.mark.slow
-def test_the_longest_pivot_ends_where_the_right_contact_stops_sliding(task):
+def test_the_pivot_crosses_its_slip_reversal_through_a_hold_and_ends_where_its_band_closes(task):
+    """The right contact's sliding reverses at -45.69 deg: the formation search cuts the pivot there and joins the
+    pieces by a certified hold; the second piece's band falls below the resolution near -48.7 deg (issue 32)."""
     from dataclasses import replace
 
     longer = replace(task, goal=replace(task.goal, theta=-0.85))
-    with pytest.raises(PlanFailure, match=r"contact right stops sliding at theta = -45\.69 deg"):
+    with pytest.raises(PlanFailure, match=r"the band is 0\.01\d+ N m wide at theta = -48\.\d+ deg"):
         plan_task(longer)
-    ok = plan_task(replace(task, goal=replace(task.goal, theta=-0.79)))  # just short of it: planned
-    assert ok.phases[-1].poses(0.0)[-1, 2] == -0.79
+    ok = plan_task(replace(task, goal=replace(task.goal, theta=-0.79)))  # just short of the reversal: one piece
+    assert ok.phases[-1].poses(0.0)[-1, 2] == -0.79 and [p.kind for p in ok.phases] == ["slide", "hold", "pivot"]
 
 
 @pytest.fixture(scope="module")
@@ -183,12 +185,15 @@ def test_mujoco_keeps_the_turning_plans_modes(run):
 def test_the_pivot_with_the_left_finger_torque_controlled(task):
     """The other candidate of the widest-first choice: the left finger torque-controlled, the right one driven; its
     transition band is bounded above (the left finger pushes inward, issue 23: <= -2.72 N m without margin)."""
-    from qsplan.planner.plan.reorient import pivot_phase, widest_pivot
+    from qsplan.hands.pivots import pivot_path
+    from qsplan.planner.plan.pivot import piece_phase, pivot_rate, pivot_thetas, widest_piece
 
-    fi = flush_instant(task.hand)
-    left = pivot_phase(task, "left", fi, -0.2, 0.0, "left")
+    pivot, start = pivot_formations(task.hand)[0]
+    path = pivot_path(task.hand, pivot, start, pivot_thetas(0.0, -0.2))
+    rows = np.arange(path.theta.size)
+    left = piece_phase(task, "left", pivot, path, rows, "left", pivot_rate(task, path, rows), True)
     assert left.effort_joint == "left" and np.isnan(left.qd[:, 0]).all() and np.isfinite(left.qd[:, 1]).all()
     assert np.isinf(left.lower[0]) and left.upper[0] < -2.72 and np.all(left.command < left.upper)
     assert np.all(left.width >= task.torque_resolution) and left.modes()[0] == "BSSSS"
-    right = widest_pivot(task, "right", fi, -0.2, lambda line: None)
+    right = widest_piece(task, "right", pivot, path, rows, True)
     assert right.effort_joint == "right" and np.isinf(np.min(right.width))  # unbounded: nothing is wider
