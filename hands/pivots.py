@@ -20,6 +20,7 @@ the polygon search's (:mod:`qsplan.hands.found_contacts`): a pivot adds no secon
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Protocol
 
 import numpy as np
 
@@ -37,12 +38,39 @@ FLUSH_STARTS = np.linspace(0.1, 0.9, 9)
 _TURN = {"left": -1.0, "right": 1.0}
 
 
+class FingerFeature(Protocol):
+    """What a pivot's non-flush finger touches: a value that says how (one gap constraint) and in words.
+
+    Attributes
+    ----------
+    kind : str
+        Its key in :data:`FINGER_FEATURES`.
+    key : str
+        Names it among its hand's candidates, in :attr:`Pivot.name` (letters and digits: ``vertex2``, ``corner2e1``).
+    """
+
+    kind: str
+
+    @property
+    def key(self) -> str: ...
+
+    def constraint(self, hand, finger: str) -> VertexOnLine:
+        """The gap constraint that keeps ``finger`` on it (:mod:`qsplan.hands.manifold`)."""
+
+    def words(self, hand) -> str:
+        """In words, the task's numbering (``on vertex 2``)."""
+
+
 @dataclass(frozen=True, slots=True)
 class VertexOnFinger:
     """The finger's inner edge on a workpiece vertex (internal numbering)."""
 
     vertex: int
     kind = "vertex"
+
+    @property
+    def key(self) -> str:
+        return f"vertex{self.vertex}"
 
     def constraint(self, hand, finger: str) -> VertexOnLine:
         from qsplan.hands.contact_sets import finger_inner_edge
@@ -61,6 +89,10 @@ class CornerOnEdge:
     edge: int
     kind = "corner"
 
+    @property
+    def key(self) -> str:
+        return f"corner{self.corner}e{self.edge}"
+
     def constraint(self, hand, finger: str) -> VertexOnLine:
         return VertexOnLine(finger, self.corner, "workpiece", self.edge)
 
@@ -69,7 +101,8 @@ class CornerOnEdge:
 
 
 #: What the non-flush finger of a pivot may touch, by kind: each kind's candidates on a hand and workpiece.  A new
-#: kind (a value with ``constraint`` and ``words``) is one entry here.
+#: kind (a value of the :class:`FingerFeature` protocol) is one entry here: the search, the names, the certifier's
+#: formation check and the plots take it from here.
 FINGER_FEATURES = {
     "vertex": lambda hand, finger: tuple(VertexOnFinger(v) for v in range(len(hand.workpiece))),
     "corner": lambda hand, finger: tuple(CornerOnEdge(c, e) for c in _tip_corners(hand, finger)
@@ -85,9 +118,6 @@ def _tip_corners(hand, finger: str) -> tuple:
     shape = np.asarray(manipulator_of(hand).joints[finger_link(hand, finger)].link_shape, dtype=float)
     far = shape[:, 0].max()
     return tuple(int(i) for i in np.flatnonzero(np.isclose(shape[:, 0], far)))
-
-
-FingerFeature = VertexOnFinger | CornerOnEdge
 
 
 @dataclass(frozen=True, slots=True)
@@ -124,8 +154,7 @@ class Pivot:
     @property
     def name(self) -> str:
         """A key naming the formation (internal numbering): ``pivot:v1:left:e3:vertex2``."""
-        feat = f"vertex{self.other.vertex}" if self.other.kind == "vertex" else f"corner{self.other.corner}e{self.other.edge}"
-        return f"pivot:v{self.vertex}:{self.flush}:e{self.edge}:{feat}"
+        return f"pivot:v{self.vertex}:{self.flush}:e{self.edge}:{self.other.key}"
 
     def words(self, hand) -> str:
         """In words, the task's numbering: ``pivot on vertex 1 (clockwise), the left finger flush on edge 3, the
@@ -157,17 +186,22 @@ class Pivot:
         return 1 - self.vertex
 
 
-def pivot_from_name(name: str) -> Pivot | None:
-    """The pivot formation :attr:`Pivot.name` names (``pivot:v1:left:e3:vertex2``, ``pivot:v0:right:e1:corner3e2``),
-    or None where ``name`` names none (another formation, or not a formation's name)."""
+def pivot_from_name(name: str, hand) -> Pivot | None:
+    """The pivot formation of ``hand`` that :attr:`Pivot.name` names (``pivot:v1:left:e3:vertex2``,
+    ``pivot:v0:right:e1:corner3e2``): its feature the candidate of :data:`FINGER_FEATURES` with that key; None where
+    ``name`` names none (another formation, not a formation's name, or a feature this hand does not have)."""
     import re
 
-    m = re.fullmatch(r"pivot:v(\d+):(left|right):e(\d+):(?:vertex(\d+)|corner(\d+)e(\d+))", str(name))
+    m = re.fullmatch(r"pivot:v(\d+):(left|right):e(\d+):(\w+)", str(name))
     if m is None:
         return None
-    vertex, flush, edge = int(m[1]), m[2], int(m[3])
-    other = VertexOnFinger(int(m[4])) if m[4] is not None else CornerOnEdge(int(m[5]), int(m[6]))
-    return Pivot(vertex, flush, edge, other)
+    flush = m[2]
+    other = "right" if flush == "left" else "left"
+    for candidates in FINGER_FEATURES.values():
+        for feature in candidates(hand, other):
+            if feature.key == m[4]:
+                return Pivot(int(m[1]), flush, int(m[3]), feature)
+    return None
 
 
 def finger_sides(hand, finger: str) -> tuple:

@@ -263,7 +263,7 @@ def _formation_claim(name, task, cols, rows, last, path) -> list:
     from qsplan.mechanics.model.geometry import CONTACT_TOL
     from qsplan.planner.certify.rows import row_pose, row_q
 
-    pivot = pivot_from_name(name)
+    pivot = pivot_from_name(name, task.hand)
     if pivot is None:
         fits = sorted(n for n, f in FORMATIONS.items() if f.contact_names == last)
         if name in fits:

@@ -77,8 +77,9 @@ def test_the_demo_offers_a_pivot_each_way_named_for_a_reader():
     names = [p.name for p, _ in found]
     assert names == ["pivot:v1:left:e3:vertex2", "pivot:v0:right:e1:vertex3"]
     assert [p.direction for p, _ in found] == [-1.0, 1.0]
-    assert all(pivot_from_name(p.name) == p for p, _ in found)
-    assert pivot_from_name("palm_edge") is None and pivot_from_name("pivot:v1:up:e3:vertex2") is None
+    assert all(pivot_from_name(p.name, hand) == p for p, _ in found)
+    assert pivot_from_name("palm_edge", hand) is None and pivot_from_name("pivot:v1:up:e3:vertex2", hand) is None
+    assert pivot_from_name("pivot:v1:left:e3:vertex9", hand) is None  # no vertex 9 on this workpiece
     for p, c in found:  # each flush instant: the five constraints closed, theta 0, on the palm
         assert np.max(np.abs(gaps(hand, p.flush_constraints(hand), c))) < 1e-14 and c[2] == 0.0
 
