@@ -11,7 +11,6 @@ import json
 import math
 import re
 import reprlib
-import tomllib
 from pathlib import Path
 
 import numpy as np
@@ -254,7 +253,12 @@ def read_document(path, what: str = "scene", error=SceneError) -> dict:
     text = read_text(path, what, error)
     kind = "TOML" if path.suffix.lower() == ".toml" else "JSON"
     try:
-        doc = tomllib.loads(text) if kind == "TOML" else json.loads(text)
+        if kind == "TOML":
+            import tomllib  # loaded when needed: ~6 ms that a JSON scene (qsplan modes FILE.json) does without
+
+            doc = tomllib.loads(text)
+        else:
+            doc = json.loads(text)
     except RecursionError:
         raise error(f"{path}: invalid {kind}: nested too deeply; expected at most {MAX_DEPTH} levels") from None
     except ValueError as exc:  # JSONDecodeError, TOMLDecodeError, and integers of thousands of digits

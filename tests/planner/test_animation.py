@@ -12,18 +12,12 @@ from qsplan.mechanics import QsplanError
 from qsplan.planner.plan.results import ContactSegmentPlan
 from qsplan.planner.plotting.animation import MAX_FRAMES, plan_animation
 from qsplan.planner.plotting.plan import animation_frames, sliding_directions
-from qsplan.planner.task.task import load_task, task_paths
-
-_PLANS = {}
-
 
 def planned(name):
-    """``plan_task`` of a bundled task, once per test session."""
-    from qsplan.planner.plan.scripted import plan_task
+    """``plan_task`` of a bundled task, once per test run (tests/planner/bundled.py)."""
+    from tests.planner.bundled import planned as shared
 
-    if name not in _PLANS:
-        _PLANS[name] = plan_task(load_task(task_paths()[name]))
-    return _PLANS[name]
+    return shared(name)
 
 
 @pytest.mark.ompl

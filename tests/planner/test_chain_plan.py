@@ -19,7 +19,9 @@ GAP = 1e-6
 
 @pytest.fixture(scope="module")
 def two_link_plan():
-    return plan_task(load_task(task_paths()["two_link_task"]))
+    from tests.planner.bundled import planned
+
+    return planned("two_link_task")
 
 
 def _check_rows(plan):
@@ -98,9 +100,10 @@ def test_a_regrasp_onto_another_feature_is_planned():
     from qsplan.hands.chain_hand import close_grasp
     from qsplan.hands.grasps import internal_edge
     from qsplan.planner.plan.results import RegraspPlan
+    from tests.planner.bundled import bundled_task, planned
 
-    task = load_task(task_paths()["two_link_regrasp_task"])
-    plan = plan_task(task)
+    task = bundled_task("two_link_regrasp_task")
+    plan = planned("two_link_regrasp_task")
     kinds = [type(p).__name__ for p in plan.phases]
     assert "RegraspPlan" in kinds and "ContactSegmentPlan" in kinds
     _check_rows(plan)

@@ -31,6 +31,7 @@ from qsplan.planner.export.plan_files import export_plan
 from qsplan.planner.plan.results import PlanFailure
 from qsplan.planner.plan.scripted import plan_task
 from qsplan.planner.task.task import load_task, task_paths
+from tests.planner.bundled import bundled_task, planned
 
 REFERENCE = Path(__file__).resolve().parent.parent / "data" / "reference_plans"
 
@@ -116,7 +117,7 @@ def test_reference_plans_cover_every_bundled_paper_task():
 
 @pytest.mark.parametrize("name", PAPER_PLANS)
 def test_paper_plans_equal_the_pre_pipeline_planner(name, tmp_path):
-    plan = plan_task(load_task(task_paths()[name]))
+    plan = planned(name)
     csv_path, _ = export_plan(plan, tmp_path)
     want = REFERENCE / f"{name}.csv"
     _same_cells(_rows(csv_path), _rows(want))
@@ -124,7 +125,7 @@ def test_paper_plans_equal_the_pre_pipeline_planner(name, tmp_path):
 
 def test_paper_failure_report_equals_the_pre_pipeline_planner():
     with pytest.raises(PlanFailure) as info:
-        plan_task(load_task(task_paths()["friction_closes_task"]))
+        planned("friction_closes_task")
     got = json.loads(json.dumps(info.value.report.as_dict()))
     want = json.loads((REFERENCE / "friction_closes_task.failure.json").read_text())
     for key in ("kind", "mode", "mode_name", "competitor", "message"):
@@ -141,13 +142,13 @@ def _outline(plan) -> list:
 @pytest.mark.parametrize("name", PAPER_TASKS)
 def test_generic_path_equals_the_accelerated_paper_hand(name):
     """Accelerator off: the described hand's generic closing, scenes and grasp candidates."""
-    task = load_task(task_paths()[name])
+    task = bundled_task(name)
     generic = replace(task, hand=replace(task.hand, accelerated=False))
     assert task.hand.accelerated and not generic.hand.accelerated
     results = []
     for t in (task, generic):
         try:
-            plan = plan_task(t)
+            plan = planned(name) if t is task else plan_task(t)
         except PlanFailure as exc:
             report = exc.report.as_dict()
             results.append(("failure", report.get("kind"), report.get("mode"), report.get("x_m", report.get("x"))))

@@ -12,11 +12,10 @@ import pytest
 from qsplan.hands.interface import contacts_at, joint_axes, joint_kinds, joint_names
 from qsplan.mechanics import SceneError
 from qsplan.planner.plan.results import ContactSegmentPlan, RegraspPlan
-from qsplan.planner.plan.scripted import plan_task
 from qsplan.planner.plotting.card import card_snapshots, phase_rows, plan_card
 from qsplan.planner.plotting.hands import STATES, effort_direction, plan_snapshots
 from qsplan.planner.plotting.style import torque_text
-from qsplan.planner.task.task import load_task, task_paths
+from qsplan.planner.task.task import task_paths
 from tests.planner.figure_checks import all_text, labels_without_units, legends_over_axes, overlapping_texts
 
 pytestmark = pytest.mark.ompl
@@ -27,14 +26,11 @@ TASKS = sorted(n for n in task_paths() if n != "friction_closes_task")
 #: Tasks whose cards are drawn in the default run (one paper-hand slide, one chain-hand regrasp); the rest are slow.
 QUICK_CARDS = ("demo_task", "two_link_regrasp_task")
 
-_PLANS = {}
-
-
 def planned(name):
-    """``plan_task`` of a bundled task, once per test session."""
-    if name not in _PLANS:
-        _PLANS[name] = plan_task(load_task(task_paths()[name]))
-    return _PLANS[name]
+    """``plan_task`` of a bundled task, once per test run (tests/planner/bundled.py)."""
+    from tests.planner.bundled import planned as shared
+
+    return shared(name)
 
 
 def every_finger_touches(plan, pose, q) -> bool:

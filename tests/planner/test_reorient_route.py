@@ -16,7 +16,6 @@ from qsplan.mechanics.bands.hold import hold_torque_interval, prove_hold
 from qsplan.planner.certify.rows import friction_points
 from qsplan.planner.plan.results import PlanFailure
 from qsplan.planner.plan.scripted import plan_task
-from qsplan.planner.task.task import load_task, task_paths
 
 #: Seeded random friction vectors checked besides the friction box's vertices.
 N_RANDOM = 20
@@ -24,12 +23,16 @@ N_RANDOM = 20
 
 @pytest.fixture(scope="module")
 def task():
-    return load_task(task_paths()["reorient_task"])
+    from tests.planner.bundled import bundled_task
+
+    return bundled_task("reorient_task")
 
 
 @pytest.fixture(scope="module")
 def plan(task):
-    return plan_task(task)
+    from tests.planner.bundled import planned
+
+    return planned("reorient_task")
 
 
 def _contacts(task, ph, k):

@@ -104,13 +104,12 @@ def test_reintegrated_velocity_reproduces_the_exported_q(name):
 def chain_plans(tmp_path_factory):
     """The bundled chain-hand tasks planned and exported: ``{name: plan directory}``."""
     from qsplan.planner.export.plan_files import export_plan
-    from qsplan.planner.plan.scripted import plan_task
-    from qsplan.planner.task.task import load_task, task_paths
+    from tests.planner.bundled import planned
 
     out = {}
     for name in ("parallel_jaw_task", "two_link_task"):
         d = tmp_path_factory.mktemp(name)
-        export_plan(plan_task(load_task(task_paths()[name])), d)
+        export_plan(planned(name), d)
         out[name] = d
     return out
 
@@ -238,10 +237,9 @@ def test_plan_sample_is_the_files_samples(tmp_path):
     """``Plan.sample`` (the planned plan) and ``sample_plan`` (its exported files) give the same ticks: one rule."""
     from qsplan.planner.export.plan_files import export_plan
     from qsplan.planner.export.sample import sample_plan, tick_times
-    from qsplan.planner.plan.scripted import plan_task
-    from qsplan.planner.task.task import load_task, task_paths
+    from tests.planner.bundled import planned
 
-    plan = plan_task(load_task(task_paths()["parallel_jaw_task"]))
+    plan = planned("parallel_jaw_task")
     export_plan(plan, tmp_path)
     ticks = tick_times(plan.duration, 200)
     a, b = plan.sample(ticks), sample_plan(tmp_path, ticks)

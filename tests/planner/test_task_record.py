@@ -51,9 +51,10 @@ def test_every_bundled_task_round_trips(name):
 
 def test_the_rebuilt_task_plans_the_same_plan():
     from qsplan.planner.plan.scripted import plan_task
+    from tests.planner.bundled import bundled_task, planned
 
-    task = load_task(task_paths()["parallel_jaw_task"])
-    a, b = plan_task(task), plan_task(task_from_record(task_record(task)))
+    task = bundled_task("parallel_jaw_task")
+    a, b = planned("parallel_jaw_task"), plan_task(task_from_record(task_record(task)))
     assert [p.name for p in a.phases] == [p.name for p in b.phases]
     assert b.narrowest()[2] == pytest.approx(a.narrowest()[2], rel=1e-12)
 
@@ -92,10 +93,10 @@ def test_the_certifier_checks_the_record_but_not_the_tasks_name(tmp_path):
 
     from qsplan.planner.certify.certify import certify_plan
     from qsplan.planner.export.plan_files import export_plan
-    from qsplan.planner.plan.scripted import plan_task
+    from tests.planner.bundled import bundled_task, planned
 
-    task = load_task(task_paths()["parallel_jaw_task"])
-    export_plan(plan_task(task), tmp_path)
+    task = bundled_task("parallel_jaw_task")
+    export_plan(planned("parallel_jaw_task"), tmp_path)
     assert certify_plan(tmp_path, replace(task, name="another name"), n_random=0).ok
     refused = certify_plan(tmp_path, replace(task, mu_range=(0.0, 0.25)), n_random=0)
     assert any(v.kind == "metadata" and "task_record" in v.message for v in refused.violations)
