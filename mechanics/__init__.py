@@ -55,6 +55,8 @@ _LAZY = {
     "HoldProof": "qsplan.mechanics.bands.hold",
     "prove_hold": "qsplan.mechanics.bands.hold",
     "hold_torque_interval": "qsplan.mechanics.bands.hold",
+    "FrictionHold": "qsplan.mechanics.bands.friction_hold",
+    "prove_friction_hold": "qsplan.mechanics.bands.friction_hold",
     "Band": "qsplan.mechanics.bands.effort",
     "ForceMargin": "qsplan.mechanics.bands.effort",
     "effort_band": "qsplan.mechanics.bands.effort",
