@@ -1,8 +1,9 @@
 """Certified holds on the demo's hand and workpiece (issue 23, item 3): nothing moves while the hand holds still and
 ramps a torque, proved for every friction (:mod:`qsplan.mechanics.bands.hold`), with timings.
 
-* (a) the flush instant (five contacts, :func:`qsplan.hands.reorient.transition_scene`), the left finger held and
-  the right finger's torque ramped from the slide's end (the demo's last command, or its band's lower edge) to the
+* (a) the flush instant (five contacts: the clockwise pivot's start, :func:`qsplan.hands.pivots.pivot_formations`,
+  its scene from the contacts the polygons show, :func:`qsplan.hands.found_contacts.row_contact_scene`), the left
+  finger held and the right finger's torque ramped from the slide's end (the demo's last command, or its band's lower edge) to the
   transition band's edge (3.8994 N m with the 0.05 N margin, ``docs/reorientation.md``); the interval of right
   torques a hold is proved at (normal forces >= 1e-6 N, and >= the task's force margin); without and with the
   demo's inertial box; and, for the route search, the left finger torque-controlled with the right one held;
@@ -30,8 +31,9 @@ from pathlib import Path
 
 import numpy as np
 
+from qsplan.hands.found_contacts import row_contact_scene
 from qsplan.hands.interface import scene_at
-from qsplan.hands.reorient import flush_instant, paper_form, transition_scene
+from qsplan.hands.pivots import pivot_formations
 from qsplan.mechanics.bands.hold import hold_matrix, hold_torque_interval, prove_hold
 from qsplan.mechanics.solver.lp import solve_lp
 from qsplan.planner.task.dynamics import inertial_box
@@ -111,15 +113,17 @@ def main():
     hand, margin = task.hand, task.force_margin.normal
     row = list(csv.DictReader(DEMO_PLAN.open()))[-1]
     command, band = float(row["tau_right"]), (float(row["tau_right_min"]), float(row["tau_right_max"]))
-    fi, t_fi = timed(lambda: flush_instant(hand), args.repeat)
-    flush = transition_scene(hand, fi, "right")
-    box = inertial_box(0.2, fi.pose[1], 0.02)
+    (pivot, start), t_fi = timed(lambda: pivot_formations(hand)[0], args.repeat)  # the clockwise pivot: the left flush
+    pose_fi, q_fi = start[:3], start[3:]
+    flush = row_contact_scene(hand, pose_fi, q_fi, [False, True], np.zeros(2))  # a hold: the velocities play no part
+    box = inertial_box(0.2, pose_fi[1], 0.02)
     print(f"demo task: friction box {task.mu_range} per contact (not used by the proof), force margin {margin} N, "
           f"inertial box lo={box.lo} hi={box.hi} (N, N, N m)")  # fmt: skip
     print(f"slide end (last row of {DEMO_PLAN.name}): x = {row['x_workpiece']} m, right command {command:.5f} N m, "
           f"band [{band[0]:.5f}, {band[1]:.5f}] N m")  # fmt: skip
 
-    print(f"\n(a) flush instant x = {fi.x:.6f} m ({1e3 * t_fi:.2f} ms), contacts {', '.join(flush.contact_names)}; "
+    print(f"\n(a) flush instant of {pivot.name}: x = {pose_fi[0]:.6f} m (every pivot formation generated in "
+          f"{1e3 * t_fi:.2f} ms), contacts {', '.join(flush.contact_names)}; "
           "left finger held, right torque-controlled")  # fmt: skip
     print(f"  {'proved torque interval':<46} {'box':>4} {'margin':>10}   interval (N m)")
     for b, m in product((None, box), (1e-6, margin)):
@@ -130,7 +134,7 @@ def main():
         proof_row("ramp: end command -> far above", flush, [command, FAR], b, args.repeat)
     p0 = proof_row("right torque 0", flush, [0.0], None, args.repeat)
     print(f"    {p0.reason}")
-    left = transition_scene(hand, fi, "left")
+    left = row_contact_scene(hand, pose_fi, q_fi, [True, False], np.zeros(2))
     print("  the left finger torque-controlled, the right one held:")
     for b in (None, box):
         interval_row("left torque", left, b, margin, args.repeat)
@@ -154,7 +158,7 @@ def main():
     _, hi = hold_torque_interval(end)
     beyond = proof_row("just above the interval", end, [hi + 0.01], None, args.repeat)
     c = centre(beyond.witness[:3])
-    v = paper_form(hand).workpiece + np.asarray(pose[:2])
+    v = hand.workpiece + np.asarray(pose[:2])
     print(f"    {beyond.reason}")
     print(f"    instantaneous centre ({c[0]:.4f}, {c[1]:.4f}) m; vertex 0 at ({v[0, 0]:.4f}, {v[0, 1]:.4f}), "
           f"vertex 1 at ({v[1, 0]:.4f}, {v[1, 1]:.4f})")  # fmt: skip

@@ -21,8 +21,8 @@
   closed configurations, for any hand; :mod:`qsplan.hands.reclose` - the fingers closed again between segments.
 * :mod:`qsplan.hands.collision` - overlaps between every pair of bodies, batched.
 * :mod:`qsplan.hands.contact_sets` - a scene from an explicit, named contact set at any pose (issue 23).
-* :mod:`qsplan.hands.reorient` - the flush instant ending the slide, its five-contact transition, the pivot's manifold.
-* :mod:`qsplan.hands.pivot_sweep` - the pivot swept over theta: its 4S bands and events.
+* :mod:`qsplan.hands.pivots` - the pivot formations of a hand and workpiece, generated, and their flush instants;
+  :mod:`qsplan.hands.manifold` - a formation's configuration manifold solved for any hand (issue 32).
 
 Submodules are imported on first use so that ``import qsplan.hands`` stays light.
 """
@@ -37,12 +37,6 @@ _LAZY = {
     "contact_set_scene": "qsplan.hands.contact_sets",
     "flush_contacts": "qsplan.hands.contact_sets",
     "locate_contacts": "qsplan.hands.contact_sets",
-    "flush_instant": "qsplan.hands.reorient",
-    "transition_scene": "qsplan.hands.reorient",
-    "pivot_configurations": "qsplan.hands.reorient",
-    "pivot_scene": "qsplan.hands.reorient",
-    "sweep_pivot": "qsplan.hands.pivot_sweep",
-    "pivot_band": "qsplan.hands.pivot_sweep",
     "eq37_scene": "qsplan.hands.paper",
     "eq42_scene": "qsplan.hands.paper",
     "rod_scene": "qsplan.hands.paper",

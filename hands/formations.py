@@ -6,10 +6,12 @@ contacts, band, friction vector, export column and plot), the desired contact mo
 Section 3's ``R``/``S``/``B``) and which joints close onto the workpiece.  Every layer reads these from the
 formation (:func:`formation`), never from literals, so a new formation is one entry of :data:`FORMATIONS`.
 
-Today's formation (Section 5.2, Fig. 9) is ``"palm_edge"``: the workpiece rests on the palm on its bottom
-edge (its internal vertices 0 and 1, :mod:`qsplan.hands.workpiece`), each finger touches it at one point
+The one registered formation (Section 5.2, Fig. 9) is ``"palm_edge"``: the workpiece rests on the palm on its
+bottom edge (its internal vertices 0 and 1, :mod:`qsplan.hands.workpiece`), each finger touches it at one point
 (its last joint closes onto it), and the desired mode is 4S: the workpiece slides on the palm and under both
-fingers.  Units: none (names and letters).
+fingers.  The formations that turn the workpiece are not entries here: they are generated per hand and workpiece
+(:func:`qsplan.hands.pivots.pivot_formations`) and named by :attr:`qsplan.hands.pivots.Pivot.name`.  Units: none
+(names and letters).
 """
 
 from __future__ import annotations
@@ -123,7 +125,7 @@ class Formation:
         return self.bodies("left"), self.bodies("right")
 
 
-#: Every formation, by name.
+#: Every registered formation, by name (the pivots that turn the workpiece are generated: :mod:`qsplan.hands.pivots`).
 FORMATIONS = {
     "palm_edge": Formation(
         name="palm_edge",
@@ -137,40 +139,6 @@ FORMATIONS = {
         closing="last",
         description="the bottom edge on the palm, one point of each finger; 4S: sliding on the palm and under both "
                     "fingers (Section 5.2, Fig. 9)",
-    ),
-    # Issue 23's reorientation (qsplan.hands.reorient): the instant that ends the palm-edge slide with the left
-    # finger flush on the longest edge, and the pivot that follows.  The planner does not serve them yet
-    # (qsplan.hands.described_states.check_formation refuses them by name).
-    "flush_to_pivot_v1": Formation(
-        name="flush_to_pivot_v1",
-        contacts=(
-            ContactSlot("palm:0", "palm", "vertex", 0, "the workpiece's bottom-left vertex on the palm"),
-            ContactSlot("palm:1", "palm", "vertex", 1, "the workpiece's bottom-right vertex on the palm"),
-            ContactSlot("left:base", "left", "any", None, "the left finger flush on the longest edge: the overlap's "
-                                                          "end toward the finger's base (vertex 0)"),
-            ContactSlot("left:tip", "left", "any", None, "the left finger flush on the longest edge: the overlap's end "
-                                                         "toward the fingertip (vertex 3)"),
-            ContactSlot("right", "right", "any", None, "the right finger on the workpiece (vertex 2)"),
-        ),
-        mode="BSSSS",
-        closing="last",
-        description="the flush instant ending the palm-edge slide (the left finger along the longest edge); the "
-                    "transition mode BSSSS: vertex 0 lifts, the workpiece pivots on vertex 1 into pivot_v1",
-    ),
-    "pivot_v1": Formation(
-        name="pivot_v1",
-        contacts=(
-            ContactSlot("palm:1", "palm", "vertex", 1, "the workpiece's vertex 1 on the palm: the pivot"),
-            ContactSlot("left:base", "left", "any", None, "the left finger flush on the longest edge: the overlap's "
-                                                          "end toward the finger's base (vertex 0)"),
-            ContactSlot("left:tip", "left", "any", None, "the left finger flush on the longest edge: the overlap's end "
-                                                         "toward the fingertip (vertex 3, later the fingertip's corner)"),
-            ContactSlot("right", "right", "any", None, "the right finger on the workpiece (vertex 2)"),
-        ),
-        mode="SSSS",
-        closing="last",
-        description="pivoting on vertex 1, the left finger flush on the longest edge (two contacts), the right finger "
-                    "on vertex 2; 4S: sliding at every contact while the workpiece turns clockwise",
     ),
 }
 

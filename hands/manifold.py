@@ -15,8 +15,8 @@ direction per unit of one *driving* coordinate (its other coordinates held: a ha
 follows the manifold along the driving coordinate by prediction (the tangent) and correction (:func:`project`).
 
 One algorithm for every hand the :class:`qsplan.hands.protocol.Hand` protocol describes (single-link fingers,
-chains, prismatic jaws); a hand's closed forms (the paper hand's, :mod:`qsplan.hands.reorient`) are checked against
-it in the tests.  Units SI.
+chains, prismatic jaws); the tests check it against the paper hand's closed form (``tests/reference/paper_pivot.py``).
+Units SI.
 """
 
 from __future__ import annotations

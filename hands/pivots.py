@@ -12,9 +12,10 @@ and its mirror image).
 Everything is generated from the hand and the workpiece (:func:`pivot_formations`): each finger, each side it can
 lie along, each feature of the other finger (:data:`FINGER_FEATURES`, one registry: a workpiece vertex on the
 finger's inner edge, a finger corner on a workpiece edge).  The manifold is solved by one algorithm for every hand
-(:mod:`qsplan.hands.manifold`); the paper hand's closed form (:func:`qsplan.hands.reorient.pivot_configurations`)
-agrees with it to 1e-14 (the tests).  Where a row's contacts are, in the canonical order a plan's letters follow, is
-the polygon search's (:mod:`qsplan.hands.found_contacts`): a pivot adds no second way to name contacts.  Units SI.
+(:mod:`qsplan.hands.manifold`); the paper hand's closed form, derived apart from it for the tests
+(``tests/reference/paper_pivot.py``), agrees with it to 1e-14 in the pose.  Where a row's contacts are, in the
+canonical order a plan's letters follow, is the polygon search's (:mod:`qsplan.hands.found_contacts`): a pivot adds
+no second way to name contacts.  Units SI.
 """
 
 from __future__ import annotations

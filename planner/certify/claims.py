@@ -264,6 +264,9 @@ def _formation_claim(name, task, cols, rows, last, path) -> list:
     from qsplan.planner.certify.rows import row_pose, row_q
 
     pivot = pivot_from_name(name, task.hand)
+    if pivot is None and name not in FORMATIONS:  # e.g. a name of the retired hand-built route (issue 32)
+        return [f"{path}.formation states {show(name)}: neither a registered formation ({', '.join(sorted(FORMATIONS))}) "
+                "nor a pivot formation of this hand and workpiece (pivot:vVERTEX:FINGER:eEDGE:FEATURE)"]  # fmt: skip
     if pivot is None:
         fits = sorted(n for n, f in FORMATIONS.items() if f.contact_names == last)
         if name in fits:

@@ -61,7 +61,7 @@ def test_bundled_tasks_along_their_segments(name):
 
     task = load_task(task_paths()[name])
     if task.goal is not None and task.goal.x is None:  # a turning goal: its palm-edge slide ends at the flush instant
-        from qsplan.hands.reorient import flush_instant
+        from tests.reference.paper_pivot import flush_instant
 
         end = [flush_instant(task.hand).x]
     else:

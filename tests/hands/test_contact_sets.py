@@ -1,5 +1,6 @@
-"""Named contact sets at any workpiece pose (qsplan.hands.contact_sets) and the reorientation geometry of the demo's
-hand (qsplan.hands.reorient, qsplan.hands.pivot_sweep): conventions, the flush instant, the pivot manifold, events."""
+"""Named contact sets at any workpiece pose (qsplan.hands.contact_sets) and the demo hand's pivot in closed form
+(tests/reference/paper_pivot.py): conventions, the flush instant (against an independent root and the generic
+search's), the pivot manifold, the polygon search's contacts along it."""
 
 from __future__ import annotations
 
@@ -11,11 +12,7 @@ from scipy.optimize import brentq
 
 from qsplan.hands.contact_sets import (ContactSpec, body_ring, contact_set_scene, finger_inner_edge, finger_link,
                                        flush_contacts, locate_contacts, palm_top_edge)  # fmt: skip
-from qsplan.hands.formations import formation
-from qsplan.hands.pivot_sweep import (EVENT_TOL, geometric_events, locate_event, polygon_contacts, same_contacts,
-                                      slip_speeds, sweep_pivot)  # fmt: skip
-from qsplan.hands.reorient import (PIVOT_FORMATION, TRANSITION_FORMATION, flush_instant, pivot_configurations,
-                                   pivot_contacts, pivot_scene, transition_contacts, transition_scene)  # fmt: skip
+from qsplan.hands.found_contacts import polygon_contacts
 from qsplan.hands.segments import flush_angle
 from qsplan.hands.two_finger_scene import hand_geometric_scene
 from qsplan.hands.workpiece import rotation, workpiece_world
@@ -23,6 +20,9 @@ from qsplan.mechanics import QsplanError
 from qsplan.mechanics.model.geometric_scene import find_scene_contacts, scene_from_geometric_scene
 from qsplan.mechanics.model.manipulator import link_poses
 from qsplan.planner.task.task import load_task, task_paths
+
+from tests.reference.paper_pivot import (PIVOT, TRANSITION, flush_instant, pivot_configurations, pivot_contacts,
+                                         pivot_scene, same_contacts, transition_contacts, transition_scene)  # fmt: skip
 
 #: Round-off of closed-form geometry (m, rad): a few ulps of 0.1 m scenes.
 GEOMETRY_ATOL = 1e-12
@@ -53,6 +53,12 @@ def test_flush_instant_reproduces_the_issue_and_an_independent_root():
     assert fi.x == pytest.approx(root, abs=1e-12)
     lim = hand.description.joint_limits
     assert np.all((lim[:, 0] < fi.q) & (fi.q < lim[:, 1]))
+    # the generic search's flush instant (Newton's method on the five gap constraints) is the same configuration
+    from qsplan.hands.pivots import pivot_formations
+
+    pivot, start = pivot_formations(hand)[0]
+    assert (pivot.flush, pivot.edge, pivot.other.vertex) == ("left", fi.edge, fi.right_vertex)
+    np.testing.assert_allclose(start, [*fi.pose, *fi.q], atol=GEOMETRY_ATOL)
 
 
 def test_flush_instant_scene_is_the_polygon_search_scene():
@@ -65,7 +71,7 @@ def test_flush_instant_scene_is_the_polygon_search_scene():
         ref = scene_from_geometric_scene(gs, found)
         for name in ("Wn", "Wt", "Jn", "Jt", "g_obj", "g_man"):
             np.testing.assert_allclose(getattr(scene, name), getattr(ref, name), atol=GEOMETRY_ATOL)
-        assert scene.contact_names == formation(TRANSITION_FORMATION).contact_names
+        assert scene.contact_names == TRANSITION.contact_names
         assert same_contacts(locate_contacts(hand, fi.pose, fi.q, transition_contacts(hand, fi)),
                              polygon_contacts(hand, fi.pose, fi.q))
 
@@ -180,35 +186,8 @@ def test_pivot_contacts_are_the_formation_and_the_polygon_search_agrees():
     c = pivot_configurations(hand, np.radians(np.arange(-1.0, -54.0, -2.0)))
     for i in range(len(c.theta)):
         contacts = pivot_contacts(hand, c.pose[i], c.q[i])
-        assert tuple(s.name for s in contacts) == formation(PIVOT_FORMATION).contact_names
+        assert tuple(s.name for s in contacts) == PIVOT.contact_names
         assert same_contacts(locate_contacts(hand, c.pose[i], c.q[i], contacts), polygon_contacts(hand, c.pose[i], c.q[i]))
-
-
-def test_geometric_events_are_located_where_their_conditions_hold():
-    hand, task = _hand(), _task()
-    sweep = sweep_pivot(hand, task.mu_range, effort_joints=(), limits=task.joint_limits, step=np.radians(1.0))
-    events = {e.name: e for e in sweep.events}
-    # the issue's angles, to the digits it prints
-    assert np.degrees(events["left_tip"].theta) == pytest.approx(-33.04, abs=5e-3)
-    assert np.degrees(events["com"].theta) == pytest.approx(-40.32, abs=5e-3)
-    assert np.degrees(events["right_flush_12"].theta) == pytest.approx(-54.85, abs=5e-3)
-    assert [e.name for e in sweep.events if e.ends] == ["right_flush_12"]
-    assert sweep.configurations.theta[-1] > events["right_flush_12"].theta  # the sweep stops at the formation's end
-    for name in ("left_tip", "com", "right_flush_12"):
-        th = events[name].theta
-        g = [geometric_events(hand, pivot_configurations(hand, [t]), task.joint_limits)[name][2][0]
-             for t in (th + EVENT_TOL, th - EVENT_TOL)]  # fmt: skip
-        assert g[0] * g[1] < 0  # the sign changes within the bracket
-    assert sweep.agrees[1:].all() and not sweep.agrees[0]  # at theta = 0 vertex 0 still touches the palm
-    # the right contact's sliding direction reverses once (it rolls there): its slip speed changes sign in the bracket
-    assert [e.name for e in sweep.events if e.name.startswith("slip_")] == ["slip_right"]
-    th, j = events["slip_right"].theta, formation(PIVOT_FORMATION).contact_names.index("right")
-    speeds = [slip_speeds(hand, pivot_configurations(hand, [t]))[0, j] for t in (th + EVENT_TOL, th - EVENT_TOL)]
-    assert speeds[0] * speeds[1] < 0
-
-
-def test_locate_event_brackets_a_root():
-    assert locate_event(lambda t: t - 0.3, 0.0, 1.0) == pytest.approx(0.3, abs=EVENT_TOL)
 
 
 def test_finger_features_of_the_paper_hand():
@@ -269,31 +248,3 @@ def test_flush_contacts_validation():
     shifted = fi.pose + [0.001, 0.0, 0.0]
     with pytest.raises(QsplanError, match="lies .* m off workpiece edge 3's line"):
         flush_contacts(hand, shifted, fi.q, "left", 3, inner)
-
-
-def test_reorient_validation():
-    hand, fi = _hand(), flush_instant(_hand())
-    with pytest.raises(QsplanError, match="hand: the reorientation mechanics need the paper's form"):
-        flush_instant(_task("two_link_task").hand)
-    with pytest.raises(QsplanError, match=r"edge: expected a workpiece edge in \[0, 4\)"):
-        flush_instant(hand, edge=4)
-    with pytest.raises(QsplanError, match="edge: workpiece edge 1 is not a left side"):
-        flush_instant(hand, edge=1)
-    with pytest.raises(QsplanError, match="theta: expected a finite 1-D array"):
-        pivot_configurations(hand, [np.nan])
-    with pytest.raises(QsplanError, match=r"pivot: expected a workpiece vertex in \[0, 4\)"):
-        pivot_configurations(hand, [0.0], pivot=4)
-    with pytest.raises(QsplanError, match="effort_joint: expected 'left' or 'right'"):
-        transition_scene(hand, fi, "thumb")
-    with pytest.raises(QsplanError, match="theta_rate: expected a nonzero finite rate"):
-        transition_scene(hand, fi, "right", theta_rate=0.0)
-
-
-def test_sweep_validation():
-    hand, task = _hand(), _task()
-    with pytest.raises(QsplanError, match="theta_end, step: expected theta_end < 0"):
-        sweep_pivot(hand, task.mu_range, theta_end=0.1)
-    with pytest.raises(QsplanError, match="resolution: expected a nonnegative torque"):
-        sweep_pivot(hand, task.mu_range, resolution=-1.0)
-    with pytest.raises(QsplanError, match=r"limits: expected \[\[lo, hi\], \[lo, hi\]\]"):
-        sweep_pivot(hand, task.mu_range, limits=[[1.0, 0.0], [0.0, 1.0]])

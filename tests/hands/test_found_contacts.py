@@ -1,19 +1,19 @@
 """Every contact the polygons show, in the canonical order (issue 23: the certifier's and the replay's view of a row in
-any formation): the order against the registered formations, the names, the contact a motion makes, the scene
-against the named contact sets, and the errors."""
+any formation): the order against the paper hand's flush instant and pivot in closed form (tests/reference), the
+names, the contact a motion makes, the scene against the named contact sets, and the errors."""
 
 from __future__ import annotations
 
 import numpy as np
 import pytest
 
-from qsplan.hands.formations import formation
 from qsplan.hands.found_contacts import (contact_names, drawable_contacts, made_contacts, ordered_contacts,
                                          row_contact_scene)  # fmt: skip
-from qsplan.hands.reorient import (PIVOT_FORMATION, TRANSITION_FORMATION, flush_instant, pivot_configurations,
-                                   pivot_scene, transition_scene)  # fmt: skip
 from qsplan.mechanics.errors import QsplanError
 from qsplan.planner.task.task import load_task, task_paths
+
+from tests.reference.paper_pivot import (PIVOT, TRANSITION, flush_instant, pivot_configurations, pivot_scene,
+                                         transition_scene)  # fmt: skip
 
 
 @pytest.fixture(scope="module")
@@ -21,13 +21,13 @@ def hand():
     return load_task(task_paths()["demo_task"]).hand
 
 
-def test_the_canonical_order_is_the_registered_formations(hand):
+def test_the_canonical_order_is_the_closed_form_formations(hand):
     fi = flush_instant(hand)
     at_flush = ordered_contacts(hand, fi.pose, fi.q)
-    assert contact_names(hand, fi.pose, at_flush) == formation(TRANSITION_FORMATION).contact_names
+    assert contact_names(hand, fi.pose, at_flush) == TRANSITION.contact_names
     c = pivot_configurations(hand, [-0.3])
     assert contact_names(hand, c.pose[0], ordered_contacts(hand, c.pose[0], c.q[0])) == \
-        formation(PIVOT_FORMATION).contact_names  # fmt: skip
+        PIVOT.contact_names  # fmt: skip
     # palm-edge: the order of every earlier plan (palm:0, palm:1, left, right), the palm's left to right
     before = (fi.pose + [0.005, 0.0, 0.0], None)
     from qsplan.hands.two_finger import finger_angles

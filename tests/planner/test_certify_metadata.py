@@ -20,6 +20,7 @@ from qsplan.planner import ompl_available, task_paths
 from qsplan.planner.export.schema import INFORMATIONAL, informational_paths, validate
 
 from tests.planner.test_certify_tampering import _read, _run, _write
+from tests.reference.paper_pivot import RETIRED_NAMES
 
 pytestmark = pytest.mark.ompl
 
@@ -165,6 +166,25 @@ def test_every_stated_fact_is_checked(captured, name):
 def test_every_stated_fact_of_a_jaw_plan_is_checked(captured):
     """The same on the parallel jaw's plan (prismatic joints, efforts in N; planned in ~2 s), in the default suite."""
     _every_fact_checked(captured, "parallel_jaw_task")
+
+
+@pytest.mark.parametrize("stated", [*RETIRED_NAMES, "palm_edge"])
+def test_a_pivot_phase_stating_another_formation_is_refused(captured, stated):
+    """The pivot phase of ``reorient_task`` claiming a formation other than its generated pivot's: the retired names of
+    the hand-built route (issue 32: no longer registered) and the palm edge's (registered, other contacts) are
+    refused, naming the field, the claim and what the phase's contacts are."""
+    plan = captured("reorient_task")
+    doc = plan[1]
+    bad = dict(doc, metadata=copy.deepcopy(doc["metadata"]))
+    k, phase = next((k, p) for k, p in enumerate(bad["metadata"]["phases"]) if p.get("phase_kind") == "pivot")
+    assert phase["formation"].startswith("pivot:v1:left:")
+    phase["formation"] = stated
+    found = _metadata_violations(plan, bad)
+    messages = [message for _, kind, message in found if kind == "metadata"]
+    assert any(f"phases[{k}].formation states \"{stated}\"" in m for m in messages), found
+    assert all("np." not in m for m in messages)
+    if stated != "palm_edge":
+        assert any("neither a registered formation (palm_edge) nor a pivot formation" in m for m in messages), found
 
 
 def test_informational_labels_follow_the_schema():

@@ -1,7 +1,8 @@
 """The formation search that turns the workpiece (issue 32): generated formations, either direction, chains of pivots.
 
 - The generic manifold (:mod:`qsplan.hands.manifold`) against the paper hand's closed form, an independent
-  derivation (:func:`qsplan.hands.reorient.pivot_configurations`): poses, joints and their rates.
+  derivation (``tests/reference/paper_pivot.py``): poses, joints and their rates, and where a contact's sliding
+  reverses.
 - The formations a hand and workpiece offer are generated, and named so that a reader (the certifier) can parse them.
 - The demo mirrored (x -> -x) with theta = +0.5 rad plans the mirror image of ``reorient_task``'s plan: counter-
   clockwise on vertex 0, the right finger flush; joint angles ``pi - q`` of the other finger to 1e-9 rad.
@@ -39,7 +40,7 @@ def _task(tmp_path, edits, name="turn.toml"):
 
 def test_the_generic_manifold_is_the_paper_hands_closed_form():
     from qsplan.hands.contact_sets import finger_inner_edge, palm_top_edge
-    from qsplan.hands.reorient import flush_instant, pivot_configurations
+    from tests.reference.paper_pivot import flush_instant, pivot_configurations
 
     hand = load_task(task_paths()["reorient_task"]).hand
     inst = flush_instant(hand)
@@ -56,6 +57,33 @@ def test_the_generic_manifold_is_the_paper_hands_closed_form():
     np.testing.assert_allclose(m.q, ref.q, atol=1e-13)
     np.testing.assert_allclose(m.dc[:, :3], ref.dpose, atol=1e-13)
     np.testing.assert_allclose(m.dc[:, 3:], ref.dq, atol=1e-12)
+
+
+def test_the_generic_slip_reversal_is_the_closed_forms():
+    """Where the generic search cuts the demo's pivot (a contact's sliding reverses, bisected on the generic manifold
+    with the polygons' contacts) the closed form's right contact reverses its sliding (eq. 6 with the closed form's
+    tangent), within the bisection's bracket, and no other contact does."""
+    from qsplan.planner.plan.pivot import REVERSAL_TOL, pivot_geometry
+
+    from tests.reference.paper_pivot import PIVOT, pivot_configurations, pivot_scene
+
+    task = load_task(task_paths()["reorient_task"])
+    hand = task.hand
+    (pivot, start), _ = pivot_formations(hand)
+    geometry = pivot_geometry(task, pivot, start, -0.84)
+    assert geometry.end is None and len(geometry.cuts) == 1
+    cut = geometry.cuts[0]
+    assert np.degrees(cut) == pytest.approx(-45.69, abs=5e-3)
+
+    def slips(theta):
+        c = pivot_configurations(hand, [theta])
+        scene, (dx, dy, dth), (x, y) = pivot_scene(hand, c, 0), c.dpose[0], c.pose[0, :2]
+        nu = np.array([dx + dth * y, dy - dth * x, dth])  # the twist at the world origin per unit theta
+        return scene.Wt.T @ nu - scene.Jt @ c.dq[0]
+
+    # the cut lies on the bracket's far side: the zero is within REVERSAL_TOL before it (the turn is clockwise)
+    before, after = np.sign(slips(cut + 2 * REVERSAL_TOL)), np.sign(slips(cut))
+    assert [PIVOT.contact_names[j] for j in np.flatnonzero(before != after)] == ["right"]
 
 
 def test_the_constraint_jacobian_is_the_gaps_derivative():
