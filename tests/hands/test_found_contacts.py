@@ -70,9 +70,9 @@ def test_the_contact_a_motion_makes_at_its_end(hand):
 
 def test_a_chain_hand_draws_its_grasp_contacts():
     from qsplan.hands.interface import contacts_at
-    from qsplan.planner.plan.scripted import plan_task
+    from tests.planner.bundled import bundled_task, planned
 
-    task = load_task(task_paths()["two_link_task"])
-    first = plan_task(task).phases[0]  # a grasp the chain hand closes (its first row)
+    task = bundled_task("two_link_task")
+    first = planned("two_link_task").phases[0]  # a grasp the chain hand closes (its first row)
     pose, q = first.poses(task.hand.rest_height)[0], first.q[0]
     assert [c.body for c in drawable_contacts(task.hand, pose, q)] == [c.body for c in contacts_at(task.hand, pose, q)]
