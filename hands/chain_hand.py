@@ -93,6 +93,14 @@ class ChainHand:
         """Workpiece pose ``(x, rest height, 0)`` (m, m, rad), shape (3,)."""
         return np.array([float(x), self.rest_height, 0.0])
 
+    def range_fields(self) -> list:
+        """``[(field, value, kind)]``: the workpiece's span and mass, gravity and friction, which a task checks against
+        its plausible ranges (``qsplan.planner.task.fields.TASK_RANGES``); the description's own numbers are checked by
+        its file's ranges (:data:`qsplan.hands.description.model.HAND_RANGES`)."""
+        return [("hand.workpiece (its width or height)", float(np.max(np.ptp(self.workpiece, axis=0))), "size"),
+                ("hand.workpiece_mass", float(self.workpiece_mass), "mass"), ("hand.gravity", float(self.gravity), "gravity"),
+                ("hand.mu", float(self.mu), "friction")]  # fmt: skip
+
 
 def make_chain_hand(description, workpiece, workpiece_mass=0.2, mu=0.2, palm_edge=None) -> ChainHand:
     """Validate and build a :class:`ChainHand`.

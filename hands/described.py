@@ -23,6 +23,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from qsplan.hands.formations import FORMATIONS, Formation, formation as registered_formation
+from qsplan.hands.protocol import JOINT_UNITS
 from qsplan.mechanics.errors import QsplanError
 
 __all__ = ["DescribedHand"]
@@ -31,7 +32,7 @@ __all__ = ["DescribedHand"]
 #: The parameters of the paper hand's form (:class:`qsplan.hands.two_finger.TwoFingerHand`) a described hand of that
 #: form answers (:meth:`DescribedHand.__getattr__`).
 _PAPER_PARAMETERS = frozenset({"finger_base", "finger_length", "finger_width", "finger_mass", "palm_halfwidth",
-                               "palm_thickness", "pivots"})
+                               "pivots"})  # palm_thickness: every hand's (DescribedHand.palm_thickness)
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -142,6 +143,75 @@ class DescribedHand:
         lo, hi = self.description.palm_top
         return float(lo - self.workpiece[0, 0]), float(hi - self.workpiece[1, 0])
 
+    @property
+    def _record(self):
+        """The record whose implementation answers the questions below: the paper's parameters where its closed forms
+        answer (accelerated), else the chain record (the polygon search's reference)."""
+        return self.paper if self.accelerated else self.chain
+
+    @property
+    def finger_joint_names(self) -> tuple:
+        """``(left finger's joints, right finger's joints)``, each a tuple of names from the palm to the tip."""
+        names = self.joint_names
+        return tuple(tuple(names[j] for j in f) for f in self.finger_joints)
+
+    @property
+    def finger_of_joint(self) -> dict:
+        """``{joint name: "left" or "right"}``: the finger each joint belongs to."""
+        return {name: side for side, names in zip(("left", "right"), self.finger_joint_names) for name in names}
+
+    def joint_units(self, quantity: str = "q") -> tuple:
+        """The unit of each joint's ``quantity`` (``"q"``: position, ``"qd"``: velocity, ``"tau"``: effort), in joint
+        order: ``("rad", "m")`` for a revolute and a prismatic joint's positions (:data:`JOINT_UNITS`).
+
+        Raises
+        ------
+        QsplanError
+            Naming ``quantity`` when it is none of those.
+        """
+        if quantity not in JOINT_UNITS["revolute"]:
+            raise QsplanError(f"quantity: expected one of {', '.join(JOINT_UNITS['revolute'])}; got {quantity!r}")
+        return tuple(JOINT_UNITS[k][quantity] for k in self.joint_kinds)
+
+    def joint_unit(self, joint: str, quantity: str = "q") -> str:
+        """The unit of joint ``joint``'s ``quantity`` (:meth:`joint_units`): a jaw's effort in N, a finger's in N m."""
+        return self.joint_units(quantity)[self.joint_names.index(joint)]
+
+    @property
+    def palm_thickness(self) -> float:
+        """How far (m) the palm reaches below its top ``y = 0``: the paper's parameter, else ``-min y`` of the palm."""
+        from qsplan.hands.interface import palm_thickness
+
+        return palm_thickness(self._record)
+
+    @property
+    def finger_reach(self) -> float:
+        """A characteristic finger length (m): the paper's finger length; else the longer finger's sum, over its links,
+        of the farthest link vertex from the link's frame origin (the scale of drawn normals, a sweep's joint step)."""
+        from qsplan.hands.interface import finger_reach
+
+        return finger_reach(self._record)
+
+    def joint_axes(self, q) -> np.ndarray:
+        """World position (m) of each joint's frame origin at ``q`` (n_j,), shape (n_j, 2): a revolute joint's axis,
+        where a prismatic joint's link frame sits at ``q_i = 0``.  The paper's fingers turn about fixed pivots."""
+        from qsplan.hands.interface import joint_axes
+
+        return joint_axes(self._record, q)
+
+    def range_fields(self) -> list:
+        """``[(field, value, kind)]``: the numbers a task checks against its plausible ranges: the paper's parameters
+        where its closed forms answer (:meth:`qsplan.hands.two_finger.TwoFingerHand.range_fields`), and every hand's
+        workpiece span and mass, gravity and friction (:meth:`qsplan.hands.chain_hand.ChainHand.range_fields`)."""
+        return self._record.range_fields()
+
+    def description_table(self) -> dict:
+        """The description as a plain table in the hand-file format (:mod:`qsplan.hands.description.files`): ``name``,
+        ``gravity``, ``palm``, ``fingers`` (:func:`qsplan.hands.description.files.hand_from_table` reads it back)."""
+        from qsplan.hands.interface import description_table
+
+        return description_table(self.description)
+
     def _closed_forms(self, formation) -> bool:
         return self.accelerated and formation == FORMATIONS["palm_edge"]
 
@@ -153,7 +223,7 @@ class DescribedHand:
         """World polygons (m): ``{"palm", "workpiece", <joint name>...}`` -> (k, 2), at ``pose`` (3,) and ``q`` (n_j,)."""
         from qsplan.hands.interface import hand_body_polygons
 
-        return hand_body_polygons(self.paper if self.accelerated else self.chain, pose, q)
+        return hand_body_polygons(self._record, pose, q)
 
     def grasp_candidates(self, formation="palm_edge", free=None, xs=None) -> tuple:
         """The grasps the planner's tables consider.
@@ -255,22 +325,21 @@ class DescribedHand:
 
         if method not in ("auto", "generic"):
             raise QsplanError(f"method: expected 'auto' or 'generic'; got {method!r}")
-        return scene_at(self.paper if self.accelerated else self.chain, pose, q, effort_controlled, velocity, effort,
-                        mu, method)  # fmt: skip
+        return scene_at(self._record, pose, q, effort_controlled, velocity, effort, mu, method)
 
     def collide(self, poses, q) -> np.ndarray:
         """Whether any two bodies overlap beyond their tolerance at each state (housings respected): ``poses`` (n, 3),
         ``q`` (n, n_j) -> bool (n,) (:func:`qsplan.hands.collision.find_collisions_batch`)."""
         from qsplan.hands.collision import find_collisions_batch
 
-        return find_collisions_batch(self.paper if self.accelerated else self.chain, poses, q)
+        return find_collisions_batch(self._record, poses, q)
 
     def collisions(self, pose, q, first: bool = False) -> list:
         """The overlapping body pairs at ``pose`` (3,), ``q`` (n_j,), named
         (:func:`qsplan.hands.collision.find_collisions`)."""
         from qsplan.hands.collision import find_collisions
 
-        return find_collisions(self.paper if self.accelerated else self.chain, pose, q, first)
+        return find_collisions(self._record, pose, q, first)
 
     def opening(self, grasp, x, q) -> np.ndarray:
         """Each joint's opening direction (-1, 0, +1), shape (n_j,), releasing ``grasp`` with the workpiece at ``x`` (m)

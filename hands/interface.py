@@ -1,7 +1,9 @@
-"""Any planar two-finger hand, one dispatch place: the paper's hand and described chain hands (issue 15).
+"""The hand records' answers, one dispatch place: the paper's hand and described chain hands (issue 15).
 
-Everything downstream of the planner (export, collisions, the certifier, the replay, the plots) asks
-its questions about a hand here, and nowhere else: a
+The planner does not ask here (issue 32): it asks the :class:`~qsplan.hands.protocol.Hand` protocol, whose one
+implementation, :class:`~qsplan.hands.described.DescribedHand`, knows which record answers it (the paper's where
+its closed forms answer, else its chain record) and hands that record to the functions below.  They take a record
+(or a described hand, answered by its record) and dispatch on its type: a
 :class:`~qsplan.hands.two_finger.TwoFingerHand` (two single-link revolute fingers ``"left"`` and
 ``"right"``, Fig. 9) is answered by exactly the code that answered it before (its cached
 manipulator, :func:`~qsplan.hands.two_finger_scene.hand_polygons`,
@@ -22,6 +24,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from qsplan.hands.protocol import JOINT_UNITS
 from qsplan.mechanics.errors import QsplanError
 
 __all__ = [
@@ -46,9 +49,6 @@ __all__ = [
     "scene_at",
 ]
 
-#: Units of a joint's position (``q``), velocity (``qd``) and effort (``tau``), by joint kind (SI).
-JOINT_UNITS = {"revolute": {"q": "rad", "qd": "rad/s", "tau": "N m"},
-               "prismatic": {"q": "m", "qd": "m/s", "tau": "N"}}  # fmt: skip
 
 
 def _record(hand):
@@ -229,18 +229,10 @@ def range_fields(hand) -> list:
     """``[(field, value, kind)]``: the hand's numbers a task checks against its plausible ranges (``kind`` a key of
     ``qsplan.planner.task.fields.TASK_RANGES``): the paper's parameters when given so (finger sizes and mass, the
     palm), and for every hand the workpiece's span, mass, gravity and friction (a described hand's own numbers are
-    checked by its file's ranges, :data:`qsplan.hands.description.model.HAND_RANGES`)."""
-    hand = _record(hand)
-    out = []
-    if not _check(hand):
-        out += [(f"hand.{name}", float(getattr(hand, name)), "size")
-                for name in ("finger_base", "finger_length", "finger_width", "palm_halfwidth", "palm_thickness")]  # fmt: skip
-    out.append(("hand.workpiece (its width or height)", float(np.max(np.ptp(hand.workpiece, axis=0))), "size"))
-    out.append(("hand.workpiece_mass", float(hand.workpiece_mass), "mass"))
-    if not _check(hand):
-        out.append(("hand.finger_mass", float(hand.finger_mass), "finger_mass"))
-    out += [("hand.gravity", float(hand.gravity), "gravity"), ("hand.mu", float(hand.mu), "friction")]
-    return out
+    checked by its file's ranges, :data:`qsplan.hands.description.model.HAND_RANGES`); each record answers its own
+    (:meth:`qsplan.hands.two_finger.TwoFingerHand.range_fields`, :meth:`qsplan.hands.chain_hand.ChainHand.range_fields`)."""
+    _check(_record(hand))
+    return _record(hand).range_fields()
 
 
 def palm_thickness(hand) -> float:

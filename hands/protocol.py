@@ -6,8 +6,9 @@ bottom edge on the palm and one contact per finger, each finger's last joint clo
 :class:`qsplan.mechanics.motion.system.MotionSystem` is for finite motions): body polygons at a
 configuration, the grasps worth considering, the grasp's configurations along the palm
 (:class:`GraspStates`: closed joints, contacts, joint rates), their scenes' arrays batched
-(:class:`GraspSceneArrays`, eqs. 1-5), one scene, collisions, opening directions, metadata.  Its one
-implementation is :class:`qsplan.hands.described.DescribedHand`.
+(:class:`GraspSceneArrays`, eqs. 1-5), one scene, collisions, opening directions, metadata, and the joints'
+units, fingers and axes, the scales a drawing takes and the numbers a task checks (issue 32: the planner asks a
+hand through this protocol only).  Its one implementation is :class:`qsplan.hands.described.DescribedHand`.
 
 :class:`ChainGrasp` is a grasp of any described hand: per finger the contact key ``(link, kind, feature)``
 the closing gives (:class:`FingerContact`) and the free joints' values; the paper's hand keeps its
@@ -24,13 +25,18 @@ import numpy as np
 
 from qsplan.hands.grasps import parse_goal
 
-__all__ = ["CONTACT_KINDS", "ChainGrasp", "FingerContact", "GraspSceneArrays", "GraspStates", "Hand", "SlideMotion",
-           "STATE_REASONS",
+__all__ = ["CONTACT_KINDS", "ChainGrasp", "FingerContact", "GraspSceneArrays", "GraspStates", "Hand", "JOINT_UNITS",
+           "SlideMotion", "STATE_REASONS",
            "NO_CONTACT", "OTHER_CONTACT", "FLUSH", "NO_PLACEMENT", "SINGULAR"]
 
 #: A finger contact's kind: ``"vertex"``, a workpiece vertex on a link edge; ``"edge"``, a link vertex (a corner)
 #: on a workpiece edge (:class:`qsplan.hands.closing.ClosedFinger`).
 CONTACT_KINDS = ("vertex", "edge")
+
+#: Units of a joint's position (``q``), velocity (``qd``) and effort (``tau``), by joint kind (SI):
+#: :meth:`Hand.joint_units` reads it.
+JOINT_UNITS = {"revolute": {"q": "rad", "qd": "rad/s", "tau": "N m"},
+               "prismatic": {"q": "m", "qd": "m/s", "tau": "N"}}  # fmt: skip
 
 #: Why a state of :class:`GraspStates` is not a configuration of its grasp (``GraspStates.reason``; 0 where it is).
 NO_CONTACT, OTHER_CONTACT, FLUSH, NO_PLACEMENT, SINGULAR = 1, 2, 3, 4, 5
@@ -329,6 +335,19 @@ class Hand(Protocol):
         The hand's joint ranges (rad or m) and speeds (rad/s or m/s); None for the paper's hand given by its parameters.
     accelerated : bool
         Whether the paper's closed forms answer (decided once at construction).
+    finger_joint_names : (tuple of str, tuple of str)
+        Each finger's joint names, base to tip: left, right.
+    finger_of_joint : dict
+        ``{joint name: "left" or "right"}``.
+    finger_reach : float
+        A characteristic finger length (m), the scale of drawn normals and of a sweep's joint step: the paper's
+        finger length; else the longer finger's sum, over its links, of the farthest link vertex from the link's frame.
+    palm_thickness : float
+        How far (m) the palm reaches below its top ``y = 0``.
+    user_vertices, user_edges : ndarray of int, shape (k,)
+        The user's number of each internal vertex and edge.
+    simulation_travel : float or None
+        Largest workpiece travel (m) per step of a finite-motion simulation of this hand (None: no bound).
     """
 
     name: str
@@ -349,6 +368,13 @@ class Hand(Protocol):
     palm: np.ndarray
     own_limits: tuple | None
     accelerated: bool
+    finger_joint_names: tuple
+    finger_of_joint: dict
+    finger_reach: float
+    palm_thickness: float
+    user_vertices: np.ndarray
+    user_edges: np.ndarray
+    simulation_travel: float | None
 
     def pose(self, x) -> np.ndarray:
         """Workpiece pose ``(x, rest_height, 0)`` (m, m, rad), shape (3,)."""
@@ -391,5 +417,25 @@ class Hand(Protocol):
         """Each joint's opening direction (-1, 0, +1), shape (n_j,), releasing ``grasp`` at workpiece ``x``, joints ``q``
         (n_j,)."""
 
+    def joint_units(self, quantity: str = "q") -> tuple:
+        """The unit of each joint's ``quantity`` (``"q"``, ``"qd"``, ``"tau"``), in joint order (:data:`JOINT_UNITS`)."""
+
+    def joint_unit(self, joint: str, quantity: str = "q") -> str:
+        """The unit of joint ``joint``'s ``quantity`` (:meth:`joint_units`): a jaw's effort in N, a finger's in N m."""
+
+    def joint_axes(self, q) -> np.ndarray:
+        """World position (m) of each joint's frame origin at ``q`` (n_j,), shape (n_j, 2)."""
+
+    def range_fields(self) -> list:
+        """``[(field, value, kind)]``: the numbers a task checks against its plausible ranges (``kind`` a key of
+        ``qsplan.planner.task.fields.TASK_RANGES``)."""
+
+    def description_table(self) -> dict:
+        """The hand's description as a plain table in the hand-file format (:mod:`qsplan.hands.description.files`)."""
+
+    def reclose(self, pose, q_planned, planned_pose) -> np.ndarray:
+        """The plan's grasp (joints ``q_planned`` (n_j,) at ``planned_pose`` (3,)) closed again on the workpiece at
+        ``pose`` (3,): the joints (n_j,)."""
+
     def metadata(self) -> dict:
-        """The hand as a plan's metadata records it (:func:`qsplan.hands.described.hand_from_metadata` reads it)."""
+        """The hand as a plan's metadata records it (:func:`qsplan.hands.described_build.hand_from_metadata` reads it)."""

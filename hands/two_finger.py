@@ -114,6 +114,17 @@ class TwoFingerHand:
         """Joint axes in the world (m), shape (2, 2): left, right."""
         return np.array([[-self.finger_base, 0.0], [self.finger_base, 0.0]])
 
+    def range_fields(self) -> list:
+        """``[(field, value, kind)]``: the numbers a task checks against its plausible ranges (``kind`` a key of
+        ``qsplan.planner.task.fields.TASK_RANGES``): the finger sizes and the palm, the workpiece's span and mass, the
+        finger mass, gravity and friction, in that order (the first out of range is the one reported)."""
+        out = [(f"hand.{name}", float(getattr(self, name)), "size")
+               for name in ("finger_base", "finger_length", "finger_width", "palm_halfwidth", "palm_thickness")]  # fmt: skip
+        out.append(("hand.workpiece (its width or height)", float(np.max(np.ptp(self.workpiece, axis=0))), "size"))
+        out.append(("hand.workpiece_mass", float(self.workpiece_mass), "mass"))
+        out.append(("hand.finger_mass", float(self.finger_mass), "finger_mass"))
+        return out + [("hand.gravity", float(self.gravity), "gravity"), ("hand.mu", float(self.mu), "friction")]
+
 
 def _positive(value, field, unit, allow_zero=False) -> float:
     try:

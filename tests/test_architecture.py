@@ -306,6 +306,81 @@ def test_the_hand_type_check_finds_branches(tmp_path):
                                                                        "qsplan.planner.plan.c"]  # fmt: skip
 
 
+#: The module the planner asked its questions about a hand through before issue 32 (it dispatches on the hand records'
+#: types): the planner asks the :class:`qsplan.hands.protocol.Hand` protocol instead.
+HAND_DISPATCH = "qsplan.hands.interface"
+
+
+def _interface_importers(modules=None) -> list:
+    """Every ``qsplan.planner`` module importing :data:`HAND_DISPATCH` (or a name of it), imports inside functions
+    counted, as ``module imports target``."""
+    out = []
+    for name, path in (MODULES if modules is None else modules).items():
+        if name.startswith("qsplan.planner"):
+            out += [f"{name} imports {t}" for t, n in _imports(name, path)
+                    if HAND_DISPATCH in (t, f"{t}.{n}") or t.startswith(HAND_DISPATCH + ".")]  # fmt: skip
+    return out
+
+
+def test_the_planner_does_not_import_the_hand_dispatch():
+    assert _interface_importers() == []
+
+
+def test_the_dispatch_import_check_finds_imports(tmp_path):
+    sources = {"qsplan.planner.plan.a": "def f(h):\n    from qsplan.hands.interface import joint_names\n",
+               "qsplan.planner.plan.b": "import qsplan.hands.interface as i\n",
+               "qsplan.planner.plan.c": "from qsplan.hands import interface\n",
+               "qsplan.planner.plan.d": "# from qsplan.hands.interface import scene_at\nX = 'qsplan.hands.interface'\n",
+               "qsplan.hands.e": "from qsplan.hands.interface import scene_at\n"}  # fmt: skip
+    modules = {}
+    for name, text in sources.items():
+        modules[name] = tmp_path / f"{name}.py"
+        modules[name].write_text(text)
+    assert [f.split(" ")[0] for f in _interface_importers(modules)] == ["qsplan.planner.plan.a", "qsplan.planner.plan.b", "qsplan.planner.plan.c"]
+
+
+def _protocol_members() -> set:
+    """The :class:`qsplan.hands.protocol.Hand` protocol's attributes and methods, read from its source."""
+    tree = ast.parse(MODULES["qsplan.hands.protocol"].read_text())
+    cls = next(n for n in tree.body if isinstance(n, ast.ClassDef) and n.name == "Hand")
+    return {n.target.id for n in cls.body if isinstance(n, ast.AnnAssign)} | \
+        {n.name for n in cls.body if isinstance(n, ast.FunctionDef)}
+
+
+def _hand_questions(modules=None) -> dict:
+    """``{attribute: [module:line, ...]}``: every attribute the planner reads on a hand (a name ``hand``, or any
+    ``<...>.hand``: ``task.hand``, ``plan.task.hand``, ``self.hand``)."""
+    out = {}
+    for name, path in (MODULES if modules is None else modules).items():
+        if not name.startswith("qsplan.planner"):
+            continue
+        for node in ast.walk(ast.parse(path.read_text(), filename=str(path))):
+            if isinstance(node, ast.Attribute) and isinstance(node.ctx, ast.Load):
+                v = node.value
+                if (isinstance(v, ast.Name) and v.id == "hand") or (isinstance(v, ast.Attribute) and v.attr == "hand"):
+                    out.setdefault(node.attr, []).append(f"{name}:{node.lineno}")
+    return out
+
+
+def test_the_planner_asks_a_hand_only_what_the_protocol_answers():
+    questions = _hand_questions()
+    assert {"joint_units", "body_polygons", "scene", "finger_joint_names", "metadata"} <= set(questions)  # it looks
+    assert {q: w for q, w in questions.items() if q not in _protocol_members()} == {}
+
+
+def test_the_question_check_finds_questions_outside_the_protocol(tmp_path):
+    sources = {"qsplan.planner.plan.a": "def f(task):\n    return task.hand.chain_polygons(0), task.hand.joint_names\n",
+               "qsplan.planner.plan.b": "def f(hand):\n    return hand.finger_length\n",
+               "qsplan.hands.c": "def f(hand):\n    return hand.paper\n"}  # fmt: skip
+    modules = {}
+    for name, text in sources.items():
+        modules[name] = tmp_path / f"{name}.py"
+        modules[name].write_text(text)
+    questions = _hand_questions(modules)
+    assert set(questions) == {"chain_polygons", "joint_names", "finger_length"}
+    assert {q for q in questions if q not in _protocol_members()} == {"chain_polygons", "finger_length"}
+
+
 def test_no_private_name_crosses_a_module_boundary():
     crossings = [
         f"{name} imports {imported} from {target}"

@@ -84,9 +84,7 @@ def band_checks(task, cols, k, rb) -> list:
     tau, lo, hi = (float(cols[f"tau_{e}{s}"][k]) for s in ("", "_min", "_max"))
     if not (math.isfinite(tau) and not math.isnan(lo) and not math.isnan(hi)):
         return []  # no command or band: the torque check names it
-    from qsplan.hands.interface import joint_names, joint_unit
-
-    unit = joint_unit(task.hand, e, "tau") if e in joint_names(task.hand) else "N m"
+    unit = task.hand.joint_unit(e, "tau") if e in task.hand.joint_names else "N m"
     out = []
     if not rb.feasible:
         out.append(("band", f"no guaranteed band exists here (recomputed: {rb.reason}); the file claims "

@@ -4,7 +4,7 @@ A plan that exits 0 promises that it is physically possible, and a controller ma
 :func:`certify_plan` checks every fact the export states (``plan.csv`` and ``plan.json``, written by
 :func:`qsplan.planner.export.plan_files.export_plan`) independently of the planner's bookkeeping: every row is
 rebuilt from the task (the hand's polygons, the row's joint positions and workpiece pose; the paper's hand or a
-described chain hand, :mod:`qsplan.hands.interface`).  :data:`CHECKS` says what each kind of check covers:
+described chain hand, asked through :class:`qsplan.hands.protocol.Hand`).  :data:`CHECKS` says what each kind of check covers:
 
 * the files (:mod:`~qsplan.planner.certify.files`): both present files hold the same cells, the JSON
   follows its schema, and its metadata (friction, resolution, force margin, limits, hand, phases, narrowest band)
@@ -282,9 +282,7 @@ def certify_plan(plan, task, *, n_random: int = 8, seed: int = 0, force_margin: 
     if not (isinstance(force_margin, (int, float)) and math.isfinite(force_margin) and force_margin >= 0):
         raise QsplanError(f"force_margin: expected a nonnegative finite number (N); got {force_margin!r}")
     start = time.perf_counter()
-    from qsplan.hands.interface import joint_names
-
-    names = joint_names(task.hand)
+    names = task.hand.joint_names
     sources = plan_sources(plan)
     read = [read_plan_file(p) for p in sources]
     for p, (cols_p, _) in zip(sources, read):

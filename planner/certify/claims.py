@@ -89,9 +89,7 @@ def _phase_rows(cols, i) -> np.ndarray:
 
 def _effort_ok(task, cols, rows) -> bool:
     """Every row names one of the hand's joints as its effort joint (else the input check names it)."""
-    from qsplan.hands.interface import joint_names
-
-    names = set(joint_names(task.hand))
+    names = set(task.hand.joint_names)
     return all(str(cols["effort_joint"][k]) in names for k in rows)
 
 
@@ -160,9 +158,7 @@ def _phase_kind(cols, rows, names) -> str:
 
 def phase_claims(phases, task, cols, evidence) -> list:
     """Each ``metadata.phases`` entry against its rows and ``evidence`` (the module docstring)."""
-    from qsplan.hands.interface import joint_names, joint_unit
-
-    names = joint_names(task.hand)
+    names = task.hand.joint_names
     ph = np.asarray(cols["phase"], float)
     if not isinstance(phases, list) or not np.all(np.isfinite(ph)) or len(phases) != int(np.max(ph)) + 1:
         count = int(np.max(ph)) + 1 if np.all(np.isfinite(ph)) else "unnumbered"
@@ -179,7 +175,7 @@ def phase_claims(phases, task, cols, evidence) -> list:
             out.append((int(rows[0]), "metadata", f"{path} is not an object"))
             continue
         out += [(int(rows[0]), "metadata", m) for m in _core(d, cols, rows, path)]
-        out += [(int(rows[0]), "metadata", m) for m in _more(d, task, cols, rows, path, evidence, names, joint_unit)]
+        out += [(int(rows[0]), "metadata", m) for m in _more(d, task, cols, rows, path, evidence, names)]
     return out
 
 
@@ -214,7 +210,7 @@ def _core(d, cols, rows, path) -> list:
 _CORE = frozenset({"index", "rows", "t_start_s", "t_end_s", "kind", "mode", "effort_joint", "narrowest_band"})
 
 
-def _more(d, task, cols, rows, path, evidence, names, joint_unit) -> list:
+def _more(d, task, cols, rows, path, evidence, names) -> list:
     """The rest of a phase's claims (the module docstring), each against the rows or ``evidence``."""
     contact = str(cols["mode"][rows[0]]) != "free"
     truth, out = {}, []
@@ -226,7 +222,7 @@ def _more(d, task, cols, rows, path, evidence, names, joint_unit) -> list:
     if not contact:
         truth["x_workpiece_m"] = float(cols["x_workpiece"][rows[0]])
     elif _effort_ok(task, cols, rows):
-        truth["effort_unit"] = joint_unit(task.hand, str(cols["effort_joint"][rows[0]]), "tau")
+        truth["effort_unit"] = task.hand.joint_unit(str(cols["effort_joint"][rows[0]]), "tau")
         truth["phase_kind"] = _phase_kind(cols, rows, names)
         truth["command"] = _command(cols, rows)
     else:
@@ -328,11 +324,9 @@ def _speed_claims(claim, task, cols, rows, path, names) -> list:
 
 def sequence_claims(sequence, phases, task, cols, evidence) -> list:
     """``metadata.sequence`` against the phases' rows (the module docstring)."""
-    from qsplan.hands.interface import joint_names, joint_unit
-
     if not isinstance(sequence, list) or not all(isinstance(s, dict) for s in sequence):
         return [(None, "metadata", "metadata.sequence is not a list of steps")]
-    names = joint_names(task.hand)
+    names = task.hand.joint_names
     ph = np.asarray(cols["phase"], float)
     n_phases = int(np.max(ph)) + 1 if np.all(np.isfinite(ph)) else 0
     steps = [(j, s) for j, s in enumerate(sequence) if s.get("kind") not in INFORMATIONAL_STEPS]
@@ -362,7 +356,7 @@ def sequence_claims(sequence, phases, task, cols, evidence) -> list:
             unknown |= {"effort_joint", "effort_unit", "narrowest_band", "torque_from", "torque_to", "proved_interval"}
         elif contact:
             e = str(cols["effort_joint"][rows[0]])
-            truth.update(effort_joint=e, effort_unit=joint_unit(task.hand, e, "tau"))
+            truth.update(effort_joint=e, effort_unit=task.hand.joint_unit(e, "tau"))
             _, w = narrowest(cols, rows)
             tau = np.asarray(cols[f"tau_{e}"], float)[rows]
             ends = {"slide": ("x_from", "x_to", x), "hold": ("torque_from", "torque_to", tau),

@@ -28,10 +28,9 @@ def _same_phase(cols, a, b) -> bool:
 
 
 def _configuration(task, cols, k):
-    from qsplan.hands.interface import joint_names
     from qsplan.planner.certify.rows import row_pose, row_q
 
-    return row_pose(cols, k), row_q(cols, k, joint_names(task.hand))
+    return row_pose(cols, k), row_q(cols, k, task.hand.joint_names)
 
 
 def hold_row(cols, k) -> bool:

@@ -73,7 +73,6 @@ def metadata_checks(meta, task, cols, evidence=None) -> list:
     :mod:`qsplan.planner.certify.claims`).  Not checked, the keys the schema labels informational: ``source``,
     ``task``, ``planner``, ``narrowest_band.phase``, ``hand.description_source``, ``task_record.name`` and those of
     :mod:`~qsplan.planner.certify.claims`."""
-    from qsplan.hands.interface import hand_metadata
     from qsplan.planner.certify.claims import RowEvidence, phase_claims, sequence_claims
     from qsplan.planner.export.plan_files import (command_metadata, disturbance_metadata, force_margin_metadata,
                                                   friction_metadata, plan_metadata_limits,
@@ -95,11 +94,11 @@ def metadata_checks(meta, task, cols, evidence=None) -> list:
             raise KeyError(lacking[0])
         claim(close(meta["torque_resolution_N_m"], task.torque_resolution),
               f"torque resolution {meta['torque_resolution_N_m']} is not the task's {task.torque_resolution:g}")
-        hand = hand_metadata(task.hand)
-        hand.pop("description_source", None)  # where the description was read from: not a fact of the plan
+        recorded = task.hand.metadata()
+        recorded.pop("description_source", None)  # where the description was read from: not a fact of the plan
         for key, truth in (("friction", friction_metadata(task)), ("force_margin", force_margin_metadata(task)),
                            ("command", command_metadata(task)), ("time_scaling", time_scaling_metadata(task)),
-                           ("limits", plan_metadata_limits(task)), ("hand", hand),
+                           ("limits", plan_metadata_limits(task)), ("hand", recorded),
                            ("task_tables", task_tables(task)), ("formation", task.formation.as_dict()),
                            ("task_record", task_record(task))):  # fmt: skip
             if key in meta:

@@ -1,6 +1,6 @@
 """The mode check of the plan certifier (:mod:`qsplan.planner.certify.certify`): the planned mode, alone.
 
-:func:`mode_checks` rebuilds a row's scene from the task (:func:`qsplan.hands.interface.scene_at`:
+:func:`mode_checks` rebuilds a row's scene from the task (:meth:`qsplan.hands.protocol.Hand.scene`:
 the effort-controlled joints those with a torque command, the others driven at their ``qd``)
 and asks which modes its commands make feasible at every friction vector to test, with the
 mechanics' :func:`qsplan.mechanics.solve_many` (the kinematic stage once, the equilibrium and
@@ -118,7 +118,7 @@ def _under_msg(msg, w) -> str:
 
 
 def row_scene(task, cols, k, judged=None):
-    """The scene of in-contact row ``k`` rebuilt from the task (:func:`qsplan.hands.interface.scene_at`): the joints
+    """The scene of in-contact row ``k`` rebuilt from the task (:meth:`qsplan.hands.protocol.Hand.scene`): the joints
     with a torque command (and the row's ``effort_joint``) effort-controlled at it, the others at their ``qd`` (a row
     at rest: the direction of the motion that leaves or reaches it, :func:`qsplan.planner.certify.timing.row_velocity`).
 
@@ -127,11 +127,9 @@ def row_scene(task, cols, k, judged=None):
     QsplanError
         When the row's polygons give no four-contact grasp.
     """
-    from qsplan.hands.interface import joint_names, scene_at
-
     from qsplan.planner.certify.rows import row_pose, row_q
 
-    names = joint_names(task.hand)
+    names = task.hand.joint_names
     tau = np.array([cols[f"tau_{n}"][k] for n in names], dtype=float)
     effort = np.isfinite(tau) | (np.array(names) == str(cols["effort_joint"][k]))
     qd = np.array([cols[f"qd_{n}"][k] for n in names], dtype=float)
@@ -147,7 +145,7 @@ def row_scene(task, cols, k, judged=None):
     # method="generic": contacts found by polygon contact finding, the reference path, not the
     # closed-form grasp the planner uses (qsplan.hands.two_finger_analytic): a certifier shares no
     # shortcut with what it certifies (~2 ms per row); a chain hand's contacts are always found so
-    return scene_at(task.hand, row_pose(cols, k), row_q(cols, k, names), effort, qd, effort=tau, method="generic")
+    return task.hand.scene(row_pose(cols, k), row_q(cols, k, names), effort, qd, effort=tau, method="generic")
 
 
 def mode_misfit(scene, mode: str) -> str | None:
@@ -168,13 +166,11 @@ def slip_velocities(task, cols, k, scene):
     """Each contact's tangential velocity (m/s, shape (n_c,); eq. 6: ``W_t^T nu - J_t thetadot``) at row ``k`` from the
     rows' own motion: finite differences of the workpiece pose and every joint to the next row of the phase (the
     previous one at its end); None when the phase has one row."""
-    from qsplan.hands.interface import joint_names
-
     from qsplan.planner.certify.rows import row_pose, row_q
 
     t, ph = cols["t"], cols.get("phase")
     same = (lambda i: ph[i] == ph[k]) if ph is not None else (lambda i: cols["mode"][i] != "free")
-    names = joint_names(task.hand)
+    names = task.hand.joint_names
     for a, b in ((k, k + 1), (k - 1, k)):
         if 0 <= a and b < t.size and same(a) and same(b) and t[b] > t[a]:
             dt = float(t[b] - t[a])

@@ -85,14 +85,12 @@ def touched_features(task, bodies, finger: int) -> set:
     for a workpiece vertex on one of its links, ``("edge", K)`` for a link corner on workpiece edge ``K``."""
     from shapely.geometry import LineString, Point
 
-    from qsplan.hands.interface import finger_joint_names
-
     polys = bodies["polys"]
     wp = polys["workpiece"]
     W = np.asarray(wp.exterior.coords)[:-1]
     edges = [LineString([W[e], W[(e + 1) % len(W)]]) for e in range(len(W))]
     out = set()
-    for name in finger_joint_names(task.hand)[finger]:
+    for name in task.hand.finger_joint_names[finger]:
         link = polys[name]
         if link.distance(wp) > FEATURE_TOL:
             continue
@@ -126,8 +124,6 @@ def _finger_claims(task, bodies, wanted, where: str, row: int) -> list:
 
 def endpoint_checks(task, cols, first_bodies, last_bodies) -> list:
     """The first row is the task's start, the last its goal; a scripted task's stretches end at its waypoints."""
-    from qsplan.hands.interface import joint_names
-
     x, n = cols["x_workpiece"], cols["t"].size
     out = []
     if abs(x[0] - task.start_x) > ENDPOINT_TOL:
@@ -135,7 +131,7 @@ def endpoint_checks(task, cols, first_bodies, last_bodies) -> list:
     free = bool(task.hand.free_joints)  # a hand with free joints starts from them; the others from features
     out += _finger_claims(task, first_bodies, (None, None) if free else task.start_features, "start", 0)
     if free and task.start_joints is not None:
-        names = joint_names(task.hand)
+        names = task.hand.joint_names
         for j in task.hand.free_joints:
             q0 = cols[f"q_{names[j]}"][0]
             if abs(q0 - task.start_joints[j]) > ENDPOINT_TOL:
@@ -230,19 +226,17 @@ def _reach(man) -> np.ndarray:
 
 def free_path_checks(task, cols, k, roots) -> list:
     """Overlaps along the straight joint-space line from free row ``k`` to row ``k + 1`` (both free, one phase)."""
-    from qsplan.hands.interface import finger_joint_names, joint_names, manipulator_of
-
     from qsplan.planner.certify.rows import bodies_at, body_overlaps, row_pose, row_q
 
-    names = joint_names(task.hand)
+    names = task.hand.joint_names
     q0, q1 = row_q(cols, k, names), row_q(cols, k + 1, names)
     dq = q1 - q0
-    man = manipulator_of(task.hand)
+    man = task.hand.manipulator
     # a prismatic joint's travel moves the links after it further out: bound it by its largest extension
     extra = sum(max(abs(a), abs(b)) for (a, b), jt in zip(task.joint_limits, man.joints) if jt.kind == "prismatic")
     step = np.abs(dq) * (_reach(man) + extra * np.array([jt.kind == "revolute" for jt in man.joints]))
     # each finger is one body chain: its points move at most the sum over its joints (the fingers move independently)
-    travel = max(float(np.sum(step[[names.index(n) for n in chain]])) for chain in finger_joint_names(task.hand))
+    travel = max(float(np.sum(step[[names.index(n) for n in chain]])) for chain in task.hand.finger_joint_names)
     n = max(1, math.ceil(travel / FREE_PATH_STEP))
     pose = row_pose(cols, k)
     for s in range(1, n):

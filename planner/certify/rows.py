@@ -4,7 +4,7 @@ Every function here takes the task, the plan's columns (``{name: ndarray}`` as
 :func:`qsplan.planner.export.plan_files.read_plan_csv` returns them) and a row
 index, and returns ``(kind, message)`` pairs: nothing of the planner's own
 validity checker or band computation is used.  The geometry comes from the
-hand's polygons (:func:`qsplan.hands.interface.hand_body_polygons`: the paper's hand or any
+hand's polygons (:meth:`qsplan.hands.protocol.Hand.body_polygons`: the paper's hand or any
 described chain hand, every joint of it); the mechanics of a row (the mode check) is in
 :mod:`qsplan.planner.certify.modes`.  Units SI (m, rad, s, N, N m; a prismatic joint's
 positions, speeds and efforts in m, m/s and N).
@@ -94,10 +94,8 @@ def joint_housings(hand) -> dict:
     """
     from shapely.geometry import Point
 
-    from qsplan.hands.interface import joint_axes, manipulator_of
-
-    man = manipulator_of(hand)
-    axes = joint_axes(hand, np.zeros(man.n_joints))
+    man = hand.manipulator
+    axes = hand.joint_axes(np.zeros(man.n_joints))
     out = {}
     for j, joint in enumerate(man.joints):
         if joint.kind != "revolute" or joint.link_shape is None:
@@ -117,24 +115,20 @@ def row_bodies(task, cols, k, roots=None) -> dict:
     ``roots``: :func:`joint_housings` of the task's hand, when already built (a joint on a moving link gets its
     disk about its axis at the row's joint positions).
     """
-    from qsplan.hands.interface import joint_names
-
-    return bodies_at(task, row_pose(cols, k), row_q(cols, k, joint_names(task.hand)), roots)
+    return bodies_at(task, row_pose(cols, k), row_q(cols, k, task.hand.joint_names), roots)
 
 
 def bodies_at(task, pose, q, roots=None) -> dict:
     """:func:`row_bodies` at workpiece pose ``pose`` (3,) and joint positions ``q`` (n_j,) (m, rad)."""
     from shapely.geometry import Point, Polygon
 
-    from qsplan.hands.interface import hand_body_polygons, joint_axes
-
-    polys = {name: Polygon(v) for name, v in hand_body_polygons(task.hand, pose, q).items()}
+    polys = {name: Polygon(v) for name, v in task.hand.body_polygons(pose, q).items()}
     housings = joint_housings(task.hand) if roots is None else roots
     axes = None
     disks = {}
     for link, (carrier, j, radius, disk) in housings.items():
         if disk is None:
-            axes = joint_axes(task.hand, q) if axes is None else axes
+            axes = task.hand.joint_axes(q) if axes is None else axes
             disk = Point(axes[j]).buffer(radius, 64)
         disks[link] = (carrier, disk)
     return {"polys": polys, "roots": disks}
@@ -169,9 +163,7 @@ def overlap_pairs(hand) -> tuple:
     workpiece/palm, left/palm, right/palm)."""
     from itertools import combinations
 
-    from qsplan.hands.interface import joint_names
-
-    links = joint_names(hand)
+    links = hand.joint_names
     return (tuple(combinations(links, 2)) + tuple((n, "workpiece") for n in links) + (("workpiece", "palm"),)
             + tuple((n, "palm") for n in links))  # fmt: skip
 
@@ -205,10 +197,8 @@ def body_overlaps(task, bodies) -> list:
 def limit_checks(task, cols, k) -> list:
     """Check 2 (one row): joint limits, exported joint-speed commands, the effort inside its band, one command per
     joint (a torque for the row's ``effort_joint``, a velocity for every other joint)."""
-    from qsplan.hands.interface import joint_names, joint_units
-
-    names = joint_names(task.hand)
-    units, speeds = joint_units(task.hand), joint_speeds(task)
+    names = task.hand.joint_names
+    units, speeds = task.hand.joint_units(), joint_speeds(task)
     out = []
     q = row_q(cols, k, names)
     if not np.all(np.isfinite(q)) or not np.all(np.isfinite(row_pose(cols, k))):
@@ -252,9 +242,7 @@ def limit_checks(task, cols, k) -> list:
 
 def step_checks(task, cols, k) -> list:
     """Check 2 (rows ``k`` and ``k + 1``): time order, speed limits over the step, no jump at a switch."""
-    from qsplan.hands.interface import joint_names, joint_units
-
-    names, units, speeds = joint_names(task.hand), joint_units(task.hand), joint_speeds(task)
+    names, units, speeds = task.hand.joint_names, task.hand.joint_units(), joint_speeds(task)
     t0, t1 = cols["t"][k], cols["t"][k + 1]
     dt = t1 - t0
     if not (np.isfinite(dt) and dt >= 0):

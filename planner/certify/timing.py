@@ -89,14 +89,12 @@ def row_velocity(cols, k, names):
 def timing_checks(task, cols) -> list:
     """Stops, the rule's velocities, acceleration limits and the inertial load (the module docstring); returns
     ``[(row, kind, message)]``, at most one per kind and phase."""
-    from qsplan.hands.interface import joint_names, joint_units
-
     from qsplan.planner.certify.rows import COMMAND_RTOL, path_bend
     from qsplan.planner.task.dynamics import task_dynamics, turning_wrench
 
     if "speed_scale" not in cols:
         return [(None, "timing", "the plan has no speed_scale column: its phases do not start and end at rest")]
-    names, units = joint_names(task.hand), joint_units(task.hand)
+    names, units = task.hand.joint_names, task.hand.joint_units()
     u = np.asarray(cols["speed_scale"], float)
     bad = np.flatnonzero(~(np.isfinite(u) & (u >= 0) & (u <= 1)))
     out = [(int(bad[0]), "timing", f"speed_scale {float(u[bad[0]])!r} outside [0, 1]")] if bad.size else []
@@ -177,7 +175,6 @@ def hold_checks(task, cols, scenes) -> tuple:
     leaves out a contact the motion makes there (it opens along that motion), and at rest that contact pushes as
     well as any other."""
     from qsplan.hands.found_contacts import hold_scene
-    from qsplan.hands.interface import joint_names
     from qsplan.mechanics.bands.hold import prove_hold
     from qsplan.mechanics.errors import QsplanError
 
@@ -186,7 +183,7 @@ def hold_checks(task, cols, scenes) -> tuple:
     if "speed_scale" not in cols:
         return [], []
     found, records = [], []
-    names = joint_names(task.hand)
+    names = task.hand.joint_names
     for k in sorted(scenes):
         if cols["speed_scale"][k] != 0.0:
             continue

@@ -80,10 +80,8 @@ def run_task(task, args, out, inputs=()) -> int:
         out.write(f"sequence found by the {search.planner!r} search on band tables of {search.grasps} grasps x "
                   f"{search.grid_points} positions ({search.table_states} configurations, {search.band_states} "
                   f"guaranteed bands in {search.table_seconds:.3g} s; search {search.search_seconds:.3g} s)\n")  # fmt: skip
-    from qsplan.hands.interface import joint_unit
-
     seg = next((s for s in plan.segments if s.name == name), None)
-    unit = "N m" if seg is None else joint_unit(task.hand, seg.effort_joint, "tau")
+    unit = "N m" if seg is None else task.hand.joint_unit(seg.effort_joint, "tau")
     width = torque_text(w, unit, side="upper").replace("unbounded above", "unbounded")
     out.write(f"narrowest guaranteed band: {width} at t = {t:.4g} s (resolution {task.torque_resolution:g} {unit})\n")
     out.write(f"{result.certificate.summary()}\n")

@@ -4,7 +4,7 @@ Format ``qsplan.torque_schedule.plan``, version 1: the columns of :mod:`qsplan.p
 (the band issue's format) for every joint of the plan's hand, in the hand's joint order (the paper's
 hand: ``left``, ``right``; a described hand: its joints, e.g. ``left_proximal``, ``left_distal``, ...),
 since the torque-controlled joint may change between segments, then extra columns (extended, never
-renamed).  Units per joint kind (:data:`qsplan.hands.interface.JOINT_UNITS`): a revolute joint's
+renamed).  Units per joint kind (:data:`qsplan.hands.protocol.JOINT_UNITS`): a revolute joint's
 in rad, rad/s and N m as in the table; a prismatic joint's in m, m/s and N.  One row per sample, in
 this order:
 
@@ -40,7 +40,7 @@ non-finite numbers ``null`` (``tau_<joint>_min``: unbounded below, ``tau_<joint>
 above, elsewhere not applicable); the schema is ``torque_schedule.schema.json`` beside this module
 (:func:`qsplan.planner.export.schema.check_schedule_document`).  ``metadata`` records the task, the
 friction model, limits, force margin, the command rule and each phase, the hand
-(:func:`qsplan.hands.interface.hand_metadata`: a described hand's description and workpiece, enough to
+(:meth:`qsplan.hands.protocol.Hand.metadata`: a described hand's description and workpiece, enough to
 rebuild it) and the planned ``sequence`` when the plan has one.  Files are never overwritten without
 ``force``.
 """
@@ -116,8 +116,6 @@ def plan_metadata(plan) -> dict:
     """
     from qsplan.planner.plan.results import ContactSegmentPlan
 
-    from qsplan.hands.interface import hand_metadata
-
     task = plan.task
     name, t, w = plan.narrowest()
     phases = []
@@ -156,7 +154,7 @@ def plan_metadata(plan) -> dict:
                     "route_search": plan.search.planner if plan.search is not None else "scripted",
                     "validity_checks": plan.validity_checks, "checks_per_second": _num(plan.checks_per_second)},
         "phases": phases,
-        "hand": hand_metadata(task.hand),
+        "hand": task.hand.metadata(),
     }  # fmt: skip
     if plan.sequence:
         from qsplan.planner.plan.steps import step_dicts
@@ -166,10 +164,10 @@ def plan_metadata(plan) -> dict:
 
 
 def _joint_units(hand) -> dict:
-    """``{joint: {"q", "qd", "tau"} -> unit}`` (:data:`qsplan.hands.interface.JOINT_UNITS`)."""
-    from qsplan.hands.interface import JOINT_UNITS, joint_kinds, joint_names
+    """``{joint: {"q", "qd", "tau"} -> unit}`` (:data:`qsplan.hands.protocol.JOINT_UNITS`)."""
+    from qsplan.hands.protocol import JOINT_UNITS
 
-    return {n: JOINT_UNITS[k] for n, k in zip(joint_names(hand), joint_kinds(hand))}
+    return {n: JOINT_UNITS[k] for n, k in zip(hand.joint_names, hand.joint_kinds)}
 
 
 def friction_metadata(task) -> dict:
@@ -257,11 +255,9 @@ def export_plan(plan, out_dir, stem: str = "plan", force: bool = False) -> list:
     out = check_out_dir(out_dir)
     paths = [out / f"{stem}.csv", out / f"{stem}.json"]
     check_outputs(paths, force)
-    from qsplan.hands.interface import joint_kinds, joint_names
-
     cols, units = plan_columns(plan)
     names = list(cols)
-    kinds = dict(zip(joint_names(plan.task.hand), joint_kinds(plan.task.hand)))
+    kinds = dict(zip(plan.task.hand.joint_names, plan.task.hand.joint_kinds))
     doc = {"format": PLAN_FORMAT, "version": VERSION, "columns": names, "units": units,
            "descriptions": column_meanings(names, kinds),
            "data": {k: [json_value(v) for v in vals] for k, vals in cols.items()}, "metadata": plan_metadata(plan),

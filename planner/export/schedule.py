@@ -111,7 +111,7 @@ def schedule_columns(bands) -> tuple:
 def schedule_metadata(bands, resolution=None) -> dict:
     """What a controller engineer needs to trust the schedule (all SI); ``resolution``: the controller's torque
     resolution (N m) the command's margin was sized with, if any."""
-    from qsplan.hands.interface import hand_metadata
+    from qsplan.hands.described_build import as_hand
     from qsplan.mechanics.bands.effort import check_force_margin
     from qsplan.mechanics.modes.contact_mode import ContactMode
 
@@ -122,7 +122,7 @@ def schedule_metadata(bands, resolution=None) -> dict:
 
     S = bands.samples
     seg = S.segment
-    hand = seg.hand
+    hand = as_hand(seg.hand)  # the door: a segment's record (the paper hand by its parameters) as a described hand
     g = bands.guaranteed
     band = g.band
     scene = S.scenes[0]
@@ -155,7 +155,7 @@ def schedule_metadata(bands, resolution=None) -> dict:
                                                  "upper_N_m": float(band.upper[k])},
         },
         "command": command_rule(bands.safety_margin, bands.max_margin, resolution),
-        "hand": hand_metadata(hand),
+        "hand": hand.metadata(),
     }  # fmt: skip
 
 

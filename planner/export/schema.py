@@ -195,7 +195,7 @@ def _plan_joint_problems(doc) -> list:
     """A plan file's joints against its hand (``metadata.hand``): every joint's five columns present with its kind's
     units (the paper's hand: ``left`` and ``right``, revolute; a described hand: its description's joints), and
     ``effort_joint`` one of them or ``none``."""
-    from qsplan.hands.interface import JOINT_UNITS
+    from qsplan.hands.protocol import JOINT_UNITS
 
     hand = doc["metadata"]["hand"]
     if "description" in hand:

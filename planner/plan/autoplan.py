@@ -30,7 +30,7 @@ from dataclasses import replace
 
 import numpy as np
 
-from qsplan.hands.interface import JOINT_UNITS
+from qsplan.hands.protocol import JOINT_UNITS
 from qsplan.mechanics.errors import QsplanError
 
 from qsplan.planner.plan.release import release_holds
@@ -40,7 +40,6 @@ from qsplan.planner.plan.timing import time_scale
 from qsplan.planner.search.ompl_search import search_route
 from qsplan.planner.search.tables import band_tables, table_grid
 from qsplan.planner.task.goal import feature_text
-from qsplan.hands.interface import joint_unit
 
 __all__ = ["FREE_GRID", "FREE_SEARCH_MARGIN", "MAX_GOAL_GRASPS", "MAX_ROUNDS", "grasp_rows", "goal_nodes",
            "plan_automatic", "route_phases", "start_nodes"]
@@ -315,7 +314,7 @@ def plan_automatic(task, options=None, progress=None, planner: str = "widest", t
             raise PlanFailure(no_route_report(task, tables, graph, starts, i_start, goals, forbidden))
         best = max(found, key=lambda r: (r.route.width, -r.route.regrasps, -len(r.route.steps)))
         route = best.route
-        units = sorted({joint_unit(task.hand, e, "tau") for e in tables.efforts})  # a jaw's force in N
+        units = sorted({task.hand.joint_unit(e, "tau") for e in tables.efforts})  # a jaw's force in N
         progress(f"route ({planner}, round {rounds}): {len(route.steps)} steps, {route.regrasps} regrasps, narrowest "
                  f"band {route.width:.4g} {' or '.join(units)}, {best.evaluations} evaluations in "
                  f"{best.seconds:.3f} s")  # fmt: skip

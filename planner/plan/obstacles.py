@@ -233,9 +233,7 @@ def no_route_report(task, tables, graph, starts, i_start, goals, forbidden) -> N
         x0, x1 = float(tables.x[narrow.i]), float(tables.x[narrow.to_i])
         band = failure_report(task, f"the widest route's narrowest slide (grasp {row.label})", x0, x1, e, d, None,
                               xs=np.array([x0, x1]), grasp=row.grasp, path=row.path, status=SEARCHED_BANDS)  # fmt: skip
-        from qsplan.hands.interface import joint_unit
-
-        u = joint_unit(task.hand, e, "tau")  # a jaw's force in N
+        u = task.hand.joint_unit(e, "tau")  # a jaw's force in N
         summary = (f"every route's guaranteed band is narrower than the torque resolution "
                    f"({task.torque_resolution:g} {u}): the widest route's narrowest band is {route.width:.4g} {u} "
                    f"at x = {x0:.4g} m (grasp {row.label}, {_joint_words(task, e)} torque-controlled)")  # fmt: skip

@@ -283,15 +283,13 @@ def regrasp_phase(task, name, x, q_from, q_to, t0, options, progress, counters, 
     hand's inner edges': the left finger counter-clockwise), every joint moves to the opened ``q_to`` and the
     fingers close; the workpiece rests on the palm meanwhile.  Every leg is collision-free
     (:func:`check_free_state`), and the straight lines between OMPL's states are checked again every
-    :data:`SWEEP_STEP` of a link's travel (:func:`qsplan.hands.interface.finger_reach` sets the joint step).
+    :data:`SWEEP_STEP` of a link's travel (:attr:`qsplan.hands.protocol.Hand.finger_reach` sets the joint step).
 
     Raises
     ------
     PlanFailure
         With a :class:`qsplan.planner.plan.failure.ConfigurationReport` naming the leg and what blocks it.
     """
-    from qsplan.hands.interface import finger_reach
-
     progress(name)
     q, q_to = np.asarray(q_from, float), np.asarray(q_to, float)
     default = task.hand.opening(None, x, q) if opening_from is None or opening_to is None else None
@@ -317,7 +315,7 @@ def regrasp_phase(task, name, x, q_from, q_to, t0, options, progress, counters, 
     path = np.vstack(path)
     # OMPL checked its edges at validity_resolution; the fingers move on straight lines between the rows
     # exported, so check those lines again every SWEEP_STEP of travel at the fingertips (m for a prismatic joint)
-    reach = finger_reach(task.hand)
+    reach = task.hand.finger_reach
     steps = np.array([SWEEP_STEP / reach if k == "revolute" else SWEEP_STEP for k in task.hand.joint_kinds])
     dense = densify_rows(path, steps)
     for qk in dense:

@@ -38,7 +38,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from qsplan.hands.interface import JOINT_UNITS
+from qsplan.hands.protocol import JOINT_UNITS
 from qsplan.mechanics.errors import QsplanError
 
 __all__ = ["CONTROL_MODES", "MAX_TICKS", "TIME_SNAP", "PlanSamples", "path_fraction", "sample_columns", "tick_times"]

@@ -64,7 +64,7 @@ _NAME_CHARS = frozenset("abcdefghijklmnopqrstuvwxyz0123456789_")
 
 
 def plan_joints(hand) -> tuple:
-    """The joints a plan of ``hand`` has columns for, in the hand's order (:func:`qsplan.hands.interface.joint_names`).
+    """The joints a plan of ``hand`` has columns for, in the hand's order (:attr:`qsplan.hands.protocol.Hand.joint_names`).
 
     Raises
     ------
@@ -72,10 +72,9 @@ def plan_joints(hand) -> tuple:
         A joint whose name cannot name a column (lowercase letters, digits and underscores; not ``none``), or two
         joints whose columns would share a name.
     """
-    from qsplan.hands.interface import joint_names
     from qsplan.mechanics.errors import QsplanError
 
-    names = joint_names(hand)
+    names = hand.joint_names
     for n in names:
         if not n or set(n) - _NAME_CHARS or n == "none":
             raise QsplanError(f"hand.joint_names: {n!r} cannot name a plan column; expected lowercase letters, digits "
@@ -104,9 +103,9 @@ def plan_columns(plan) -> tuple:
     :class:`~qsplan.planner.plan.results.RegraspPlan`) is a free motion of every joint); one group of
     columns per joint of ``plan.task.hand``, in its order, with its kind's units.
     """
-    from qsplan.hands.interface import JOINT_UNITS, joint_kinds
+    from qsplan.hands.protocol import JOINT_UNITS
     joints = plan_joints(plan.task.hand)
-    kinds = dict(zip(joints, joint_kinds(plan.task.hand)))
+    kinds = dict(zip(joints, plan.task.hand.joint_kinds))
     order = ["t", *(f"q_{n}" for n in joints), *(f"qd_{n}" for n in joints)]
     for n in joints:
         order += [f"tau_{n}", f"tau_{n}_min", f"tau_{n}_max"]

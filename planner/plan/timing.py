@@ -200,12 +200,11 @@ def rest_scene(task, ph, k, other, effort, velocity):
     or where the polygons show another contact set there (a slide's last row at the flush instant), every contact
     found but those the motion makes only at ``k`` (:func:`qsplan.hands.found_contacts.made_contacts`)."""
     from qsplan.hands.found_contacts import made_contacts, ordered_contacts, row_contact_scene
-    from qsplan.hands.interface import scene_at
     from qsplan.mechanics.errors import SceneError
 
     pose = ph.poses(task.hand.rest_height)
     try:
-        return scene_at(task.hand, pose[k], ph.q[k], effort, velocity)
+        return task.hand.scene(pose[k], ph.q[k], effort, velocity)
     except SceneError:
         found = ordered_contacts(task.hand, pose[k], ph.q[k])
         drop = made_contacts(task.hand, (pose[other], ph.q[other]), (pose[k], ph.q[k]), found) if other < k else None

@@ -1,6 +1,6 @@
 """A plan as an animation: ``plan_animation.gif`` and the same frames in a self-contained HTML page with a slider.
 
-Each frame shows the hand and the workpiece (:func:`qsplan.hands.interface.hand_body_polygons`), the contacts
+Each frame shows the hand and the workpiece (:meth:`qsplan.hands.protocol.Hand.body_polygons`), the contacts
 where every finger touches, with the way the workpiece slides against the body at each (the frames:
 :func:`qsplan.planner.plotting.plan.animation_frames`),
 the torque-controlled link with the way its command pushes it, a gauge of each commanded joint's command inside
@@ -80,11 +80,9 @@ class _Scene:
     def __init__(self, fig, plan, frames):
         from matplotlib.patches import Polygon as Patch
 
-        from qsplan.hands.interface import finger_of_joint, hand_body_polygons, joint_names
-
         self.plan, self.frames, self.hand = plan, frames, plan.task.hand
         hand = self.hand
-        self.joints = [j for j in joint_names(hand) if any(is_contact(p) and p.effort_joint == j for p in plan.phases)]
+        self.joints = [j for j in hand.joint_names if any(is_contact(p) and p.effort_joint == j for p in plan.phases)]
         lim = hand_limits(hand, [(f.pose, f.q) for f in frames])
         self.size = _ARROW * float(lim[0][1] - lim[0][0])
         ax = self.ax = fig.add_axes((0.01, 0.16, 0.50, 0.68))
@@ -93,8 +91,8 @@ class _Scene:
         ax.set_aspect("equal")
         ax.set_xticks([])
         ax.set_yticks([])
-        polys = hand_body_polygons(hand, frames[0].pose, frames[0].q)
-        finger = finger_of_joint(hand)
+        polys = hand.body_polygons(frames[0].pose, frames[0].q)
+        finger = hand.finger_of_joint
         self.patches = {}
         for name in ["palm"] + [n for n in polys if n not in ("palm", "workpiece")] + ["workpiece"]:
             face, edge = body_style(finger.get(name, name))
@@ -222,12 +220,10 @@ class _Scene:
         """Set the artists of frame ``n``; returns those to draw over its phase's background."""
         from matplotlib.patches import FancyArrowPatch
 
-        from qsplan.hands.interface import hand_body_polygons
-
         f = self.frames[n]
         ph = self.plan.phases[f.phase]
         effort = ph.effort_joint if is_contact(ph) else None
-        for name, poly in hand_body_polygons(self.hand, f.pose, f.q).items():
+        for name, poly in self.hand.body_polygons(f.pose, f.q).items():
             self.patches[name].set_xy(poly)
             self.patches[name].set_linewidth(2.4 if name == effort else 1.0)
         arrows = [(p, p + self.size * d, "k", 1.0) for p, d in f.contacts if np.any(d)]

@@ -453,10 +453,8 @@ def _card(plan, stated, snapshots) -> tuple:
     """``(figure, the verdict's text artists)`` of :func:`plan_card` with the verdict ``stated`` = ``(line, ok)``."""
     from matplotlib.figure import Figure
 
-    from qsplan.hands.interface import joint_names, joint_units
-
     hand = plan.task.hand
-    names, units = joint_names(hand), dict(zip(joint_names(hand), joint_units(hand, "qd")))
+    names, units = hand.joint_names, dict(zip(hand.joint_names, hand.joint_units("qd")))
     shots = card_snapshots(plan, snapshots)
     letters = _letters(len(shots))
     torque_joints = [j for j in names if any(is_contact(p) and p.effort_joint == j for p in plan.phases)]

@@ -199,9 +199,7 @@ def failure_figure(task, report, path=None):
         end, edge = report.palm_end, report.edge
         far = edge[0] if report.side == "left" else edge[1]
         ax.plot([end, far], [0.0, 0.0], color=COLLISION, lw=4, solid_capstyle="butt", zorder=8)
-    from qsplan.hands.interface import joint_units
-
-    units = joint_units(task.hand)
+    units = task.hand.joint_units()
     what = ("fingers drawn open at mid-range: no grasp closes here" if q is None else
             "q = (" + ", ".join(f"{v:.4g} {u}" for v, u in zip(q, units)) + ")")  # fmt: skip
     red = "; red: overlapping bodies, joints beyond their limits" if hits or over else ""

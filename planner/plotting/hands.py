@@ -5,7 +5,7 @@ Compute lives in :mod:`qsplan.hands`; this module only draws.  ``plot_*`` functi
 ``ax=None`` (a new figure is made) and return the axes; ``*_figure`` functions return a
 ``matplotlib.figure.Figure`` (no pyplot).  matplotlib is imported inside the functions.
 
-Every body :func:`qsplan.hands.interface.hand_body_polygons` returns is drawn (palm, workpiece and
+Every body :meth:`qsplan.hands.protocol.Hand.body_polygons` returns is drawn (palm, workpiece and
 every link: the paper's two fingers, or every link of a described hand's chains, each in its
 finger's colour); the torque-controlled joint's link is drawn with a thick outline and marked
 ``tau``, with an arrow the way its commanded effort pushes it (:func:`effort_direction`); contacts are dots with
@@ -29,7 +29,7 @@ from qsplan.planner.plotting.style import FONT, axes_or_new, body_style, joint_c
 __all__ = ["phase_pose", "SAME_CONFIGURATION", "STATES", "TOUCH_TOL", "Snapshot", "effort_direction", "fingers_touching", "hand_limits", "hand_strip_figure",
            "pivot_vertex", "plan_snapshots", "plot_hand", "row_state", "snapshot_legend_handles", "state_words"]
 
-#: Relative length of the drawn contact normals (of the finger length, :func:`qsplan.hands.interface.finger_reach`).
+#: Relative length of the drawn contact normals (of the finger length, :attr:`qsplan.hands.protocol.Hand.finger_reach`).
 _NORMAL = 0.12
 
 #: Relative length of the arrow of the commanded effort on its link (of the finger length).
@@ -65,12 +65,13 @@ def fingers_touching(hand, pose, q) -> dict:
     """
     from shapely.geometry import Polygon
 
-    from qsplan.hands.interface import finger_of_joint, hand_body_polygons
+    from qsplan.hands.described_build import as_hand
 
-    polys = hand_body_polygons(hand, pose, q)
+    hand = as_hand(hand)  # the door: a hand record becomes a described hand
+    polys = hand.body_polygons(pose, q)
     work = Polygon(polys["workpiece"])
     out = {"left": False, "right": False}
-    for joint, side in finger_of_joint(hand).items():
+    for joint, side in hand.finger_of_joint.items():
         out[side] |= bool(Polygon(polys[joint]).distance(work) <= TOUCH_TOL)
     return out
 
@@ -78,13 +79,14 @@ def fingers_touching(hand, pose, q) -> dict:
 def effort_direction(hand, pose, q, joint, sign) -> tuple:
     """``(point, direction)``: the centre of ``joint``'s link (m, shape (2,)) and the unit vector (shape (2,)) it moves
     along when the joint's effort has the sign of ``sign`` (a torque turns it, a force pushes it along its axis)."""
-    from qsplan.hands.interface import hand_body_polygons, joint_names
+    from qsplan.hands.described_build import as_hand
 
+    hand = as_hand(hand)  # the door: a hand record becomes a described hand
     q = np.asarray(q, dtype=float)
     step = np.zeros_like(q)
-    step[joint_names(hand).index(joint)] = _EFFORT_STEP * np.sign(sign)
-    a = hand_body_polygons(hand, pose, q)[joint]
-    b = hand_body_polygons(hand, pose, q + step)[joint]
+    step[hand.joint_names.index(joint)] = _EFFORT_STEP * np.sign(sign)
+    a = hand.body_polygons(pose, q)[joint]
+    b = hand.body_polygons(pose, q + step)[joint]
     d = (b - a).mean(axis=0)
     return a.mean(axis=0), d / max(float(np.hypot(*d)), 1e-300)
 
@@ -95,27 +97,26 @@ def hand_limits(hand, configurations, pad: float = 0.08) -> tuple:
     The palm is cut at the limits (it is wider than anything that moves), so snapshots keep no empty
     margin; its thickness stays in view (the scale bar is drawn on it).
     """
-    from qsplan.hands.interface import hand_body_polygons, palm_thickness
+    from qsplan.hands.described_build import as_hand
 
-    pts = [np.vstack([p for name, p in hand_body_polygons(hand, pose, q).items() if name != "palm"])
+    hand = as_hand(hand)  # the door: a hand record becomes a described hand
+    pts = [np.vstack([p for name, p in hand.body_polygons(pose, q).items() if name != "palm"])
            for pose, q in configurations]  # fmt: skip
     pts = np.vstack(pts)
     lo, hi = pts.min(axis=0), pts.max(axis=0)
     span = hi - lo
     x = (lo[0] - pad * span[0], hi[0] + pad * span[0])
-    return x, (min(lo[1], -palm_thickness(hand)), hi[1] + pad * span[1])
+    return x, (min(lo[1], -hand.palm_thickness), hi[1] + pad * span[1])
 
 
 def _scale_bar(ax, hand, limits):
     """A bar of a round length (1, 2 or 5 cm or mm) drawn on the palm, under the workpiece, labelled right of it."""
-    from qsplan.hands.interface import palm_thickness
-
     (x0, x1), _ = limits
     target = 0.3 * (x1 - x0)
     e = 10.0 ** np.floor(np.log10(target))
     length = max(m * e for m in (1.0, 2.0, 5.0) if m * e <= target)
     label = f"{length * 100:g} cm" if length >= 0.01 else f"{length * 1000:g} mm"
-    xm, y = 0.5 * (x0 + x1), -0.5 * palm_thickness(hand)
+    xm, y = 0.5 * (x0 + x1), -0.5 * hand.palm_thickness
     ax.plot([xm - length / 2, xm + length / 2], [y, y], color="k", lw=2.0, solid_capstyle="butt", zorder=4)
     ax.annotate(label, (xm + length / 2, y), xytext=(3, 0), textcoords="offset points", ha="left", va="center",
                 fontsize=FONT["note"], zorder=4)  # fmt: skip
@@ -127,7 +128,9 @@ def plot_hand(hand, pose, q=None, ax=None, alpha=1.0, contacts=True, label_joint
 
     Parameters
     ----------
-    hand : qsplan.hands.two_finger.TwoFingerHand or qsplan.hands.chain_hand.ChainHand
+    hand : qsplan.hands.protocol.Hand
+        Or a hand record (:class:`~qsplan.hands.two_finger.TwoFingerHand`, :class:`~qsplan.hands.chain_hand.ChainHand`),
+        converted at the door (:func:`qsplan.hands.described_build.as_hand`).
     pose : array-like, shape (3,)
         Workpiece ``(x, y, theta)`` (m, m, rad).
     q : array-like, shape (n_j,), optional
@@ -152,12 +155,13 @@ def plot_hand(hand, pose, q=None, ax=None, alpha=1.0, contacts=True, label_joint
     """
     from matplotlib.patches import Polygon as Patch
 
+    from qsplan.hands.described_build import as_hand
     from qsplan.hands.found_contacts import drawable_contacts
-    from qsplan.hands.interface import finger_of_joint, finger_reach, hand_body_polygons
 
+    hand = as_hand(hand)  # the door: a hand record becomes a described hand
     ax = axes_or_new(ax, size=(3.2, 2.6))
-    polys = hand_body_polygons(hand, pose, q)
-    finger = finger_of_joint(hand)
+    polys = hand.body_polygons(pose, q)
+    finger = hand.finger_of_joint
     order = ["palm"] + [n for n in polys if n not in ("palm", "workpiece")] + ["workpiece"]
     for name in order:
         face, edge = body_style(finger.get(name, name))  # a chain's links in their finger's colours
@@ -171,18 +175,16 @@ def plot_hand(hand, pose, q=None, ax=None, alpha=1.0, contacts=True, label_joint
                     zorder=6, bbox={"boxstyle": "circle,pad=0.15", "fc": "white", "ec": colour, "lw": 1.0})  # fmt: skip
         if effort_sign is not None and np.sign(effort_sign) != 0:
             p, d = effort_direction(hand, pose, q, effort_joint, effort_sign)
-            ax.annotate("", xy=p + _EFFORT_ARROW * finger_reach(hand) * d, xytext=p, zorder=6,
+            ax.annotate("", xy=p + _EFFORT_ARROW * hand.finger_reach * d, xytext=p, zorder=6,
                         arrowprops={"arrowstyle": "-|>", "color": colour, "lw": 1.6, "shrinkA": 7, "shrinkB": 0})  # fmt: skip
     if contacts:
-        scale = _NORMAL * finger_reach(hand)
+        scale = _NORMAL * hand.finger_reach
         for c in drawable_contacts(hand, pose, q):
             ax.plot(*c.point, "o", ms=3.5, color="k", alpha=alpha, zorder=5)
             ax.arrow(*c.point, *(scale * c.normal), width=0.0, head_width=0.2 * scale, color="k", lw=0.8,
                      length_includes_head=True, alpha=alpha, zorder=5)  # fmt: skip
     if label_joints:
-        from qsplan.hands.interface import joint_axes, joint_names
-
-        for name, p in zip(joint_names(hand), joint_axes(hand, q)):
+        for name, p in zip(hand.joint_names, hand.joint_axes(q)):
             ax.annotate(name, p, xytext=(0, -9), textcoords="offset points", ha="center", va="top",
                         fontsize=FONT["note"], color=joint_colour(hand, name))  # fmt: skip
     limits = limits or hand_limits(hand, [(pose, q)])
@@ -233,18 +235,20 @@ def hand_strip_figure(samples, n=5, title=None):
     """
     from matplotlib.figure import Figure
 
+    from qsplan.hands.described_build import as_hand
     from qsplan.planner.plotting.style import figure_legend
 
     n = max(2, int(n))
     idx = np.unique(np.round(np.linspace(0, len(samples) - 1, n)).astype(int))
     seg = samples.segment
-    lim = hand_limits(seg.hand, [(samples.pose[k], samples.q[k]) for k in idx])
+    hand = as_hand(seg.hand)  # the door: a segment's record (the paper hand by its parameters) as a described hand
+    lim = hand_limits(hand, [(samples.pose[k], samples.q[k]) for k in idx])
     w = 2.3
     h = w * (lim[1][1] - lim[1][0]) / (lim[0][1] - lim[0][0])
     fig = Figure(figsize=(w * len(idx), h + 1.2), layout="constrained")
     axes = fig.subplots(1, len(idx), squeeze=False)[0]
     for ax, k in zip(axes, idx):
-        plot_hand(seg.hand, samples.pose[k], samples.q[k], ax=ax, effort_joint=seg.effort_joint, limits=lim,
+        plot_hand(hand, samples.pose[k], samples.q[k], ax=ax, effort_joint=seg.effort_joint, limits=lim,
                   scale_bar=k == idx[0])
         ax.set_title(f"t = {samples.t[k]:.3g} s\nq = ({np.degrees(samples.q[k, 0]):.1f}, "
                      f"{np.degrees(samples.q[k, 1]):.1f}) deg (left, right)", fontsize=FONT["note"])  # fmt: skip

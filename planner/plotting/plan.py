@@ -223,10 +223,11 @@ def sliding_directions(hand, pose0, q0, pose1, q1) -> list:
     """
     from shapely.geometry import Point, Polygon
 
+    from qsplan.hands.described_build import as_hand
     from qsplan.hands.found_contacts import drawable_contacts
-    from qsplan.hands.interface import hand_body_polygons
 
-    before, after = hand_body_polygons(hand, pose0, q0), hand_body_polygons(hand, pose1, q1)
+    hand = as_hand(hand)  # the door: a hand record becomes a described hand
+    before, after = hand.body_polygons(pose0, q0), hand.body_polygons(pose1, q1)
     rw, tw = _rigid(before["workpiece"], after["workpiece"])
     links = [n for n in before if n not in ("palm", "workpiece")]
     out = []

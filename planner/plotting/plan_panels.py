@@ -57,14 +57,12 @@ def is_contact(phase) -> bool:
 
 def effort_words(hand, joint) -> tuple:
     """``(word, unit)`` of a joint's effort: ``("torque", "N m")`` for a revolute joint (the paper's fingers, and
-    without a hand), ``("force", "N")`` for a prismatic one (units: :data:`qsplan.hands.interface.JOINT_UNITS`)."""
-    from qsplan.hands.interface import JOINT_UNITS
+    without a hand), ``("force", "N")`` for a prismatic one (units: :data:`qsplan.hands.protocol.JOINT_UNITS`)."""
+    from qsplan.hands.protocol import JOINT_UNITS
 
     kind = "revolute"
     if hand is not None:
-        from qsplan.hands.interface import joint_kinds, joint_names
-
-        kind = dict(zip(joint_names(hand), joint_kinds(hand))).get(joint, "revolute")
+        kind = dict(zip(hand.joint_names, hand.joint_kinds)).get(joint, "revolute")
     return ("force" if kind == "prismatic" else "torque"), JOINT_UNITS[kind]["tau"]
 
 

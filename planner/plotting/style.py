@@ -101,9 +101,7 @@ def finger_colour(name: str) -> str:
 def joint_colour(hand, name: str) -> str:
     """The colour of joint ``name`` of ``hand``: its finger's (:data:`FINGER`; a chain hand's links share their
     finger's colour)."""
-    from qsplan.hands.interface import finger_of_joint
-
-    return finger_colour(finger_of_joint(hand).get(str(name), name))
+    return finger_colour(hand.finger_of_joint.get(str(name), name))
 
 
 def step_colour(colour, kind: str) -> str:

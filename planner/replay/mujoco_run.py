@@ -170,9 +170,7 @@ class MujocoSim:
         self.creep_rate = creep_rates(m, self.pairs)
         self.cols = cols
         # each pair's finger joints (indices into samples.joints; none for the palm's)
-        from qsplan.hands.interface import finger_joint_names
-
-        fingers = dict(zip(("left", "right"), finger_joint_names(task.hand)))
+        fingers = dict(zip(("left", "right"), task.hand.finger_joint_names))
         self.pair_joints = [[names.index(n) for n in fingers.get(c, ())] for c in contact_pairs(task.hand)]
         self.task, self._geometry = task, None
 

@@ -91,9 +91,7 @@ def servo_gains(kind: str) -> tuple:
 
 def contact_pairs(hand) -> dict:
     """``{paper contact: (pair names)}``: ``palm:0``, ``palm:1``, ``left``, ``right`` -> the MJCF pairs carrying it."""
-    from qsplan.hands.interface import finger_joint_names
-
-    left, right = finger_joint_names(hand)
+    left, right = hand.finger_joint_names
     return {"palm:0": ("palm:0",), "palm:1": ("palm:1",), "left": tuple(f"left:{n}" for n in left),
             "right": tuple(f"right:{n}" for n in right)}  # fmt: skip
 

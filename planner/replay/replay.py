@@ -19,7 +19,7 @@ effort-controlled joint its torque column, both interpolated linearly between ro
 quasistatic speed (:func:`qsplan.planner.plan.timing.quasistatic_rows`: the model is homogeneous in the velocity
 input, so the plan's stops and accelerations, which change no path, are left out; the plan's clock is then the
 path parameter);
-scenes come from :func:`qsplan.hands.interface.scene_at`.  Between segments the plan's regrasp
+scenes come from :meth:`qsplan.hands.protocol.Hand.scene`.  Between segments the plan's regrasp
 puts both fingers back on the workpiece where it is, so each segment starts from the simulated
 end of the previous one (errors carry over): the paper's fingers by tangency with the planned
 grasp, any other described hand's by closing each finger's last joint onto the workpiece from the plan's free
@@ -117,9 +117,7 @@ class ReplaySystem:
 
     @property
     def state_names(self) -> tuple:
-        from qsplan.hands.interface import joint_names, joint_units
-
-        joints = tuple(f"q_{n} ({u})" for n, u in zip(joint_names(self.hand), joint_units(self.hand)))
+        joints = tuple(f"q_{n} ({u})" for n, u in zip(self.hand.joint_names, self.hand.joint_units()))
         return ("x (m)", "y (m)", "theta (rad)") + joints + ("t (s)",)
 
     def commands(self, t) -> tuple:

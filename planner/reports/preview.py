@@ -173,7 +173,7 @@ def _words(task, tables, g, pair) -> tuple:
     if min(pair) < 0:
         return f"{row.label} (valid nowhere on the palm)", f"{row.label} (valid nowhere)"
     if task.hand.free_joints:  # a described hand's contacts name themselves; its free joints and their slope follow
-        from qsplan.hands.interface import JOINT_UNITS
+        from qsplan.hands.protocol import JOINT_UNITS
 
         grasp, hand = row.grasp, task.hand
         unit = " or ".join(sorted({JOINT_UNITS[hand.joint_kinds[j]]["q"] for j in hand.free_joints}))
@@ -333,7 +333,7 @@ def _preview(task, progress, t0, goal_name="goal", turn=None, refused=False) -> 
 
 def _effort_unit(hand) -> str:
     """The unit of the hand's joint efforts: ``"N m"``, ``"N"`` or both."""
-    from qsplan.hands.interface import JOINT_UNITS
+    from qsplan.hands.protocol import JOINT_UNITS
 
     return " or ".join(sorted({JOINT_UNITS[k]["tau"] for k in hand.joint_kinds}, reverse=True))
 

@@ -200,9 +200,7 @@ def goal_candidates(tables, task, i) -> list:
 
 
 def _limit_excess(task, q) -> tuple:
-    from qsplan.hands.interface import joint_units
-
-    lim, units = task.joint_limits, joint_units(task.hand)
+    lim, units = task.joint_limits, task.hand.joint_units()
     return tuple(LimitExcess(name, float(q[k]), float(lim[k, 0]), float(lim[k, 1]), units[k])
                  for k, name in enumerate(task.hand.joint_names) if not lim[k, 0] <= q[k] <= lim[k, 1])  # fmt: skip
 

@@ -36,9 +36,7 @@ def _effort_words(task, name) -> str:
 
 
 def _unit(task, name) -> str:
-    from qsplan.hands.interface import joint_unit
-
-    return joint_unit(task.hand, name, "tau")
+    return task.hand.joint_unit(name, "tau")
 
 
 def _width(w: float, unit: str) -> str:

@@ -95,10 +95,8 @@ def contact_samples(task, xs, effort_joint, speed, name="segment", grasp=None, f
 
 def limit_problem(task, q) -> str | None:
     """Which joint of ``q`` (rad or m, shape (n_j,)) is beyond its limit, in words, or None."""
-    from qsplan.hands.interface import joint_units
-
     lim, hand = task.joint_limits, task.hand
-    units = joint_units(hand)
+    units = hand.joint_units()
     for k, name in enumerate(hand.joint_names):
         if lim[k, 0] <= q[k] <= lim[k, 1]:
             continue

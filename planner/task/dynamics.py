@@ -131,12 +131,11 @@ def turning_box(hand, acceleration: float):
     mass's largest ``|x|``), ``Y = R`` (its largest height with a vertex on the palm), ``R`` its farthest vertex's
     distance (the angular acceleration's bound, :meth:`Dynamics.angular_acceleration`).  Rounded up to
     :data:`BOX_GRID`."""
-    from qsplan.hands.interface import manipulator_of
     from qsplan.hands.workpiece import polygon_inertia
     from qsplan.mechanics.bands.disturbance import WrenchBox
 
     m, R = float(hand.workpiece_mass), workpiece_radius(hand)
-    X = float(np.max(np.abs(np.asarray(manipulator_of(hand).base_shape, dtype=float)[:, 0])))
+    X = float(np.max(np.abs(np.asarray(hand.manipulator.base_shape, dtype=float)[:, 0])))
     _, inertia = polygon_inertia(hand.workpiece, m)
     f = m * acceleration
     w = _grid_ceil(np.array([f, f, f * (X + R) + inertia * acceleration / R]))
@@ -232,18 +231,11 @@ def task_dynamics(task) -> Dynamics:
 
 def link_mass(hand) -> float:
     """The mass of the hand's links together (kg): a chain hand's links, the paper hand's two fingers."""
-    from qsplan.hands.interface import hand_metadata
-
-    meta = hand_metadata(hand)
-    if "description" in meta:
-        return float(sum(j["link"]["mass"] for f in meta["description"]["fingers"] for j in f["joints"]))
-    return 2.0 * float(meta["finger_mass_kg"])
+    return float(sum(float(j.link_mass) for j in hand.manipulator.joints))
 
 
 def dynamics_metadata(task) -> dict:
     """``metadata.dynamics``: the time scaling's limits and the inertial load the bands withstand (SI)."""
-    from qsplan.hands.interface import joint_units
-
     hand = task.hand
     dyn = task_dynamics(task)
     a = dyn.workpiece_acceleration
@@ -252,7 +244,7 @@ def dynamics_metadata(task) -> dict:
         "workpiece_acceleration_m_s2": a,
         "joint_acceleration": {n: float(v) for n, v in zip(hand.joint_names, dyn.joint_accelerations)},
         "release_acceleration": {n: float(v) for n, v in zip(hand.joint_names, dyn.release_accelerations)},
-        "joint_acceleration_units": {n: f"{u}/s^2" for n, u in zip(hand.joint_names, joint_units(hand))},
+        "joint_acceleration_units": {n: f"{u}/s^2" for n, u in zip(hand.joint_names, hand.joint_units())},
         "inertial_force_N": float(hand.workpiece_mass) * a,
         "disturbance_source": dyn.source,
         "links": ("massless: no link inertia" if not massive else

@@ -94,10 +94,9 @@ def in_task_range(x: float, field: str, kind: str) -> float:
 
 def check_hand(hand) -> None:
     """Every size, mass and coefficient of a hand (and its workpiece) inside :data:`TASK_RANGES`
-    (:func:`qsplan.hands.interface.range_fields`)."""
-    from qsplan.hands.interface import range_fields
-
-    for field, value, kind in range_fields(hand):
+    (``hand.range_fields()``: :meth:`qsplan.hands.protocol.Hand.range_fields`; at the door, before a record becomes a
+    described hand, the record's own, :meth:`qsplan.hands.two_finger.TwoFingerHand.range_fields`)."""
+    for field, value, kind in hand.range_fields():
         in_task_range(value, field, kind)
 
 

@@ -220,9 +220,7 @@ def palm_x_range(hand) -> tuple:
     eq. 1), so ``x + V[0, 0] >= palm's left end`` and ``x + V[1, 0] <= palm's right end``.  Exact, from
     the hand's palm polygon (an asymmetric palm included).
     """
-    from qsplan.hands.interface import manipulator_of
-
-    palm = np.asarray(manipulator_of(hand).base_shape, dtype=float)
+    palm = np.asarray(hand.manipulator.base_shape, dtype=float)
     top = palm[palm[:, 1] == 0.0, 0]
     V = hand.workpiece
     return float(top.min() - V[0, 0]), float(top.max() - V[1, 0])

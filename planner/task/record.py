@@ -7,7 +7,7 @@ record a user edited is checked as a file is.  ``plan.json`` stores the record u
 ``qsplan verify`` without ``--task`` rebuilds the task from it, and with ``--task`` the certifier checks the
 record against the named task, field by field.
 
-The hand is written inline, as its description (:func:`qsplan.hands.interface.description_table`: palm,
+The hand is written inline, as its description (:meth:`qsplan.hands.protocol.Hand.description_table`: palm,
 fingers with their joints, links, limits and speeds) with the workpiece in the user's vertex numbering (re-centred
 on its centre of mass, turned so that its palm edge is level; ``palm_edge`` names that edge), so that every
 feature a ``[start]`` or ``[goal]`` names keeps its number.  The limits are the resolved ones (the hand's,
@@ -26,9 +26,7 @@ RECORD_VERSION = 1
 
 def hand_record(hand) -> dict:
     """``[hand]`` of a task record: the description's table and the workpiece keys (see the module docstring)."""
-    from qsplan.hands.interface import description_table
-
-    table = description_table(hand.description)
+    table = hand.description_table()
     user = np.asarray(hand.workpiece)[list(hand.vertex_of_user)]
     table.update(workpiece=user.tolist(), workpiece_mass=float(hand.workpiece_mass), mu=float(hand.mu),
                  palm_edge=int(hand.user_edges[0]))  # fmt: skip

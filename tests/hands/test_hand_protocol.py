@@ -216,3 +216,79 @@ def test_a_goal_is_a_placement_string():
     contact = FingerContact(1, "left_distal", "vertex", 3, 2)
     with pytest.raises(SceneError, match="goal_left: expected 'vertex', 'vertex:K'"):
         contact.matches("corner:2", "goal_left")
+
+
+# the questions the planner asked through qsplan.hands.interface, folded into the protocol (issue 32)
+
+def _configuration(hand, centre):
+    """A closed grasp's ``(pose, q)`` and its scene inputs (the right closing joint effort-controlled)."""
+    grasps = hand.grasp_candidates("palm_edge", None if centre is None else [centre])
+    states = max((hand.grasp_states("palm_edge", g, np.linspace(-0.02, 0.02, 21)) for g in grasps),
+                 key=lambda s: s.ok.sum())  # fmt: skip
+    i = int(np.flatnonzero(states.ok)[len(np.flatnonzero(states.ok)) // 2])
+    e = np.arange(len(hand.joint_names)) == hand.closing_joints[1]
+    return states.poses[i], states.q[i], e, np.where(e, 0.0, states.dq_dx[i] * 0.01)
+
+
+def test_the_folded_questions_answer_as_the_interface_did(case):
+    """Each member the planner now asks equals the interface function it replaced, asked of the same hand, exactly;
+    and, to rounding, the same function asked of the hand's chain record (the polygon search, the accelerator's
+    reference): the paper hand's closed forms and its description agree."""
+    from qsplan.hands import interface as old
+
+    hand, centre = case
+    chain = hand.chain
+    pose, q, e, qd = _configuration(hand, centre)
+    for quantity in ("q", "qd", "tau"):
+        assert hand.joint_units(quantity) == old.joint_units(hand, quantity) == old.joint_units(chain, quantity)
+        for name in hand.joint_names:
+            assert hand.joint_unit(name, quantity) == old.joint_unit(hand, name, quantity)
+    assert hand.joint_names == old.joint_names(hand) == old.joint_names(chain)
+    assert hand.joint_kinds == old.joint_kinds(hand) == old.joint_kinds(chain)
+    assert hand.finger_joint_names == old.finger_joint_names(hand) == old.finger_joint_names(chain)
+    assert hand.finger_of_joint == old.finger_of_joint(hand) == old.finger_of_joint(chain)
+    assert hand.finger_reach == old.finger_reach(hand) and hand.palm_thickness == old.palm_thickness(hand)
+    assert hand.palm_thickness == pytest.approx(old.palm_thickness(chain), rel=0, abs=1e-15)
+    assert hand.range_fields() == old.range_fields(hand)
+    assert hand.description_table() == old.description_table(hand.description)
+    recorded = hand.paper if hand.paper_form else chain  # the paper's form by its parameters, accelerated or not
+    assert hand.metadata() == old.hand_metadata(recorded)
+    if hand.accelerated or not hand.paper_form:
+        assert hand.metadata() == old.hand_metadata(hand)
+    ours, theirs = hand.manipulator, old.manipulator_of(hand)
+    np.testing.assert_allclose(ours.base_shape, theirs.base_shape, rtol=0, atol=1e-15)
+    for a, b in zip(ours.joints, theirs.joints, strict=True):
+        assert (a.name, a.kind, a.parent) == (b.name, b.kind, b.parent) and a.link_mass == pytest.approx(b.link_mass)
+        np.testing.assert_allclose(a.link_shape, b.link_shape, rtol=0, atol=1e-15)
+        np.testing.assert_allclose(a.origin, b.origin, rtol=0, atol=1e-15)
+    for reference in (hand, chain):
+        np.testing.assert_allclose(hand.joint_axes(q), old.joint_axes(reference, q), rtol=0, atol=1e-15)
+        polys, want = hand.body_polygons(pose, q), old.hand_body_polygons(reference, pose, q)
+        assert polys.keys() == want.keys()
+        for name in polys:
+            np.testing.assert_allclose(polys[name], want[name], rtol=0, atol=1e-15)
+        for method in ("auto", "generic"):
+            one, two = hand.scene(pose, q, e, qd, method=method), old.scene_at(reference, pose, q, e, qd, method=method)
+            assert one.contact_names == two.contact_names
+            for field in ("Wn", "Wt", "Jn", "Jt", "g_obj", "g_man", "joint_velocity"):
+                np.testing.assert_allclose(getattr(one, field), getattr(two, field), rtol=0, atol=1e-12, equal_nan=True)
+
+
+def test_a_records_range_fields_are_its_described_hands():
+    """At the door a task checks a record's numbers before it becomes a described hand (whose description checks would
+    name other fields): the record and the described hand give the same fields, the paper's parameters first."""
+    two = make_two_finger_hand([[0.0, 0.0], [0.09, 0.0], [0.07, 0.06], [0.02, 0.06]], 0.15, finger_length=0.08)
+    fields = two.range_fields()
+    assert described_from_two_finger(two).range_fields() == fields
+    assert [f for f, *_ in fields][:2] == ["hand.finger_base", "hand.finger_length"] and fields[1][1] == 0.08
+    desc, wp, _ = chain_cases()["two_link_hand"]
+    chain = make_described_hand(desc, wp)
+    assert chain.range_fields() == chain.chain.range_fields()
+    assert [f for f, *_ in chain.range_fields()] == ["hand.workpiece (its width or height)", "hand.workpiece_mass",
+                                                     "hand.gravity", "hand.mu"]  # fmt: skip
+
+
+def test_a_joint_quantity_is_named():
+    hand = make_described_hand(load_hand("paper_hand"), DEFAULT_WORKPIECE)
+    with pytest.raises(QsplanError, match=r"quantity: expected one of q, qd, tau; got 'force'"):
+        hand.joint_units("force")
