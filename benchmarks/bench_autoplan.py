@@ -116,7 +116,7 @@ def hold_margin(task, ph) -> float:
     """The smallest margin (N) of the hold proofs at a hold phase's ramp ends (qsplan.mechanics.bands.hold)."""
     import numpy as np
 
-    from qsplan.hands.found_contacts import row_contact_scene
+    from qsplan.hands.contacts.found import row_contact_scene
     from qsplan.mechanics.bands.hold import prove_hold
 
     pose = ph.poses(task.hand.rest_height)[0]
@@ -193,7 +193,7 @@ def fidelity(demo):
     from qsplan.planner.plan.pivot import pivot_geometry
     from qsplan.planner.plan.results import PlanFailure
     from qsplan.planner.plan.turning import pivot_pieces
-    from qsplan.hands.pivots import pivot_formations
+    from qsplan.hands.formations.pivots import pivot_formations
     from qsplan.planner.task.goal import Goal
 
     print()

@@ -7,11 +7,11 @@ drawn in the joint limits with the workpiece anywhere along the sweep (OMPL's re
 them colliding).  Timed, best of ``--repeat`` (the machine is shared: the best run is the least
 disturbed one):
 
-* ``shapely``: :func:`qsplan.hands.collision.shapely_collisions`, every pair measured with
+* ``shapely``: :func:`qsplan.hands.geometry.collision.shapely_collisions`, every pair measured with
   shapely (the path before issue 13, the reference);
-* ``single``: :func:`qsplan.hands.collision.find_collisions`, one state per call, shapely only
+* ``single``: :func:`qsplan.hands.geometry.collision.find_collisions`, one state per call, shapely only
   for the pairs the fast path does not clear;
-* ``batch b``: :func:`qsplan.hands.collision.find_collisions_batch` on batches of b states.
+* ``batch b``: :func:`qsplan.hands.geometry.collision.find_collisions_batch` on batches of b states.
 
 Each path's verdicts are checked against the reference's; the last column counts the states the fast
 path left (partly) to shapely.
@@ -24,9 +24,9 @@ import time
 
 import numpy as np
 
-from qsplan.hands.two_finger import finger_angles
+from qsplan.hands.paper_hand.two_finger import finger_angles
 from qsplan.planner import load_task
-from qsplan.hands.collision import (COLLIDES, UNDECIDED, collision_decisions, find_collisions,
+from qsplan.hands.geometry.collision import (COLLIDES, UNDECIDED, collision_decisions, find_collisions,
                                              find_collisions_batch, shapely_collisions)  # fmt: skip
 from qsplan.planner.task.task import demo_task_path
 

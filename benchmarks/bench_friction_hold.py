@@ -20,7 +20,7 @@ from pathlib import Path
 
 import numpy as np
 
-from qsplan.hands.found_contacts import contact_names, ordered_contacts, row_contact_scene
+from qsplan.hands.contacts.found import contact_names, ordered_contacts, row_contact_scene
 from qsplan.mechanics.bands.friction_hold import prove_friction_hold
 from qsplan.planner.plan.scripted import plan_task
 from qsplan.planner.task.task import demo_task_path, load_task

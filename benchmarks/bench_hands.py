@@ -2,7 +2,7 @@
 
 Run: ``python3 benchmarks/bench_hands.py [--step 5e-4] [--repeat 3]``.  For each bundled hand (the paper hand
 twice: its closed forms, and the generic path with them switched off) holding the workpiece of its bundled
-task, every candidate grasp (:meth:`qsplan.hands.described.DescribedHand.grasp_candidates`; the two-link hand
+task, every candidate grasp (:meth:`qsplan.hands.described.hand.DescribedHand.grasp_candidates`; the two-link hand
 from a 3 x 3 grid of its proximal joints about the task's ``[start]``) is judged at every workpiece x of a grid
 (``--step``) over ``|x| <= 0.06`` m (``qsplan demo``'s tables), as the planner's band tables judge it:
 
@@ -27,7 +27,7 @@ import tomllib
 
 import numpy as np
 
-from qsplan.hands.described_build import make_described_hand
+from qsplan.hands.described.build import make_described_hand
 from qsplan.hands.description import load_hand
 from qsplan.mechanics.bands.batched import LazyScenes, batch_from_arrays
 from qsplan.mechanics.bands.batched_robust import robust_band_arrays

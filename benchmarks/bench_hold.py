@@ -1,12 +1,13 @@
 """Certified holds on the demo's hand and workpiece (issue 23, item 3): nothing moves while the hand holds still and
 ramps a torque, proved for every friction (:mod:`qsplan.mechanics.bands.hold`), with timings.
 
-* (a) the flush instant (five contacts: the clockwise pivot's start, :func:`qsplan.hands.pivots.pivot_formations`,
-  its scene from the contacts the polygons show, :func:`qsplan.hands.found_contacts.row_contact_scene`), the left
-  finger held and the right finger's torque ramped from the slide's end (the demo's last command, or its band's lower edge) to the
-  transition band's edge (3.8994 N m with the 0.05 N margin, ``docs/reorientation.md``); the interval of right
-  torques a hold is proved at (normal forces >= 1e-6 N, and >= the task's force margin); without and with the
-  demo's inertial box; and, for the route search, the left finger torque-controlled with the right one held;
+* (a) the flush instant (five contacts: the clockwise pivot's start,
+  :func:`qsplan.hands.formations.pivots.pivot_formations`, its scene from the contacts the polygons show,
+  :func:`qsplan.hands.contacts.found.row_contact_scene`), the left finger held and the right finger's torque ramped from
+  the slide's end (the demo's last command, or its band's lower edge) to the transition band's edge (3.8994 N m with the
+  0.05 N margin, ``docs/reorientation.md``); the interval of right torques a hold is proved at (normal forces >= 1e-6 N,
+  and >= the task's force margin); without and with the demo's inertial box; and, for the route search, the left finger
+  torque-controlled with the right one held;
 * (b) the demo's slide end at rest (its last row: four contacts), the left finger held, the right torque anywhere in
   its exported band; beyond the interval, the witness motion;
 * (c) every joint held (a release instant), at both;
@@ -31,9 +32,8 @@ from pathlib import Path
 
 import numpy as np
 
-from qsplan.hands.found_contacts import row_contact_scene
-from qsplan.hands.interface import scene_at
-from qsplan.hands.pivots import pivot_formations
+from qsplan.hands.contacts.found import row_contact_scene
+from qsplan.hands.formations.pivots import pivot_formations
 from qsplan.mechanics.bands.hold import hold_matrix, hold_torque_interval, prove_hold
 from qsplan.mechanics.solver.lp import solve_lp
 from qsplan.planner.task.dynamics import inertial_box
@@ -147,7 +147,7 @@ def main():
 
     pose = [float(row[k]) for k in ("x_workpiece", "y_workpiece", "theta_workpiece")]
     q = [float(row["q_left"]), float(row["q_right"])]
-    end = scene_at(hand, pose, q, [False, True], [0.0, np.nan], [np.nan, command])
+    end = hand.scene(pose, q, [False, True], [0.0, np.nan], [np.nan, command])
     print(f"\n(b) slide end at rest, contacts {', '.join(end.contact_names)}; "
           "left finger held, right torque-controlled")
     print(f"  {'proved torque interval':<46} {'box':>4} {'margin':>10}   interval (N m)")

@@ -15,7 +15,7 @@ import time
 
 import numpy as np
 
-from qsplan.hands.paper import eq42_scene
+from qsplan.hands.examples.paper import eq42_scene
 from qsplan.mechanics import scene_from_dict, solve
 from qsplan.mechanics.muspace.maps import feasibility_map, grid_points, polynomial_map
 from qsplan.mechanics.muspace.slices import boundary_agreement, mu_slice

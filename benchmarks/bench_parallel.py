@@ -19,9 +19,9 @@ import inspect
 import numpy as np
 from bench_muspace import best_of  # the script's own folder is on sys.path
 
-from qsplan.hands.paper import eq42_scene
-from qsplan.hands.segments import first_segment, sample_segment
-from qsplan.hands.two_finger import default_hand
+from qsplan.hands.examples.paper import eq42_scene
+from qsplan.hands.paper_hand.segments import first_segment, sample_segment
+from qsplan.hands.paper_hand.two_finger import default_hand
 from qsplan.mechanics import scene_from_dict, solve
 from qsplan.mechanics.muspace.maps import feasibility_map, grid_points
 from qsplan.mechanics.muspace.slices import mu_slice

@@ -47,7 +47,7 @@ def demo_wall(repeat):
 def table_rate(repeat):
     """In-contact state checks per second (best of ``repeat``): the demo's band tables, every check a scene and a
     guaranteed band with every competitor precluded (one torque-controlled finger, one direction), batched."""
-    from qsplan.hands.grasp_geometry import candidate_grasps
+    from qsplan.hands.paper_hand.grasp_geometry import candidate_grasps
     from qsplan.planner.search.tables import band_tables, table_grid
 
     task = load_task(task_paths()["demo_task"])

@@ -1,11 +1,11 @@
 """The demo's turn as the formation search sees it (issues 23, 32): the flush instant, the transition bands, the pivot
 swept to its end, with timings.
 
-* the flush instant ending the palm-edge slide (:func:`qsplan.hands.pivots.pivot_formations`: Newton's method on the
-  five gap constraints, :mod:`qsplan.hands.manifold`), against the root of segment 1's flush angle
-  (:func:`qsplan.hands.segments.flush_angle`, brentq, an independent closed form);
+* the flush instant ending the palm-edge slide (:func:`qsplan.hands.formations.pivots.pivot_formations`: Newton's method
+  on the five gap constraints, :mod:`qsplan.hands.formations.manifold`), against the root of segment 1's flush angle
+  (:func:`qsplan.hands.paper_hand.segments.flush_angle`, brentq, an independent closed form);
 * the transition mode's robust band at that instant (the five contacts the polygons show,
-  :func:`qsplan.hands.found_contacts.row_contact_scene`; :func:`qsplan.mechanics.robust_band`), each finger
+  :func:`qsplan.hands.contacts.found.row_contact_scene`; :func:`qsplan.mechanics.robust_band`), each finger
   torque-controlled, without and with the task's force margin, and the certifier's mode check
   (:func:`qsplan.planner.certify.modes.mode_checks`) at every friction-box vertex and ``--random`` seeded random
   vectors: just inside each finite edge, far along each unbounded side, just outside each finite edge;
@@ -26,9 +26,9 @@ from itertools import product
 import numpy as np
 from scipy.optimize import brentq
 
-from qsplan.hands.found_contacts import row_contact_scene
-from qsplan.hands.pivots import pivot_formations, pivot_path
-from qsplan.hands.segments import flush_angle
+from qsplan.hands.contacts.found import row_contact_scene
+from qsplan.hands.formations.pivots import pivot_formations, pivot_path
+from qsplan.hands.paper_hand.segments import flush_angle
 from qsplan.mechanics import DEFAULT_TOLERANCES, robust_band, solve_many
 from qsplan.planner.certify.modes import mode_checks
 from qsplan.planner.certify.rows import friction_points
@@ -174,13 +174,11 @@ def figure(task, geometry, rows, bands, events, path_png):
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    from qsplan.hands.interface import hand_body_polygons
-
     path = geometry.path
     fig, (ax0, ax1) = plt.subplots(1, 2, figsize=(12, 5))
     shown = [int(np.argmin(np.abs(path.theta - np.radians(d)))) for d in (0.0, -20.0, -40.0, -54.0)]
     for k, i in enumerate(shown):
-        polys = hand_body_polygons(task.hand, path.pose[i], path.q[i])
+        polys = task.hand.body_polygons(path.pose[i], path.q[i])
         colour = plt.cm.viridis(k / (len(shown) - 1))
         for name in ("left", "right", "workpiece"):
             P = np.vstack([polys[name], polys[name][:1]])

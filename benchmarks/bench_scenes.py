@@ -15,10 +15,10 @@ import time
 
 import numpy as np
 
-import qsplan.hands.two_finger_scene as scenes
-from qsplan.hands.segments import first_segment
-from qsplan.hands.two_finger import default_hand, finger_angles
-from qsplan.hands.two_finger_analytic import grasp_contacts
+import qsplan.hands.paper_hand.scene as scenes
+from qsplan.hands.paper_hand.segments import first_segment
+from qsplan.hands.paper_hand.two_finger import default_hand, finger_angles
+from qsplan.hands.paper_hand.analytic import grasp_contacts
 from qsplan.planner.states.contact import check_contact_state
 from qsplan.planner.task.task import load_task, task_paths
 

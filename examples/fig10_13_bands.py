@@ -1,7 +1,7 @@
 """Figs. 10-13 of Trinkle & Zeng (1995), Section 5.2, for our two-finger hand: torque bands along a 4S segment.
 
 The hand of Fig. 9 (a fixed palm, two single-link fingers; the paper does not
-give its dimensions, ours are in :func:`qsplan.hands.two_finger.default_hand`) holds an
+give its dimensions, ours are in :func:`qsplan.hands.paper_hand.two_finger.default_hand`) holds an
 irregular quadrilateral on the palm.  Segment 1 of the paper's plan translates
 it left until the left finger meets its longest edge, in mode 4S: the left
 finger is velocity-controlled, the right one torque-controlled.  Along it we

@@ -14,7 +14,7 @@ Usage::
     python examples/rod_bouncing.py [OUT_DIR]     # default out/
 
 Writes ``rod_bouncing.png`` and ``rod_equal_friction.png`` and prints the switch
-table against the closed form (:func:`qsplan.hands.rod.rod_closed_form`), including three
+table against the closed form (:func:`qsplan.hands.examples.rod.rod_closed_form`), including three
 random starts drawn with a fixed seed.
 """
 

@@ -1,6 +1,6 @@
 """What the planner may ask a hand: the :class:`Hand` protocol and the values it answers with (issue 22).
 
-A hand holds a workpiece on its palm in a contact *formation* (:mod:`qsplan.hands.formations`): the
+A hand holds a workpiece on its palm in a contact *formation* (:mod:`qsplan.hands.formations.registry`): the
 bottom edge on the palm and one contact per finger, each finger's last joint closed onto the workpiece
 (Section 5.2, Fig. 9).  :class:`Hand` is a :class:`typing.Protocol` (as
 :class:`qsplan.mechanics.motion.system.MotionSystem` is for finite motions): body polygons at a
@@ -8,11 +8,11 @@ configuration, the grasps worth considering, the grasp's configurations along th
 (:class:`GraspStates`: closed joints, contacts, joint rates), their scenes' arrays batched
 (:class:`GraspSceneArrays`, eqs. 1-5), one scene, collisions, opening directions, metadata, and the joints'
 units, fingers and axes, the scales a drawing takes and the numbers a task checks (issue 32: the planner asks a
-hand through this protocol only).  Its one implementation is :class:`qsplan.hands.described.DescribedHand`.
+hand through this protocol only).  Its one implementation is :class:`qsplan.hands.described.hand.DescribedHand`.
 
 :class:`ChainGrasp` is a grasp of any described hand: per finger the contact key ``(link, kind, feature)``
 the closing gives (:class:`FingerContact`) and the free joints' values; the paper's hand keeps its
-:class:`qsplan.hands.grasps.Grasp` (placements).  Both have ``label`` and ``matches``.  Arrays are numpy, in
+:class:`qsplan.hands.paper_hand.grasps.Grasp` (placements).  Both have ``label`` and ``matches``.  Arrays are numpy, in
 SI units (m, rad; m for a prismatic joint's position, rad/m or m/m for its rate per unit workpiece x).
 """
 
@@ -23,14 +23,14 @@ from typing import Protocol, runtime_checkable
 
 import numpy as np
 
-from qsplan.hands.grasps import parse_goal
+from qsplan.hands.paper_hand.grasps import parse_goal
 
 __all__ = ["CONTACT_KINDS", "ChainGrasp", "FingerContact", "GraspSceneArrays", "GraspStates", "Hand", "JOINT_UNITS",
            "SlideMotion", "STATE_REASONS",
            "NO_CONTACT", "OTHER_CONTACT", "FLUSH", "NO_PLACEMENT", "SINGULAR"]
 
 #: A finger contact's kind: ``"vertex"``, a workpiece vertex on a link edge; ``"edge"``, a link vertex (a corner)
-#: on a workpiece edge (:class:`qsplan.hands.closing.ClosedFinger`).
+#: on a workpiece edge (:class:`qsplan.hands.chains.closing.ClosedFinger`).
 CONTACT_KINDS = ("vertex", "edge")
 
 #: Units of a joint's position (``q``), velocity (``qd``) and effort (``tau``), by joint kind (SI):
@@ -77,7 +77,7 @@ class FingerContact:
 
     @property
     def key(self) -> tuple:
-        """``(link, kind, feature)``: :attr:`qsplan.hands.closing.ClosedFinger.key`."""
+        """``(link, kind, feature)``: :attr:`qsplan.hands.chains.closing.ClosedFinger.key`."""
         return (self.link, self.kind, self.feature)
 
     def __str__(self) -> str:
@@ -132,8 +132,8 @@ class ChainGrasp:
         return self.label
 
     def matches(self, goal_left=None, goal_right=None) -> bool:
-        """Whether the grasp meets the goal placements (strings as :meth:`qsplan.hands.grasps.Grasp.matches` takes them,
-        user numbering; None: anything): :meth:`FingerContact.matches` of each finger."""
+        """Whether the grasp meets the goal placements (strings as :meth:`qsplan.hands.paper_hand.grasps.Grasp.matches`
+        takes them, user numbering; None: anything): :meth:`FingerContact.matches` of each finger."""
         return self.left.matches(goal_left, "goal_left") & self.right.matches(goal_right, "goal_right")
 
 
@@ -141,13 +141,13 @@ class ChainGrasp:
 class GraspStates:
     """A grasp at ``n`` workpiece positions on the palm (pose ``(x, rest_height, 0)``), its formation's contacts.
 
-    A superset of :class:`qsplan.hands.grasp_geometry.GraspConfigurations` for any hand and formation.  Its arrays
-    may be shared with the closings a hand keeps (:func:`qsplan.hands.described_states.closing_of`): read-only.
+    A superset of :class:`qsplan.hands.paper_hand.grasp_geometry.GraspConfigurations` for any hand and formation.  Its
+    arrays may be shared with the closings a hand keeps (:func:`qsplan.hands.described.states.closing_of`): read-only.
 
     Attributes
     ----------
-    formation : qsplan.hands.formations.Formation
-    grasp : qsplan.hands.grasps.Grasp or ChainGrasp
+    formation : qsplan.hands.formations.registry.Formation
+    grasp : qsplan.hands.paper_hand.grasps.Grasp or ChainGrasp
     x : ndarray, shape (n,)
         Workpiece x (m).
     poses : ndarray, shape (n, 3)
@@ -206,9 +206,9 @@ class GraspStates:
 
     def why(self, k: int) -> str | None:
         """Why state ``k`` is not ok, in words (None where it is): a paper placement without a configuration names the
-        finger and how (:func:`qsplan.hands.grasps.no_placement_words`)."""
+        finger and how (:func:`qsplan.hands.paper_hand.grasps.no_placement_words`)."""
         if int(self.reason[k]) == NO_PLACEMENT and not isinstance(self.grasp, ChainGrasp):
-            from qsplan.hands.grasps import no_placement_words
+            from qsplan.hands.paper_hand.grasps import no_placement_words
 
             return no_placement_words(self.grasp, int(np.argmin(self.finger_ok[k])))
         return STATE_REASONS.get(int(self.reason[k]))
@@ -224,8 +224,9 @@ class GraspStates:
         return (link * 2 + kind) * 1000 + self.touched
 
     def matches(self, goal_left=None, goal_right=None) -> np.ndarray:
-        """Where the grasp meets the goal placements (strings as :meth:`qsplan.hands.grasps.Grasp.matches` takes them),
-        shape (n,) bool: ``"vertex:K"`` where the finger touches vertex ``K`` (user numbering), the others wherever ok."""
+        """Where the grasp meets the goal placements (strings as :meth:`qsplan.hands.paper_hand.grasps.Grasp.matches`
+        takes them), shape (n,) bool: ``"vertex:K"`` where the finger touches vertex ``K`` (user numbering), the others
+        wherever ok."""
         out = self.ok.copy()
         if not self.grasp.matches(goal_left, goal_right):
             return np.zeros_like(out)
@@ -264,7 +265,7 @@ class GraspSceneArrays:
     fallback : dict of int to Scene
         The states (positions in ``idx``) whose scene the polygon search built, where the closed form could not decide.
     closed_form : bool
-        Built by the paper's closed forms (:mod:`qsplan.hands.paper_accelerator`), whose scenes they build again.
+        Built by the paper's closed forms (:mod:`qsplan.hands.paper_hand.accelerator`), whose scenes they build again.
     """
 
     idx: np.ndarray
@@ -328,7 +329,7 @@ class Hand(Protocol):
     workpiece_mass, mu, rest_height, gravity : float
         kg; friction of every contact; height (m) of the centre of mass on the palm; m/s^2 along -y.
     vertex_order, vertex_of_user : tuple of int
-        Internal and user vertex numbering (:class:`qsplan.hands.workpiece.PreparedWorkpiece`).
+        Internal and user vertex numbering (:class:`qsplan.hands.geometry.workpiece.PreparedWorkpiece`).
     palm : ndarray, shape (p, 2)
         The palm polygon (m), top edge on ``y = 0``.
     own_limits : (ndarray (n_j, 2), ndarray (n_j,)) or None
@@ -401,8 +402,8 @@ class Hand(Protocol):
 
     def slide_motion(self, formation, grasp, xs, xdot, effort_joint: int, free=None, free_rates=None):
         """A slide's configurations, joint rates, contacts and scenes at ``xs`` (n,) moving at ``xdot`` (m/s):
-        :class:`qsplan.hands.motion.SlideMotion` (raises :class:`~qsplan.mechanics.errors.SceneError` naming the first
-        x without a configuration)."""
+        :class:`qsplan.hands.formations.motion.SlideMotion` (raises :class:`~qsplan.mechanics.errors.SceneError` naming
+        the first x without a configuration)."""
 
     def scene(self, pose, q, effort_controlled, velocity, effort=None, mu=None, method: str = "auto"):
         """One :class:`qsplan.mechanics.Scene` at ``pose`` (3,) and ``q`` (n_j,); ``"generic"``: the polygon search."""
@@ -411,7 +412,7 @@ class Hand(Protocol):
         """Whether two bodies overlap beyond their tolerance at each state: ``poses`` (n, 3), ``q`` (n, n_j) -> (n,)."""
 
     def collisions(self, pose, q, first: bool = False) -> list:
-        """The overlapping body pairs at one state, named (:class:`qsplan.hands.collision.Collision`)."""
+        """The overlapping body pairs at one state, named (:class:`qsplan.hands.geometry.collision.Collision`)."""
 
     def opening(self, grasp, x, q) -> np.ndarray:
         """Each joint's opening direction (-1, 0, +1), shape (n_j,), releasing ``grasp`` at workpiece ``x``, joints ``q``
@@ -438,4 +439,5 @@ class Hand(Protocol):
         ``pose`` (3,): the joints (n_j,)."""
 
     def metadata(self) -> dict:
-        """The hand as a plan's metadata records it (:func:`qsplan.hands.described_build.hand_from_metadata` reads it)."""
+        """The hand as a plan's metadata records it (:func:`qsplan.hands.described.build.hand_from_metadata` reads
+        it)."""

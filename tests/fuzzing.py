@@ -56,7 +56,7 @@ class ReachedPlanning(BaseException):
 
 def seed_scenes() -> dict:
     """``{name: (document, suffix)}``: the paper's raw scenes, a raw scene with joints, a geometric one."""
-    from qsplan.hands.paper import eq37_scene, eq42_scene, rod_scene
+    from qsplan.hands.examples.paper import eq37_scene, eq42_scene, rod_scene
 
     joints = {
         "g_obj": [0.0, -1.0, 0.0],

@@ -308,7 +308,7 @@ def test_the_hand_type_check_finds_branches(tmp_path):
 
 #: The module the planner asked its questions about a hand through before issue 32 (it dispatches on the hand records'
 #: types): the planner asks the :class:`qsplan.hands.protocol.Hand` protocol instead.
-HAND_DISPATCH = "qsplan.hands.interface"
+HAND_DISPATCH = "qsplan.hands.described.records"
 
 
 def _interface_importers(modules=None) -> list:
@@ -327,11 +327,12 @@ def test_the_planner_does_not_import_the_hand_dispatch():
 
 
 def test_the_dispatch_import_check_finds_imports(tmp_path):
-    sources = {"qsplan.planner.plan.a": "def f(h):\n    from qsplan.hands.interface import joint_names\n",
-               "qsplan.planner.plan.b": "import qsplan.hands.interface as i\n",
-               "qsplan.planner.plan.c": "from qsplan.hands import interface\n",
-               "qsplan.planner.plan.d": "# from qsplan.hands.interface import scene_at\nX = 'qsplan.hands.interface'\n",
-               "qsplan.hands.e": "from qsplan.hands.interface import scene_at\n"}  # fmt: skip
+    sources = {"qsplan.planner.plan.a": "def f(h):\n    from qsplan.hands.described.records import joint_names\n",
+               "qsplan.planner.plan.b": "import qsplan.hands.described.records as i\n",
+               "qsplan.planner.plan.c": "from qsplan.hands.described import records\n",
+               "qsplan.planner.plan.d": "# from qsplan.hands.described.records import scene_at\n"
+                                        "X = 'qsplan.hands.described.records'\n",
+               "qsplan.hands.e": "from qsplan.hands.described.records import scene_at\n"}  # fmt: skip
     modules = {}
     for name, text in sources.items():
         modules[name] = tmp_path / f"{name}.py"

@@ -4,8 +4,8 @@ A description has the paper's structure when it is two single-link revolute fing
 ``(-b, 0, 0)`` and ``(+b, 0, 0)``, both links the rectangle ``(0, -w), (L, -w), (L, w), (0, w)`` (the
 same ``L > 2 w > 0``) of equal mass with its centre at ``(L / 2, 0)``, and the palm the rectangle
 ``[-P, P] x [-T, 0]``: then :func:`two_finger_parameters` gives the arguments of
-:func:`qsplan.hands.two_finger.make_two_finger_hand` that reproduce it, so the closed forms of
-:mod:`qsplan.hands.two_finger` apply.  :func:`describe_two_finger_hand` goes the other way.
+:func:`qsplan.hands.paper_hand.two_finger.make_two_finger_hand` that reproduce it, so the closed forms of
+:mod:`qsplan.hands.paper_hand.two_finger` apply.  :func:`describe_two_finger_hand` goes the other way.
 """
 
 from __future__ import annotations
@@ -13,7 +13,7 @@ from __future__ import annotations
 import numpy as np
 
 from qsplan.hands.description.model import HandDescription, make_hand_description
-from qsplan.hands.two_finger import JOINT_NAMES, TwoFingerHand
+from qsplan.hands.paper_hand.two_finger import JOINT_NAMES, TwoFingerHand
 from qsplan.mechanics.errors import SceneError
 
 __all__ = ["FORM_TOL", "two_finger_parameters", "describe_two_finger_hand"]
@@ -39,7 +39,8 @@ def _rectangle(shape, tol):
 
 
 def two_finger_parameters(desc: HandDescription, tol: float = FORM_TOL) -> dict | None:
-    """The arguments of :func:`qsplan.hands.two_finger.make_two_finger_hand` that reproduce ``desc``, or None.
+    """The arguments of :func:`qsplan.hands.paper_hand.two_finger.make_two_finger_hand` that reproduce ``desc``, or
+    None.
 
     Parameters
     ----------
@@ -87,7 +88,7 @@ def describe_two_finger_hand(hand: TwoFingerHand, joint_limits, joint_speed, nam
                              source="inline") -> HandDescription:  # fmt: skip
     """A :class:`TwoFingerHand`'s palm and fingers as a :class:`HandDescription` (joints ``"left"``, ``"right"``).
 
-    The manipulator equals :func:`qsplan.hands.two_finger_scene.hand_manipulator`'s (joints, origins, link
+    The manipulator equals :func:`qsplan.hands.paper_hand.scene.hand_manipulator`'s (joints, origins, link
     shapes, masses and centres, palm, gravity); the workpiece and friction are not part of a hand.
 
     Parameters

@@ -12,13 +12,13 @@ message)`` triples, the row the phase's first.  What each key promises, and how 
     moves, ``pivot`` where the workpiece turns, ``slide`` otherwise.  ``contacts``: the contacts the first row's mode
     letters follow; ``contact_sets``: each run of rows (first and last, counted within the phase) with one list of
     contacts and one mode, as the row checks found the contacts; ``formation``: the registered formation
-    (:mod:`qsplan.hands.formations`) with the contacts of the last run (a pivot's first row judges the transition).
-    ``competitors_precluded``: distinct modes, each of the length of a mode the phase's rows plan and none of them.
-    The promise is what the band check proves: at every row, every mode of its contacts but the planned one is
-    precluded for every friction in the set (all of them, listed or not).  ``workpiece_speed_m_s``: the largest speed of
-    the workpiece's centre of mass at the quasistatic speed (``speed_scale`` 1): 0 where nothing moves; a translating
-    workpiece's speed over every interval (its distance over the path covered: the rule's integral of the speed scale
-    over time); a turning one's at least every interval's mean and at most the task's limit.  ``command``:
+    (:mod:`qsplan.hands.formations.registry`) with the contacts of the last run (a pivot's first row judges the
+    transition).  ``competitors_precluded``: distinct modes, each of the length of a mode the phase's rows plan and
+    none of them.  The promise is what the band check proves: at every row, every mode of its contacts but the planned
+    one is precluded for every friction in the set (all of them, listed or not).  ``workpiece_speed_m_s``: the largest
+    speed of the workpiece's centre of mass at the quasistatic speed (``speed_scale`` 1): 0 where nothing moves; a
+    translating workpiece's speed over every interval (its distance over the path covered: the rule's integral of the
+    speed scale over time); a turning one's at least every interval's mean and at most the task's limit.  ``command``:
     ``margin_N_m`` the least margin cell, ``half_narrowest_band_N_m`` half the narrowest band, ``max_N_m`` the
     largest command, ``lower_edge_max_N_m`` the largest lower edge.  ``time_scaling``: ``duration_s`` the phase's,
     ``pieces`` its rest-to-rest pieces (runs of rows in motion), ``path_acceleration_1_s2`` the largest change of the
@@ -251,11 +251,11 @@ def _more(d, task, cols, rows, path, evidence, names) -> list:
 
 def _formation_claim(name, task, cols, rows, last, path) -> list:
     """A phase's ``formation``: a registered one (the palm edge's) whose contacts are the phase's last set, or a
-    generated pivot (:func:`qsplan.hands.pivots.pivot_from_name`) whose constraints hold at every row of the phase
-    (each gap within the contact tolerance) and whose pivot vertex is on the palm at its last row."""
-    from qsplan.hands.formations import FORMATIONS
-    from qsplan.hands.manifold import gaps
-    from qsplan.hands.pivots import pivot_from_name
+    generated pivot (:func:`qsplan.hands.formations.pivots.pivot_from_name`) whose constraints hold at every row of the
+    phase (each gap within the contact tolerance) and whose pivot vertex is on the palm at its last row."""
+    from qsplan.hands.formations.registry import FORMATIONS
+    from qsplan.hands.formations.manifold import gaps
+    from qsplan.hands.formations.pivots import pivot_from_name
     from qsplan.mechanics.model.geometry import CONTACT_TOL
     from qsplan.planner.certify.rows import row_pose, row_q
 

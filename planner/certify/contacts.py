@@ -1,13 +1,13 @@
 """The certifier's contacts of a row in any formation, found in the polygons (issue 23).
 
 A row's ``mode`` has one letter per contact the row is judged with, in the canonical order of
-:mod:`qsplan.hands.found_contacts` (the palm's contacts left to right, then each finger's from its base outward).
+:mod:`qsplan.hands.contacts.found` (the palm's contacts left to right, then each finger's from its base outward).
 Which contacts those are is decided here from the row's geometry alone:
 
 * a moving row, or a row at rest that starts its phase: every contact the polygon search finds (a contact that opens
   toward the next row is judged as breaking, ``B``);
 * a row at rest that ends its phase: the same, without the contacts its motion makes only there (open at the previous
-  row: :func:`qsplan.hands.found_contacts.made_contacts`), e.g. the slide's last row at the flush instant (its hold,
+  row: :func:`qsplan.hands.contacts.found.made_contacts`), e.g. the slide's last row at the flush instant (its hold,
   :func:`qsplan.planner.certify.timing.hold_checks`, is proved with them: at rest every contact present pushes);
 * a **hold row** (every letter ``R``, at rest, its phase not moving): every contact found; nothing moves, and the hold
   proof (:mod:`qsplan.mechanics.bands.hold`), not the mode check, decides it.
@@ -44,7 +44,7 @@ def hold_row(cols, k) -> bool:
 def judged_contacts(task, cols, k):
     """``(found contacts, drop mask)`` of row ``k`` (the module docstring): the canonical contacts and which of them
     the row's motion makes only there (not judged)."""
-    from qsplan.hands.found_contacts import made_contacts, ordered_contacts
+    from qsplan.hands.contacts.found import made_contacts, ordered_contacts
 
     pose, q = _configuration(task, cols, k)
     found = ordered_contacts(task.hand, pose, q)
@@ -59,9 +59,9 @@ def judged_contacts(task, cols, k):
 def row_contact_names(task, cols, k, judged=None) -> tuple:
     """The names of the contacts row ``k``'s mode letters follow, in order: its judged contacts
     (:func:`judged_contacts`, without those its motion makes only there; named by
-    :func:`qsplan.hands.found_contacts.contact_names` among themselves: a finger left with one contact is ``left``), or
+    :func:`qsplan.hands.contacts.found.contact_names` among themselves: a finger left with one contact is ``left``), or
     without ``judged`` (a hand that does not reorient) the task's formation's."""
-    from qsplan.hands.found_contacts import contact_names
+    from qsplan.hands.contacts.found import contact_names
 
     if judged is None:
         return tuple(task.formation.contact_names)
@@ -94,8 +94,8 @@ def judged_contact_checks(task, cols, k, judged) -> list:
 
 
 def judged_scene(task, cols, k, judged, effort, qd, tau):
-    """The row's scene with its judged contacts (:func:`qsplan.hands.found_contacts.row_contact_scene`)."""
-    from qsplan.hands.found_contacts import row_contact_scene
+    """The row's scene with its judged contacts (:func:`qsplan.hands.contacts.found.row_contact_scene`)."""
+    from qsplan.hands.contacts.found import row_contact_scene
 
     found, drop = judged
     pose, q = _configuration(task, cols, k)

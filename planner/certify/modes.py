@@ -143,7 +143,7 @@ def row_scene(task, cols, k, judged=None):
 
         return judged_scene(task, cols, k, judged, effort, qd, tau)
     # method="generic": contacts found by polygon contact finding, the reference path, not the
-    # closed-form grasp the planner uses (qsplan.hands.two_finger_analytic): a certifier shares no
+    # closed-form grasp the planner uses (qsplan.hands.paper_hand.analytic): a certifier shares no
     # shortcut with what it certifies (~2 ms per row); a chain hand's contacts are always found so
     return task.hand.scene(row_pose(cols, k), row_q(cols, k, names), effort, qd, effort=tau, method="generic")
 

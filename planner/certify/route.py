@@ -75,7 +75,7 @@ def structure_checks(cols) -> list:
 
 
 def _user_edge(hand, e: int) -> int:
-    from qsplan.hands.grasps import user_edge
+    from qsplan.hands.paper_hand.grasps import user_edge
 
     return user_edge(hand, e)
 
@@ -160,7 +160,7 @@ def orientation_checks(task, cols, last_bodies) -> list:
     ``palm`` names on the palm (``edge:K``: both its ends; ``vertex:K``: that vertex), K as the task writes it."""
     from shapely.geometry import Point
 
-    from qsplan.hands.workpiece import workpiece_world
+    from qsplan.hands.geometry.workpiece import workpiece_world
 
     from qsplan.planner.certify.rows import CONTACT_GAP_TOL, row_pose
 

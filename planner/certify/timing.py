@@ -103,7 +103,7 @@ def timing_checks(task, cols) -> list:
     dyn = task_dynamics(task)
     box = task.disturbance
     m = float(task.hand.workpiece_mass)
-    from qsplan.hands.workpiece import polygon_inertia
+    from qsplan.hands.geometry.workpiece import polygon_inertia
 
     inertia = polygon_inertia(task.hand.workpiece, m)[1]  # about the centre of mass: the turning term
     for rows in _phase_rows(cols):
@@ -170,11 +170,11 @@ def hold_checks(task, cols, scenes) -> tuple:
     """Every in-contact row at rest (``speed_scale`` 0; ``scenes``: ``{row: Scene}``, the rows judged) holds:
     ``(violations [(row, kind, message)], records [{row, t_s, proved, margin_N, proof}])``.
 
-    The hold is proved with every contact present at the row (:func:`qsplan.hands.found_contacts.hold_scene`, the
+    The hold is proved with every contact present at the row (:func:`qsplan.hands.contacts.found.hold_scene`, the
     contacts found in the polygons), not only the contacts the row's mode judges: at a phase's last row the mode
     leaves out a contact the motion makes there (it opens along that motion), and at rest that contact pushes as
     well as any other."""
-    from qsplan.hands.found_contacts import hold_scene
+    from qsplan.hands.contacts.found import hold_scene
     from qsplan.mechanics.bands.hold import prove_hold
     from qsplan.mechanics.errors import QsplanError
 

@@ -140,7 +140,7 @@ def _options(args):
 def _document(args, motion, cf):
     import numpy as np
 
-    from qsplan.hands.rod import rod_distances
+    from qsplan.hands.examples.rod import rod_distances
     from qsplan.mechanics import ContactMode
 
     segs = []
@@ -197,7 +197,7 @@ def _write_figure(motion, cf, path, force):
 
 
 def run(args, out) -> int:
-    from qsplan.hands.rod import rod_closed_form, simulate_rod
+    from qsplan.hands.examples.rod import rod_closed_form, simulate_rod
 
     _check(args)
     options = _options(args)

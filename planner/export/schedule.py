@@ -111,7 +111,7 @@ def schedule_columns(bands) -> tuple:
 def schedule_metadata(bands, resolution=None) -> dict:
     """What a controller engineer needs to trust the schedule (all SI); ``resolution``: the controller's torque
     resolution (N m) the command's margin was sized with, if any."""
-    from qsplan.hands.described_build import as_hand
+    from qsplan.hands.described.build import as_hand
     from qsplan.mechanics.bands.effort import check_force_margin
     from qsplan.mechanics.modes.contact_mode import ContactMode
 

@@ -2,7 +2,7 @@
 
 :func:`plan_automatic` is :func:`qsplan.planner.plan.scripted.plan_task` for tasks with a ``[goal]``:
 
-1. **Tables.**  Every candidate grasp of the hand (:func:`qsplan.hands.grasps.candidate_grasps`:
+1. **Tables.**  Every candidate grasp of the hand (:func:`qsplan.hands.paper_hand.grasps.candidate_grasps`:
    each finger's inner edge on a vertex, or its tip on an edge) judged on a grid of the
    workpiece's ``x`` through the start and the goal, where the workpiece rests on the palm
    (:func:`qsplan.planner.search.tables.band_tables`, :func:`qsplan.planner.task.goal.palm_x_range`).
@@ -86,8 +86,8 @@ def _start_grasps(tables, task, i):
 
 def _meets(tables, task, g, i, feats) -> bool:
     """Whether row ``g`` at grid index ``i`` touches the features ``feats`` (left, right: text or None)
-    (:func:`qsplan.hands.grasps.grasp_meets`)."""
-    from qsplan.hands.grasps import grasp_meets
+    (:func:`qsplan.hands.paper_hand.grasps.grasp_meets`)."""
+    from qsplan.hands.paper_hand.grasps import grasp_meets
 
     return grasp_meets(task.hand, tables.grasps[g].grasp, tables.graph.touched[g, i, :2], feats)
 

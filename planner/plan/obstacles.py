@@ -73,7 +73,7 @@ class NoRouteReport:
 
 def _touching(task, tables, g, i) -> str:
     """What row ``g`` touches at grid index ``i``, in the polygon's numbering as written."""
-    from qsplan.hands.grasps import touch_words
+    from qsplan.hands.paper_hand.grasps import touch_words
 
     grasp = tables.grasps[g].grasp
     return " and ".join(touch_words(task.hand, grasp, k, int(tables.graph.touched[g, i, k])) for k in range(2))
@@ -142,7 +142,7 @@ def blocking_overlap(task, tables, i, rows):
 
     Returns
     -------
-    (int, ndarray (n_j,), qsplan.hands.collision.Collision, bool) or None
+    (int, ndarray (n_j,), qsplan.hands.geometry.collision.Collision, bool) or None
         The row, its joints (rad or m), the overlap, and whether the fingers were opened.
     """
     from qsplan.planner.search.tables import OVERLAP

@@ -157,8 +157,8 @@ def sweep_contact_segment(task, name, x, effort, direction, touching, comps, gra
     direction : float
         Sign of the workpiece's velocity.
     touching : ndarray, shape (2,)
-        What the fingers touch at the segment's start (:attr:`qsplan.hands.motion.SlideMotion.touching`; a change is
-        invalid).
+        What the fingers touch at the segment's start (:attr:`qsplan.hands.formations.motion.SlideMotion.touching`; a
+        change is invalid).
     comps : tuple of str
         The competing modes to preclude (:func:`qsplan.planner.torque.sweep.competing_modes`).
     grasp : optional
@@ -170,7 +170,7 @@ def sweep_contact_segment(task, name, x, effort, direction, touching, comps, gra
     -------
     k : int or None
         Index of the first invalid sample, or None.
-    samples : qsplan.hands.segments.SegmentSamples or None
+    samples : qsplan.hands.paper_hand.segments.SegmentSamples or None
         When every sample is valid: the samples moving at ``speed``; else None.
     band : qsplan.mechanics.bands.effort.Band or None
         Their guaranteed band (N m or N), competitors precluded.

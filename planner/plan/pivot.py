@@ -1,7 +1,7 @@
 """A pivot realised: its rows along the manifold, where its formation ends, its pieces' bands, the holds between them.
 
-A pivot formation (:class:`qsplan.hands.pivots.Pivot`) is swept from its start (a flush instant, theta 0) toward a
-goal angle at rows at most :data:`PIVOT_STEP` apart (:func:`pivot_geometry`), and ends at its first **event**
+A pivot formation (:class:`qsplan.hands.formations.pivots.Pivot`) is swept from its start (a flush instant, theta 0)
+toward a goal angle at rows at most :data:`PIVOT_STEP` apart (:func:`pivot_geometry`), and ends at its first **event**
 (:class:`PivotEnd`): no configuration (a finger out of reach), a joint limit or two bodies overlapping, the polygons
 showing another contact set (a contact made or lost), a contact leaving its edge.  Along the valid rows a contact's
 sliding direction may **reverse** (eq. 16: it rolls for an instant, 4S does not hold there): the pivot is then cut
@@ -9,7 +9,7 @@ into pieces at each reversal's angle, each piece a 4S phase that starts and ends
 (:func:`hold_phase`) in which the torque-controlled finger's torque ramps from one piece's command to the next.
 
 Each piece's rows are judged as the certifier judges them (:mod:`qsplan.planner.certify`): the contacts the polygons
-show, in the canonical order (:func:`qsplan.hands.found_contacts.row_contact_scene`); a row at rest (a piece's ends)
+show, in the canonical order (:func:`qsplan.hands.contacts.found.row_contact_scene`); a row at rest (a piece's ends)
 for the straight line to its neighbour; the first piece's first row with the bottom edge's lifting vertex too (its
 letter ``B``: the transition from the flush instant); the last row without a contact it makes there (an edge
 landing).  Its band is :func:`qsplan.mechanics.robust_band`'s for 4S with every competitor precluded (exact or
@@ -71,7 +71,7 @@ class PivotGeometry:
 
     Attributes
     ----------
-    path : qsplan.hands.pivots.PivotPath
+    path : qsplan.hands.formations.pivots.PivotPath
         Every row, its goal's included (rows past ``end`` are not part of the formation).
     end : PivotEnd or None
         The first event before the goal; None: the rows reach the goal.
@@ -98,9 +98,9 @@ def _expected_contacts(i: int, n: int) -> int:
 def pivot_geometry(task, pivot, start, theta_goal: float) -> PivotGeometry:
     """``pivot`` swept from configuration ``start`` (its flush instant) to ``theta_goal`` (rad), its first event and
     the slip reversals before it (module docstring)."""
-    from qsplan.hands.found_contacts import made_contacts, ordered_contacts
-    from qsplan.hands.manifold import along_edges
-    from qsplan.hands.pivots import pivot_path
+    from qsplan.hands.contacts.found import made_contacts, ordered_contacts
+    from qsplan.hands.formations.manifold import along_edges
+    from qsplan.hands.formations.pivots import pivot_path
     from qsplan.mechanics.errors import SceneError
     from qsplan.planner.states.contact import configuration_problem
 
@@ -145,7 +145,7 @@ def pivot_geometry(task, pivot, start, theta_goal: float) -> PivotGeometry:
 def _slips(hand, pose, q, dpose, dq, found=None) -> np.ndarray:
     """Each contact's sliding speed per unit turning rate (m/rad) at one row of a pivot, canonical order (eq. 6's
     ``W_t^T nu - J_t qdot`` with the manifold's tangent); ``found``: the row's contacts when already searched."""
-    from qsplan.hands.found_contacts import row_contact_scene
+    from qsplan.hands.contacts.found import row_contact_scene
 
     n_j = len(hand.joint_names)
     scene = row_contact_scene(hand, pose, q, np.zeros(n_j, bool), dq, found=found)
@@ -157,7 +157,7 @@ def _reversals(task, pivot, path, valid: int, contacts) -> tuple:
     """The angles (rad, bisected to :data:`REVERSAL_TOL`) where a contact's sliding direction reverses along the
     four-contact rows ``1 .. valid - 1`` of ``path`` (``contacts``: each row's, searched); each later cut from the
     previous one's side."""
-    from qsplan.hands.pivots import pivot_path
+    from qsplan.hands.formations.pivots import pivot_path
 
     hand = task.hand
     rows = range(1, valid)
@@ -203,14 +203,14 @@ def piece_phase(task, name, pivot, path, rows, effort_joint: str, rate: float, t
     """One piece of a pivot: ``path``'s ``rows`` (indices, in order), ``effort_joint`` torque-controlled, the other
     joints driven along the manifold at turning ``rate`` (rad/s, its sign the pivot's direction); ``transition``: the
     first row is the flush instant (the lifting vertex's letter ``B``); ``contacts``: each row's contacts, when
-    already searched (:func:`qsplan.hands.found_contacts.ordered_contacts`).  Times from 0 at the quasistatic speed.
+    already searched (:func:`qsplan.hands.contacts.found.ordered_contacts`).  Times from 0 at the quasistatic speed.
 
     Raises
     ------
     PlanFailure
         A row without a guaranteed band at least the torque resolution wide (naming the row's angle and why).
     """
-    from qsplan.hands.found_contacts import made_contacts, ordered_contacts, row_contact_scene
+    from qsplan.hands.contacts.found import made_contacts, ordered_contacts, row_contact_scene
     from qsplan.mechanics.bands.batched_robust import robust_bands
     from qsplan.planner.torque.command import plan_command, smooth_command
 
@@ -279,7 +279,7 @@ def widest_piece(task, name, pivot, path, rows, transition: bool, progress=None)
     """:func:`piece_phase` with each closing joint torque-controlled in turn, the one whose narrowest band is widest
     (the finger not lying flush first: it keeps a tie, and when its bands are all unbounded above the other is not
     computed); the first one's failure when neither has a band."""
-    from qsplan.hands.found_contacts import ordered_contacts
+    from qsplan.hands.contacts.found import ordered_contacts
 
     hand = task.hand
     fingers = (pivot.other_finger, pivot.flush)
@@ -312,11 +312,11 @@ def _row_failure(task, name, path, i, why) -> PlanFailure:
 
 
 def held_interval(task, pose, q, effort):
-    """``(scene, (lo, hi))``: every contact present at ``pose``, ``q`` (:func:`qsplan.hands.found_contacts.hold_scene`,
+    """``(scene, (lo, hi))``: every contact present at ``pose``, ``q`` (:func:`qsplan.hands.contacts.found.hold_scene`,
     the certifier's rule: the polygons' contacts), the ``effort`` joints (bool) torque-controlled and the others held,
     and the torques at which the hold is proved with every contact loaded by the task's force margin at every vertex
     of its disturbance box (N m; nan when none)."""
-    from qsplan.hands.found_contacts import hold_scene
+    from qsplan.hands.contacts.found import hold_scene
     from qsplan.mechanics.bands.hold import hold_torque_interval
 
     scene = hold_scene(task.hand, pose, q, effort)

@@ -68,7 +68,7 @@ class ContactSegmentPlan:
         Each row's contact mode, one letter per contact the row is judged with (:attr:`contacts`); None: ``mode``
         at every row.
     formation : str
-        The registered formation (:mod:`qsplan.hands.formations`) naming the phase's contacts.
+        The registered formation (:mod:`qsplan.hands.formations.registry`) naming the phase's contacts.
     contacts : tuple of tuple of str, or None
         Per row, the names of the contacts its mode's letters follow, in order; None: the formation's.
     """

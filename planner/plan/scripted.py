@@ -5,11 +5,11 @@
 1. **In-contact segments.**  Segment ``i`` slides the workpiece along the palm from
    the previous waypoint to the next in the formation's mode (4S today); its configuration
    variable is the workpiece's ``x`` alone (the fingers follow by tangency,
-   :func:`qsplan.hands.two_finger.finger_angles`), so the only path is the straight line
+   :func:`qsplan.hands.paper_hand.two_finger.finger_angles`), so the only path is the straight line
    and there is nothing to search: no OMPL here.  The line is swept every
    :data:`SWEEP_STEP` and every sample judged once with the validity conditions of
    :func:`check_contact_state`: no two bodies overlapping (every pair of fingers, palm
-   and workpiece: :mod:`qsplan.hands.collision`), the same four contacts as at
+   and workpiece: :mod:`qsplan.hands.geometry.collision`), the same four contacts as at
    the segment's start and the 4S kinematics possible (eqs. 24-25), joints inside their
    limits, and a guaranteed band (desired mode feasible for the whole friction set, every
    competing mode precluded: :func:`qsplan.planner.torque.pointwise.guaranteed_sweep`) at

@@ -162,7 +162,7 @@ def _rest_bands(task, ph):
 def _rest_holds(task, ph, lower, upper, command, margin):
     """``(lower, upper, command, margin)`` with each row at rest's command proved to hold there, as the certifier
     proves it (:func:`qsplan.planner.certify.timing.hold_checks`: every contact present, the other joints held,
-    :func:`qsplan.hands.found_contacts.hold_scene`).  A command the hold is not proved at narrows that row's band to
+    :func:`qsplan.hands.contacts.found.hold_scene`).  A command the hold is not proved at narrows that row's band to
     the proved interval (:func:`qsplan.mechanics.bands.hold.hold_torque_interval`, with the task's force margin) and
     the commands are chosen again; the rows whose holds are proved keep everything.
 
@@ -171,7 +171,7 @@ def _rest_holds(task, ph, lower, upper, command, margin):
     QsplanError
         No hold at least the torque resolution wide at a row at rest.
     """
-    from qsplan.hands.found_contacts import hold_scene
+    from qsplan.hands.contacts.found import hold_scene
     from qsplan.mechanics.bands.hold import hold_torque_interval, prove_hold
     from qsplan.mechanics.errors import QsplanError
     from qsplan.planner.torque.command import plan_command
@@ -198,8 +198,8 @@ def _rest_holds(task, ph, lower, upper, command, margin):
 def rest_scene(task, ph, k, other, effort, velocity):
     """The scene of ``ph``'s row ``k`` at rest for the motion to or from row ``other``: the formation's closed form,
     or where the polygons show another contact set there (a slide's last row at the flush instant), every contact
-    found but those the motion makes only at ``k`` (:func:`qsplan.hands.found_contacts.made_contacts`)."""
-    from qsplan.hands.found_contacts import made_contacts, ordered_contacts, row_contact_scene
+    found but those the motion makes only at ``k`` (:func:`qsplan.hands.contacts.found.made_contacts`)."""
+    from qsplan.hands.contacts.found import made_contacts, ordered_contacts, row_contact_scene
     from qsplan.mechanics.errors import SceneError
 
     pose = ph.poses(task.hand.rest_height)

@@ -6,14 +6,14 @@ formations joined in contact, generated for the task's hand and workpiece, never
 1. a **slide** on the palm edge (formation ``palm_edge``, 4S, regrasps allowed: :func:`qsplan.planner.plan.autoplan.
    plan_automatic`) to a pivot's **flush instant**, where one finger lies flush along a side of the workpiece;
 2. a certified **hold** there (nothing moves; the torque-controlled finger's torque ramps to the pivot's);
-3. the **pivot** (:class:`qsplan.hands.pivots.Pivot`: on the bottom edge's far end, turning away from the flush
-   finger), cut into pieces where a contact's sliding direction reverses, each joined to the next by a certified
+3. the **pivot** (:class:`qsplan.hands.formations.pivots.Pivot`: on the bottom edge's far end, turning away from the
+   flush finger), cut into pieces where a contact's sliding direction reverses, each joined to the next by a certified
    hold (:mod:`qsplan.planner.plan.pivot`), to the goal's angle.
 
-Every pivot formation of the hand (:func:`qsplan.hands.pivots.pivot_formations`: each finger flush on each side it
-fits, the other finger on each feature it closes on) whose turn can reach the goal is searched, the cheap part first
-(the pivot's geometry, then its bands, then the slide); of the routes found, the one whose narrowest band is widest
-is planned (then the fewest phases).  A goal none reaches is refused with a :class:`TurnReport`: every formation
+Every pivot formation of the hand (:func:`qsplan.hands.formations.pivots.pivot_formations`: each finger flush on each
+side it fits, the other finger on each feature it closes on) whose turn can reach the goal is searched, the cheap part
+first (the pivot's geometry, then its bands, then the slide); of the routes found, the one whose narrowest band is
+widest is planned (then the fewest phases).  A goal none reaches is refused with a :class:`TurnReport`: every formation
 searched and where each ended (its event and angle, or the band, or the slide that failed).  Units SI.
 """
 
@@ -93,7 +93,7 @@ class FormationOutcome:
     Attributes
     ----------
     formation : str
-        Its name (:attr:`qsplan.hands.pivots.Pivot.name`).
+        Its name (:attr:`qsplan.hands.formations.pivots.Pivot.name`).
     words : str
         It in words.
     status : str
@@ -190,7 +190,7 @@ def pivot_pieces(task, pivot, start, theta_goal, geometry, progress):
     """The pivot's pieces (planned phases, times from 0), from its flush instant ``start`` to ``theta_goal`` (rad),
     cut at ``geometry.cuts`` (:func:`qsplan.planner.plan.pivot.pivot_geometry`); raises PlanFailure naming the first
     row without a band."""
-    from qsplan.hands.pivots import pivot_path
+    from qsplan.hands.formations.pivots import pivot_path
     from qsplan.planner.plan.pivot import pivot_thetas, widest_piece
 
     hand = task.hand
@@ -287,8 +287,8 @@ class Surveyed:
 def survey(task, progress=None) -> tuple:
     """Every pivot formation of the task's hand and workpiece, judged toward its goal without the slides that reach
     them: the goal's angle for it, its geometry (where it ends), then its pieces' bands (:class:`Surveyed`, in the
-    order :func:`qsplan.hands.pivots.pivot_formations` gives)."""
-    from qsplan.hands.pivots import pivot_formations
+    order :func:`qsplan.hands.formations.pivots.pivot_formations` gives)."""
+    from qsplan.hands.formations.pivots import pivot_formations
     from qsplan.planner.plan.pivot import pivot_geometry
 
     progress = progress or (lambda line: None)

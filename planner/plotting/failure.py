@@ -72,8 +72,8 @@ def failed_pose(task, report, x: float) -> np.ndarray:
 
 def failed_configuration(task, report) -> tuple:
     """``(x, q, collisions, highlight)``: the configuration ``report`` names (m; rad or m, None where no grasp
-    closes; its pose :func:`failed_pose`), its overlapping bodies (:class:`qsplan.hands.collision.Collision`) and
-    other bodies to outline (a joint beyond its limit, the palm an edge passes)."""
+    closes; its pose :func:`failed_pose`), its overlapping bodies (:class:`qsplan.hands.geometry.collision.Collision`)
+    and other bodies to outline (a joint beyond its limit, the palm an edge passes)."""
     task, report = drawn_report(task, report)
     d = report.as_dict()
     band = _band_report(report)

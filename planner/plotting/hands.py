@@ -65,7 +65,7 @@ def fingers_touching(hand, pose, q) -> dict:
     """
     from shapely.geometry import Polygon
 
-    from qsplan.hands.described_build import as_hand
+    from qsplan.hands.described.build import as_hand
 
     hand = as_hand(hand)  # the door: a hand record becomes a described hand
     polys = hand.body_polygons(pose, q)
@@ -79,7 +79,7 @@ def fingers_touching(hand, pose, q) -> dict:
 def effort_direction(hand, pose, q, joint, sign) -> tuple:
     """``(point, direction)``: the centre of ``joint``'s link (m, shape (2,)) and the unit vector (shape (2,)) it moves
     along when the joint's effort has the sign of ``sign`` (a torque turns it, a force pushes it along its axis)."""
-    from qsplan.hands.described_build import as_hand
+    from qsplan.hands.described.build import as_hand
 
     hand = as_hand(hand)  # the door: a hand record becomes a described hand
     q = np.asarray(q, dtype=float)
@@ -97,7 +97,7 @@ def hand_limits(hand, configurations, pad: float = 0.08) -> tuple:
     The palm is cut at the limits (it is wider than anything that moves), so snapshots keep no empty
     margin; its thickness stays in view (the scale bar is drawn on it).
     """
-    from qsplan.hands.described_build import as_hand
+    from qsplan.hands.described.build import as_hand
 
     hand = as_hand(hand)  # the door: a hand record becomes a described hand
     pts = [np.vstack([p for name, p in hand.body_polygons(pose, q).items() if name != "palm"])
@@ -129,8 +129,9 @@ def plot_hand(hand, pose, q=None, ax=None, alpha=1.0, contacts=True, label_joint
     Parameters
     ----------
     hand : qsplan.hands.protocol.Hand
-        Or a hand record (:class:`~qsplan.hands.two_finger.TwoFingerHand`, :class:`~qsplan.hands.chain_hand.ChainHand`),
-        converted at the door (:func:`qsplan.hands.described_build.as_hand`).
+        Or a hand record (:class:`~qsplan.hands.paper_hand.two_finger.TwoFingerHand`,
+        :class:`~qsplan.hands.chains.hand.ChainHand`), converted at the door
+        (:func:`qsplan.hands.described.build.as_hand`).
     pose : array-like, shape (3,)
         Workpiece ``(x, y, theta)`` (m, m, rad).
     q : array-like, shape (n_j,), optional
@@ -155,8 +156,8 @@ def plot_hand(hand, pose, q=None, ax=None, alpha=1.0, contacts=True, label_joint
     """
     from matplotlib.patches import Polygon as Patch
 
-    from qsplan.hands.described_build import as_hand
-    from qsplan.hands.found_contacts import drawable_contacts
+    from qsplan.hands.described.build import as_hand
+    from qsplan.hands.contacts.found import drawable_contacts
 
     hand = as_hand(hand)  # the door: a hand record becomes a described hand
     ax = axes_or_new(ax, size=(3.2, 2.6))
@@ -225,7 +226,7 @@ def hand_strip_figure(samples, n=5, title=None):
 
     Parameters
     ----------
-    samples : qsplan.hands.segments.SegmentSamples
+    samples : qsplan.hands.paper_hand.segments.SegmentSamples
     n : int
         At least 2.
 
@@ -235,7 +236,7 @@ def hand_strip_figure(samples, n=5, title=None):
     """
     from matplotlib.figure import Figure
 
-    from qsplan.hands.described_build import as_hand
+    from qsplan.hands.described.build import as_hand
     from qsplan.planner.plotting.style import figure_legend
 
     n = max(2, int(n))

@@ -56,16 +56,16 @@ def plot_rod_distances(motion, ax=None, closed_form=None):
     Parameters
     ----------
     motion : qsplan.mechanics.motion.trajectory.Motion
-        Of a :class:`qsplan.hands.rod.RodOnSupports`.
+        Of a :class:`qsplan.hands.examples.rod.RodOnSupports`.
     ax : matplotlib Axes, optional
-    closed_form : qsplan.hands.rod.RodClosedForm, optional
+    closed_form : qsplan.hands.examples.rod.RodClosedForm, optional
         Its switch points are marked with dots, for comparison.
 
     Returns
     -------
     matplotlib.axes.Axes
     """
-    from qsplan.hands.rod import rod_distances
+    from qsplan.hands.examples.rod import rod_distances
 
     ax = _axes(ax)
     styles = ({"color": _ROLL, "label": "$l_1$ (support 1)"}, {"color": "#55a868", "label": "$l_2$ (support 2)"})
@@ -111,7 +111,7 @@ def plot_rod_mu_space(motion, ax=None, max_lines=20):
     Parameters
     ----------
     motion : qsplan.mechanics.motion.trajectory.Motion
-        Of a :class:`qsplan.hands.rod.RodOnSupports`.
+        Of a :class:`qsplan.hands.examples.rod.RodOnSupports`.
     max_lines : int
         Draw at most this many switch lines (the first ones; later ones crowd the corners).
 
@@ -121,7 +121,7 @@ def plot_rod_mu_space(motion, ax=None, max_lines=20):
     """
     from matplotlib.patches import Rectangle
 
-    from qsplan.hands.rod import rod_distances
+    from qsplan.hands.examples.rod import rod_distances
 
     ax = _axes(ax, size=(5.0, 4.6))
     fr = motion.system.friction
@@ -203,7 +203,8 @@ def plot_mode_timeline(motion, ax=None):
 
 
 def plot_push_snapshots(motion, ax=None, n_frames=6):
-    """Snapshots of a pushed polygon (:class:`qsplan.hands.pushing.PushedPolygon`), the floor and the tip's path.
+    """Snapshots of a pushed polygon (:class:`qsplan.hands.examples.pushing.PushedPolygon`), the floor and the tip's
+    path.
 
     Frames are evenly spaced in time, plus every event; points in contact at each
     frame are marked.
@@ -214,7 +215,7 @@ def plot_push_snapshots(motion, ax=None, n_frames=6):
     """
     from matplotlib import colormaps
 
-    from qsplan.hands.pushing import polygon_world
+    from qsplan.hands.examples.pushing import polygon_world
 
     ax = _axes(ax, size=(7.0, 3.6))
     system = motion.system

@@ -242,7 +242,7 @@ def rod_mu_figure(sl, l1, l2, mu_static=None, mu_kinetic=None):
     Parameters
     ----------
     sl : MuSlice
-        The rod's slice (:func:`qsplan.hands.paper.rod_scene`).
+        The rod's slice (:func:`qsplan.hands.examples.paper.rod_scene`).
     l1, l2 : float
         Distances of the supports from the centre of mass (the paper's rod has no units).
     mu_static, mu_kinetic : (float, float), optional

@@ -219,12 +219,12 @@ def sliding_directions(hand, pose0, q0, pose1, q1) -> list:
     list of (point, direction)
         The contact point (m, shape (2,)) and the unit tangent (shape (2,)) the workpiece slides along there, zeros
         where it slips less than :data:`_SLIDE_TOL`.  Raises :class:`~qsplan.mechanics.errors.SceneError` when a
-        finger does not touch (:func:`qsplan.hands.found_contacts.drawable_contacts`).
+        finger does not touch (:func:`qsplan.hands.contacts.found.drawable_contacts`).
     """
     from shapely.geometry import Point, Polygon
 
-    from qsplan.hands.described_build import as_hand
-    from qsplan.hands.found_contacts import drawable_contacts
+    from qsplan.hands.described.build import as_hand
+    from qsplan.hands.contacts.found import drawable_contacts
 
     hand = as_hand(hand)  # the door: a hand record becomes a described hand
     before, after = hand.body_polygons(pose0, q0), hand.body_polygons(pose1, q1)

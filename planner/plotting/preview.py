@@ -50,8 +50,8 @@ def _drawable(task, q):
 
 def plot_configuration(task, x, q, ax=None, collisions=(), limits=None, highlight=(), pose=None):
     """The hand with the workpiece at ``x`` (m) and joints ``q`` (n_j,; None or NaN joints: drawn faded at mid-range),
-    every overlap of ``collisions`` (:class:`qsplan.hands.collision.Collision`) in red: both bodies outlined, their
-    intersection filled; ``highlight``: more body names (``"palm"``, ``"workpiece"``, a joint) to outline in red;
+    every overlap of ``collisions`` (:class:`qsplan.hands.geometry.collision.Collision`) in red: both bodies outlined,
+    their intersection filled; ``highlight``: more body names (``"palm"``, ``"workpiece"``, a joint) to outline in red;
     ``pose`` ``(x, y, theta)`` (m, m, rad) where the workpiece does not rest on its bottom edge at ``x``.
 
     Returns
@@ -61,7 +61,7 @@ def plot_configuration(task, x, q, ax=None, collisions=(), limits=None, highligh
     from matplotlib.patches import Polygon as Patch
     from shapely.geometry import Polygon
 
-    from qsplan.hands.collision import body_label
+    from qsplan.hands.geometry.collision import body_label
     from qsplan.planner.plotting.hands import hand_limits, plot_hand
 
     ax = axes_or_new(ax, size=(3.6, HAND_HEIGHT))
@@ -195,7 +195,7 @@ def preview_figure(task, preview):
     """
     from matplotlib.figure import Figure
 
-    from qsplan.hands.collision import Collision
+    from qsplan.hands.geometry.collision import Collision
     from qsplan.planner.plotting.hands import hand_limits
 
     d = preview.as_dict()

@@ -459,11 +459,11 @@ def _friction_vectors(task, mu, n_random, seed) -> np.ndarray:
 
 
 def pair_letters(mode: str, names) -> str:
-    """A row's planned letters over its contacts ``names`` (the canonical order, :mod:`qsplan.hands.found_contacts`)
+    """A row's planned letters over its contacts ``names`` (the canonical order, :mod:`qsplan.hands.contacts.found`)
     on the scene's four pairs (:data:`CONTACTS`): ``palm:K`` on its foot, a finger's contacts on its links; a pair
     no planned contact is on is ``B`` (open: a lifted vertex); a finger flush on an edge (two contacts) slides if
     either does, else rolls."""
-    from qsplan.hands.found_contacts import slot_of
+    from qsplan.hands.contacts.found import slot_of
 
     slots = [slot_of(n, CONTACTS) for n in names]
     out = []

@@ -32,7 +32,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from qsplan.hands.workpiece import polygon_inertia  # noqa: F401 (named in __all__: its home is the hands layer)
+from qsplan.hands.geometry.workpiece import polygon_inertia  # noqa: F401 (in __all__: its home is the hands layer)
 
 from qsplan.mechanics.errors import QsplanError
 

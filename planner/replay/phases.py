@@ -11,7 +11,7 @@ describe; this module says how each is replayed, from the rows and the task alon
 * a phase whose **first row has more contacts** than the rest (the pivot's transition row: vertex 0 lifts): the all-modes
   solver at that row with all its contacts must find the planned mode alone (the replay's start check), then the
   phase is simulated from its second row with the contacts of the rest;
-* every phase's scenes come from the contacts the polygons show (:func:`qsplan.hands.found_contacts.
+* every phase's scenes come from the contacts the polygons show (:func:`qsplan.hands.contacts.found.
   row_contact_scene`), their count checked against the phase's: one path for every hand and formation.
 
 Friction: the replay's vector gives one coefficient per body of the palm-edge formation (``palm:0``, ``palm:1``,
@@ -46,8 +46,8 @@ def _configuration(hand, columns, k) -> tuple:
 
 def _makes_contact(hand, columns, a, b) -> bool:
     """Whether the motion from row ``a`` to row ``b`` makes a contact only at ``b``
-    (:func:`qsplan.hands.found_contacts.made_contacts`)."""
-    from qsplan.hands.found_contacts import made_contacts, ordered_contacts
+    (:func:`qsplan.hands.contacts.found.made_contacts`)."""
+    from qsplan.hands.contacts.found import made_contacts, ordered_contacts
 
     after = _configuration(hand, columns, b)
     return bool(made_contacts(hand, _configuration(hand, columns, a), after, ordered_contacts(hand, *after)).any())
@@ -68,10 +68,10 @@ def phase_rows(hand, columns, rows) -> tuple:
 
 def body_friction(names, mu) -> np.ndarray:
     """The friction of contacts ``names`` from the replay's vector ``mu`` (the palm edge's palm:0, palm:1, left,
-    right): each contact its slot's (:func:`qsplan.hands.found_contacts.slot_of`: a finger's contacts that finger's),
+    right): each contact its slot's (:func:`qsplan.hands.contacts.found.slot_of`: a finger's contacts that finger's),
     a palm contact under another vertex palm:0's."""
-    from qsplan.hands.formations import formation
-    from qsplan.hands.found_contacts import slot_of
+    from qsplan.hands.formations.registry import formation
+    from qsplan.hands.contacts.found import slot_of
 
     slots = formation("palm_edge").contact_names
     return np.asarray([mu[j] if (j := slot_of(n, slots)) is not None else mu[0] for n in names], float)
@@ -79,7 +79,7 @@ def body_friction(names, mu) -> np.ndarray:
 
 def found_scene(hand, x, effort_controlled, velocity, effort, tracked):
     """The scene at replay state ``x`` (pose, joints, clock) of the contacts the polygons showed at the phase's
-    start, followed by their features (``tracked``: :func:`qsplan.hands.found_contacts.track_contacts`).
+    start, followed by their features (``tracked``: :func:`qsplan.hands.contacts.found.track_contacts`).
 
     Raises
     ------
@@ -92,9 +92,9 @@ def found_scene(hand, x, effort_controlled, velocity, effort, tracked):
 def formation_of(hand, columns, k, mode):
     """``(formation, tracked contacts)``: a formation of the contacts the polygons show at row ``k`` (their canonical
     names), ``mode`` its letters, the simulator's contacts of the phase; and those contacts as features to follow
-    (:func:`qsplan.hands.found_contacts.track_contacts`)."""
-    from qsplan.hands.formations import ContactSlot, Formation
-    from qsplan.hands.found_contacts import track_contacts
+    (:func:`qsplan.hands.contacts.found.track_contacts`)."""
+    from qsplan.hands.formations.registry import ContactSlot, Formation
+    from qsplan.hands.contacts.found import track_contacts
 
     pose, q = _configuration(hand, columns, k)
     tracked = track_contacts(hand, pose, q)
@@ -112,7 +112,7 @@ def transition_modes(hand, columns, k, effort_controlled, mu) -> tuple:
     :func:`body_friction`."""
     from dataclasses import replace
 
-    from qsplan.hands.found_contacts import row_contact_scene
+    from qsplan.hands.contacts.found import row_contact_scene
     from qsplan.mechanics.solver.all_modes import solve
 
     (pose, q0), (_, q1) = _configuration(hand, columns, k), _configuration(hand, columns, k + 1)

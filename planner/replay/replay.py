@@ -23,7 +23,7 @@ scenes come from :meth:`qsplan.hands.protocol.Hand.scene`.  Between segments the
 puts both fingers back on the workpiece where it is, so each segment starts from the simulated
 end of the previous one (errors carry over): the paper's fingers by tangency with the planned
 grasp, any other described hand's by closing each finger's last joint onto the workpiece from the plan's free
-joints (:meth:`qsplan.hands.described.DescribedHand.reclose`).
+joints (:meth:`qsplan.hands.described.hand.DescribedHand.reclose`).
 """
 
 from __future__ import annotations
@@ -58,7 +58,7 @@ def _default_options(max_step=REPLAY_STEP):
 
 def _travel_step(t, x, travel) -> float:
     """A replay step (s) for a segment's rows (times ``t`` s, workpiece ``x`` m): at most ``travel`` (m) of workpiece
-    travel (:attr:`qsplan.hands.described.DescribedHand.simulation_travel`), at most :data:`REPLAY_STEP`."""
+    travel (:attr:`qsplan.hands.described.hand.DescribedHand.simulation_travel`), at most :data:`REPLAY_STEP`."""
     dt, dx = np.diff(t), np.abs(np.diff(x))
     speed = float(np.max(dx[dt > 0] / dt[dt > 0], initial=0.0))
     return min(REPLAY_STEP, travel / speed) if speed > 0 else REPLAY_STEP
@@ -89,9 +89,9 @@ class ReplaySystem:
         the other entries are not read.
     friction : qsplan.mechanics.motion.system.Friction
         Of the formation's contacts, in its order.
-    formation : qsplan.hands.formations.Formation
+    formation : qsplan.hands.formations.registry.Formation
         The contacts the replay keeps (their names and order).
-    tracked : qsplan.hands.found_contacts.TrackedContacts
+    tracked : qsplan.hands.contacts.found.TrackedContacts
         Those contacts as the polygons showed them at the phase's start, followed by their features.
     scenes : dict
         Scenes already built, by the state's bytes (a scene depends on the state alone): the
@@ -266,15 +266,15 @@ def replay_plan(columns, hand, mu, options=None, scenes=None, formation=None) ->
     scenes : dict, optional
         A cache of the scenes built, to pass again to the replays of the same ``columns`` and
         ``hand`` at other friction vectors (the scenes do not depend on friction); same results.
-    formation : qsplan.hands.formations.Formation or str, optional
+    formation : qsplan.hands.formations.registry.Formation or str, optional
         The plan's formation (the task's); default the registry's default.
 
     Returns
     -------
     Replay
     """
-    from qsplan.hands.described_build import as_hand
-    from qsplan.hands.formations import DEFAULT_FORMATION, Formation, formation as registered_formation
+    from qsplan.hands.described.build import as_hand
+    from qsplan.hands.formations.registry import DEFAULT_FORMATION, Formation, formation as registered_formation
     from qsplan.mechanics.motion.simulator import simulate
     from qsplan.mechanics.motion.system import make_friction
     from qsplan.planner.plan.timing import quasistatic_rows

@@ -15,7 +15,7 @@ import time
 
 import numpy as np
 
-from qsplan.hands.paper import eq37_scene, eq42_scene, rod_scene
+from qsplan.hands.examples.paper import eq37_scene, eq42_scene, rod_scene
 from qsplan.mechanics import count_modes, scene_from_dict
 from qsplan.mechanics.muspace.maps import polynomial_map
 from qsplan.mechanics.muspace.slices import boundary_agreement, mu_slice

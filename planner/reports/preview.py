@@ -167,7 +167,7 @@ def x_ranges(x, mask) -> list:
 
 def _words(task, tables, g, pair) -> tuple:
     """Row ``g`` touching ``pair`` (per finger, the tables' codes) in words: ``(label, short)``."""
-    from qsplan.hands.grasps import touch_words
+    from qsplan.hands.paper_hand.grasps import touch_words
 
     row = tables.grasps[g]
     if min(pair) < 0:

@@ -77,7 +77,7 @@ class ConfigurationCheck:
         Why the grasp's contacts do not exist there, in words.
     limits : tuple of LimitExcess
         Every joint beyond its limit.
-    collisions : tuple of qsplan.hands.collision.Collision
+    collisions : tuple of qsplan.hands.geometry.collision.Collision
         Every pair of bodies overlapping beyond its tolerance (names, area m^2, depth m).
     beyond_palm : str or None
         The task puts the workpiece's resting edge beyond the palm here
@@ -169,7 +169,7 @@ def features_words(task, where: str) -> str:
 def _meeting(tables, task, i, feats) -> list:
     """Rows whose grasp meets ``feats`` at grid index ``i`` (a paper placement's vertex there), else whose grasp
     matches them wherever its contacts are (an invalid configuration may touch nothing)."""
-    from qsplan.hands.grasps import grasp_meets
+    from qsplan.hands.paper_hand.grasps import grasp_meets
 
     hand, rows = task.hand, tables.grasps
     there = [g for g in range(len(rows)) if grasp_meets(hand, rows[g].grasp, tables.graph.touched[g, i, :2], feats)]

@@ -1,10 +1,10 @@
 """Band tables: every candidate grasp judged along the palm, batched (the search's input, Section 5.2).
 
-For each candidate grasp (which feature each finger touches, :mod:`qsplan.hands.grasps`) and
+For each candidate grasp (which feature each finger touches, :mod:`qsplan.hands.paper_hand.grasps`) and
 each workpiece ``x`` of a grid, :func:`band_tables` judges the configuration as the plan's
 dense sweep does (:func:`qsplan.planner.states.contact.check_contact_state`): the
 four contacts exist (the grasp's closed form), the joints inside their limits, no two bodies
-overlapping (:mod:`qsplan.hands.collision`), and for each effort-controlled finger
+overlapping (:mod:`qsplan.hands.geometry.collision`), and for each effort-controlled finger
 and each direction of the slide the guaranteed 4S band with every competitor precluded
 (:func:`qsplan.mechanics.bands.batched_robust.robust_band_arrays`, batched over the grid and the
 grasps; per-state competitors: a mode kinematically impossible at a state cannot occur there).
@@ -52,7 +52,7 @@ SEARCH_MARGIN = 0.06
 #: senses: :data:`qsplan.planner.plan.phases.SLIP_RTOL`'s value (the search layer does not import the plan layer).
 SLIP_RTOL = 1e-9
 
-#: The scene arrays the tables stack (:class:`qsplan.hands.batch_scenes.SceneArrays`).
+#: The scene arrays the tables stack (:class:`qsplan.hands.paper_hand.batch_scenes.SceneArrays`).
 _ARRAYS = ("Wn", "Wt", "Jn", "Jt", "g_obj", "g_man")
 
 
@@ -150,7 +150,7 @@ class GraspRow:
 
     Attributes
     ----------
-    grasp : qsplan.hands.grasps.Grasp or qsplan.hands.protocol.ChainGrasp
+    grasp : qsplan.hands.paper_hand.grasps.Grasp or qsplan.hands.protocol.ChainGrasp
     path : object or None
     """
 
@@ -297,7 +297,7 @@ def band_tables(task, grasps, x, progress=None) -> BandTables:
 def _unit_rates(task, row, states, arrays, idx, keep) -> np.ndarray:
     """Every joint's rate (m, n_j) per m/s of the workpiece at the states ``idx[keep]``: ``dq_dx`` with the free
     joints held (the grasp's closed form or the hand's eq. 6), else eq. 6 with the row's free-joint slopes."""
-    from qsplan.hands.motion import closing_rates
+    from qsplan.hands.formations.motion import closing_rates
     from qsplan.mechanics.errors import QsplanError
 
     if row.path is None or not np.any(np.asarray(row.path.slope) != 0):

@@ -23,7 +23,7 @@ __all__ = ["TOUCH_AREA", "StateCheck", "check_contact_state", "check_free_state"
            "contact_samples", "free_state_problem", "limit_problem", "mode_name"]
 
 #: Intersection area (m^2) below which two polygons only touch (kept for callers; the checks now measure
-#: overlaps by depth: :data:`qsplan.hands.collision.CONTACT_DEPTH_TOL`).
+#: overlaps by depth: :data:`qsplan.hands.geometry.collision.CONTACT_DEPTH_TOL`).
 TOUCH_AREA = 1e-10
 
 def mode_name(letters: str) -> str:
@@ -68,8 +68,8 @@ class StateCheck:
 
 def contact_samples(task, xs, effort_joint, speed, name="segment", grasp=None, free=None, free_rates=None):
     """The configurations at workpiece ``xs`` (m, shape (n,)) moving at ``speed`` (m/s, signed) as
-    :class:`qsplan.hands.segments.SegmentSamples` (times 0, 1, ...: bands do not depend on them), from the hand
-    (:meth:`qsplan.hands.protocol.Hand.slide_motion`).
+    :class:`qsplan.hands.paper_hand.segments.SegmentSamples` (times 0, 1, ...: bands do not depend on them), from the
+    hand (:meth:`qsplan.hands.protocol.Hand.slide_motion`).
 
     ``grasp``: the features the fingers touch (a grasp of :meth:`~qsplan.hands.protocol.Hand.grasp_candidates`);
     None: the paper hand's default, both inner edges on the vertices of tangency (the scripted tasks).  ``free``
@@ -81,7 +81,7 @@ def contact_samples(task, xs, effort_joint, speed, name="segment", grasp=None, f
     qsplan.mechanics.SceneError
         Where a configuration has no four-contact grasp.
     """
-    from qsplan.hands.segments import ManipulationSegment, SegmentSamples
+    from qsplan.hands.paper_hand.segments import ManipulationSegment, SegmentSamples
 
     hand = task.hand
     xs = np.atleast_1d(np.asarray(xs, float))
@@ -111,7 +111,7 @@ def limit_problem(task, q) -> str | None:
 def configuration_problem(task, pose, q) -> str | None:
     """What is wrong with the hand at workpiece ``pose`` (shape (3,)) and joints ``q`` (rad, shape (2,)),
     in words, or None: a joint beyond its limit, or two bodies overlapping (every pair of the palm, the
-    fingers and the workpiece: :func:`qsplan.hands.collision.find_collisions`)."""
+    fingers and the workpiece: :func:`qsplan.hands.geometry.collision.find_collisions`)."""
     q = np.asarray(q, float)
     why = limit_problem(task, q)
     if why:
@@ -173,5 +173,5 @@ def free_state_problem(task: Task, x: float, q) -> str | None:
 def check_free_state(task: Task, x: float, q) -> bool:
     """A free-space finger configuration ``q`` (rad, shape (2,)) with the workpiece at ``x`` (m):
     inside the joint limits, and no two of the fingers, the palm and the workpiece overlapping
-    (the fingers may touch the workpiece, within :data:`qsplan.hands.collision.CONTACT_DEPTH_TOL`)."""
+    (the fingers may touch the workpiece, within :data:`qsplan.hands.geometry.collision.CONTACT_DEPTH_TOL`)."""
     return free_state_problem(task, x, q) is None

@@ -131,7 +131,7 @@ def turning_box(hand, acceleration: float):
     mass's largest ``|x|``), ``Y = R`` (its largest height with a vertex on the palm), ``R`` its farthest vertex's
     distance (the angular acceleration's bound, :meth:`Dynamics.angular_acceleration`).  Rounded up to
     :data:`BOX_GRID`."""
-    from qsplan.hands.workpiece import polygon_inertia
+    from qsplan.hands.geometry.workpiece import polygon_inertia
     from qsplan.mechanics.bands.disturbance import WrenchBox
 
     m, R = float(hand.workpiece_mass), workpiece_radius(hand)

@@ -1,12 +1,12 @@
 """The fields of a task file's ``[hand]`` table and the number checks every task field shares.
 
 A ``[hand]`` table gives the workpiece (``workpiece``, ``workpiece_mass``, ``palm_edge``, ``mu``) and the hand:
-either the paper's hand by its parameters (:func:`qsplan.hands.two_finger.make_two_finger_hand`'s
+either the paper's hand by its parameters (:func:`qsplan.hands.paper_hand.two_finger.make_two_finger_hand`'s
 arguments, the original form), or a hand description (:mod:`qsplan.hands.description`): ``file`` (a bundled
 hand's name or a path, relative to the task file) or the description's own fields inline (``palm``,
 ``fingers``, ``name``, ``gravity``).  A description of the paper's form (two single-link fingers,
 :func:`qsplan.hands.description.two_finger_form.two_finger_parameters`) becomes the paper's hand with its fast
-closed forms; any other a :class:`qsplan.hands.chain_hand.ChainHand`.  Units SI.
+closed forms; any other a :class:`qsplan.hands.chains.hand.ChainHand`.  Units SI.
 """
 
 from __future__ import annotations
@@ -95,7 +95,7 @@ def in_task_range(x: float, field: str, kind: str) -> float:
 def check_hand(hand) -> None:
     """Every size, mass and coefficient of a hand (and its workpiece) inside :data:`TASK_RANGES`
     (``hand.range_fields()``: :meth:`qsplan.hands.protocol.Hand.range_fields`; at the door, before a record becomes a
-    described hand, the record's own, :meth:`qsplan.hands.two_finger.TwoFingerHand.range_fields`)."""
+    described hand, the record's own, :meth:`qsplan.hands.paper_hand.two_finger.TwoFingerHand.range_fields`)."""
     for field, value, kind in hand.range_fields():
         in_task_range(value, field, kind)
 
@@ -104,7 +104,7 @@ def _paper_hand_from_table(table: dict):
     """A TwoFingerHand from a ``[hand]`` table of its parameters: keys checked, numbers checked before the geometry."""
     import inspect
 
-    from qsplan.hands.two_finger import make_two_finger_hand
+    from qsplan.hands.paper_hand.two_finger import make_two_finger_hand
 
     allowed = set(inspect.signature(make_two_finger_hand).parameters)
     unknown = sorted(set(table) - allowed)
@@ -155,11 +155,11 @@ def hand_from_task_table(table: dict, base_dir=None) -> HandChoice:
     QsplanError
         Naming the field (``hand.<key>``; for a hand file, the file and the field in it).
     """
-    from qsplan.hands.chain_hand import make_chain_hand
+    from qsplan.hands.chains.hand import make_chain_hand
     from qsplan.hands.description.files import hand_from_table
-    from qsplan.hands.described_build import as_hand
+    from qsplan.hands.described.build import as_hand
     from qsplan.hands.description.two_finger_form import two_finger_parameters
-    from qsplan.hands.two_finger import make_two_finger_hand
+    from qsplan.hands.paper_hand.two_finger import make_two_finger_hand
 
     if not isinstance(table, dict):
         raise QsplanError(f"hand: expected a table; got {short_repr(table)}")

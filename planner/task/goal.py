@@ -250,8 +250,8 @@ def task_positions(task) -> list:
 
 def feature_text(feature):
     """A task's finger feature (``("inner", None)``, ``("edge", K)``, ``("vertex", K)`` or None) as a grasp's ``matches``
-    reads it (:func:`qsplan.hands.grasps.grasp_meets`): None (any), ``"vertex"`` (the start's ``"inner"``: the inner
-    edge on whichever vertex), ``"edge:K"``, ``"vertex:K"``."""
+    reads it (:func:`qsplan.hands.paper_hand.grasps.grasp_meets`): None (any), ``"vertex"`` (the start's ``"inner"``:
+    the inner edge on whichever vertex), ``"edge:K"``, ``"vertex:K"``."""
     if feature is None:
         return None
     return "vertex" if feature[0] == "inner" else f"{feature[0]}:{feature[1]}"

@@ -12,8 +12,8 @@ pose in a task is its centre-of-mass ``x``.
 TOML form (all SI: m, kg, rad, s, N m)::
 
     name = "regrasp like Fig. 9"
-    formation = "palm_edge"      # optional: how the hand holds the workpiece (qsplan.hands.formations)
-    [hand]                       # qsplan.hands.two_finger.make_two_finger_hand's arguments
+    formation = "palm_edge"      # optional: how the hand holds the workpiece (qsplan.hands.formations.registry)
+    [hand]                       # qsplan.hands.paper_hand.two_finger.make_two_finger_hand's arguments
     workpiece = [[0.0, 0.0], [0.080, 0.0], [0.085, 0.080], [0.008, 0.100]]
     workpiece_mass = 0.2         # optional from here on, with make_two_finger_hand's defaults
     finger_base = 0.09
@@ -61,7 +61,7 @@ from qsplan.planner.task.dynamics import resolve_dynamics
 from qsplan.planner.task.fields import (PLAN_FORCE_MARGIN, TASK_RANGES, check_hand, field_name, hand_from_task_table,
                                         in_task_range, plan_force_margin, short_repr, start_joints_of, task_disturbance,
                                         task_number)  # fmt: skip
-from qsplan.hands.formations import DEFAULT_FORMATION, FORMATIONS, Formation
+from qsplan.hands.formations.registry import DEFAULT_FORMATION, FORMATIONS, Formation
 from qsplan.planner.task.goal import Goal, make_goal, make_start_features
 from qsplan.planner.task.limits import LIMIT_KEYS, resolve_limits
 
@@ -93,7 +93,7 @@ class Task:
     Attributes
     ----------
     name : str
-    hand : qsplan.hands.described.DescribedHand
+    hand : qsplan.hands.described.hand.DescribedHand
         The hand (:class:`qsplan.hands.protocol.Hand`): the paper's form answers with its closed forms.
     start_x : float
         Workpiece centre-of-mass ``x`` at the start (m).
@@ -125,9 +125,10 @@ class Task:
     start_joints : ndarray, shape (n_j,), or None
         A described hand's free joints at the start (``[start]`` by joint name; the closing joints' entries 0);
         None: the planner chooses.
-    formation : qsplan.hands.formations.Formation
+    formation : qsplan.hands.formations.registry.Formation
         How the hand holds the workpiece: its contacts, their order, the desired mode (today's one entry of
-        :data:`qsplan.hands.formations.FORMATIONS`, the bottom edge on the palm and a point of each finger, 4S).
+        :data:`qsplan.hands.formations.registry.FORMATIONS`, the bottom edge on the palm and a point of each finger,
+        4S).
     disturbance : qsplan.mechanics.bands.disturbance.WrenchBox or None
         A box of external wrenches on the workpiece (N, N, N m) every guaranteed band and preclusion withstands
         (:mod:`qsplan.mechanics.bands.disturbance`): the task's, else the inertial load of the time scaling
@@ -186,10 +187,10 @@ def make_task(hand, start_x, waypoints=None, mu_range=(0.0, 0.2), torque_resolut
               formation=None, disturbance=None, workpiece_acceleration=None, joint_acceleration=None,
               joint_accelerations=None, release_acceleration=None) -> Task:  # fmt: skip
     """Validate and build a :class:`Task` (parameters as its attributes; ``hand`` a TwoFingerHand or a dict of
-    :func:`qsplan.hands.two_finger.make_two_finger_hand` arguments).  Either ``waypoints`` (a scripted
+    :func:`qsplan.hands.paper_hand.two_finger.make_two_finger_hand` arguments).  Either ``waypoints`` (a scripted
     sequence) or ``goal`` (the ``[goal]`` table as a dict, or a :class:`Goal`: the planner finds the sequence);
     ``start`` the ``[start]`` table as a dict (default both fingers ``"inner"``; a described hand: its free joints
-    by name).  ``hand`` may also be a :class:`qsplan.hands.chain_hand.ChainHand` or a ``[hand]`` table naming a
+    by name).  ``hand`` may also be a :class:`qsplan.hands.chains.hand.ChainHand` or a ``[hand]`` table naming a
     hand description (:mod:`qsplan.planner.task.fields`; ``base_dir`` resolves its relative ``file``).
     Limits (:func:`qsplan.planner.task.limits.resolve_limits`, the one place): ``joint_limits``
     (``{joint: [lo, hi]}`` for some joints, or one pair per joint in order), ``joint_speed`` (rad/s, every
@@ -202,7 +203,7 @@ def make_task(hand, start_x, waypoints=None, mu_range=(0.0, 0.2), torque_resolut
     QsplanError
         Naming the field, what was expected and what was received.
     """
-    from qsplan.hands.described_build import as_hand
+    from qsplan.hands.described.build import as_hand
 
     if isinstance(hand, dict):
         hand, *_ = hand_from_task_table(hand, base_dir)
@@ -270,7 +271,7 @@ def make_task(hand, start_x, waypoints=None, mu_range=(0.0, 0.2), torque_resolut
     if formation is None:
         formation = FORMATIONS[DEFAULT_FORMATION]
     elif not isinstance(formation, Formation):
-        from qsplan.hands.formations import formation as registered
+        from qsplan.hands.formations.registry import formation as registered
 
         formation = registered(formation)
     from qsplan.planner.task.goal import goal_turns

@@ -187,7 +187,7 @@ def point_band_sweep(samples, mu, mode=None, label=None) -> BandSweep:
 
     Parameters
     ----------
-    samples : qsplan.hands.segments.SegmentSamples
+    samples : qsplan.hands.paper_hand.segments.SegmentSamples
     mu : float or array-like, shape (n_c,)
     mode : str or ContactMode, optional
     label : str, optional
@@ -209,7 +209,7 @@ def guaranteed_sweep(samples, mu_range=DEFAULT_MU_RANGE, shared=False, mode=None
 
     Parameters
     ----------
-    samples : qsplan.hands.segments.SegmentSamples
+    samples : qsplan.hands.paper_hand.segments.SegmentSamples
     mu_range : (float, float)
         ``0 <= lo <= hi``: each contact's coefficient independently in ``[lo, hi]``, or
         with ``shared=True`` one coefficient for all contacts.
@@ -256,7 +256,7 @@ def sampled_guaranteed_sweep(samples, mu_values, mode=None, competitors=None, *,
 
     Parameters
     ----------
-    samples : qsplan.hands.segments.SegmentSamples
+    samples : qsplan.hands.paper_hand.segments.SegmentSamples
     mu_values : array-like, shape (m,) or (m, n_c)
         Friction points: one shared coefficient per row, or one per contact.
     mode, competitors, force_margin

@@ -70,7 +70,7 @@ class SegmentBands:
 
     Attributes
     ----------
-    samples : qsplan.hands.segments.SegmentSamples
+    samples : qsplan.hands.paper_hand.segments.SegmentSamples
     frictionless : BandSweep
         Desired mode, mu = 0 (Fig. 10).
     at_high_mu : BandSweep
@@ -173,7 +173,7 @@ def segment_bands(samples, mu_range=DEFAULT_MU_RANGE, shared=False, paper_sample
 
     Parameters
     ----------
-    samples : qsplan.hands.segments.SegmentSamples
+    samples : qsplan.hands.paper_hand.segments.SegmentSamples
     mu_range : (float, float)
         Friction uncertainty ``[lo, hi]``; Figs. 11-12 use ``hi``.
     shared : bool

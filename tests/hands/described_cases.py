@@ -10,7 +10,8 @@ from qsplan.hands.description import load_hand, make_hand_description
 #: The parallel-jaw task's hexagon (m), as written.
 HEXAGON = [[0.0, 0.0], [0.06, 0.0], [0.08, 0.05], [0.05, 0.09], [0.01, 0.09], [-0.02, 0.05]]
 
-#: The paper hand's parameters a task's ``[hand]`` may give (:func:`qsplan.hands.two_finger.make_two_finger_hand`).
+#: The paper hand's parameters a task's ``[hand]`` may give
+#: (:func:`qsplan.hands.paper_hand.two_finger.make_two_finger_hand`).
 PAPER_KEYS = ("workpiece", "workpiece_mass", "finger_base", "finger_length", "finger_width", "finger_mass",
               "palm_halfwidth", "palm_thickness", "gravity", "mu", "palm_edge")  # fmt: skip
 
@@ -57,7 +58,7 @@ def paper_task_hands() -> dict:
     """``{task stem: TwoFingerHand}`` of every bundled task on the paper's hand (a parameter table or the paper hand
     file), as the task gives it."""
     from qsplan.hands.description.two_finger_form import two_finger_parameters
-    from qsplan.hands.two_finger import make_two_finger_hand
+    from qsplan.hands.paper_hand.two_finger import make_two_finger_hand
 
     out = {}
     for stem, task in task_tables().items():

@@ -3,18 +3,18 @@
 Wherever the generic path (:func:`qsplan.mechanics.find_contacts` on the hand's polygons) builds a
 scene, ``hand_scene``'s default path gives the same one to round-off (every array, the contacts in
 the same order, the names); wherever the generic path refuses, so does the default one.  The
-closed form batched over states (:func:`qsplan.hands.batch_scenes.grasp_contacts_batch`, the band
+closed form batched over states (:func:`qsplan.hands.paper_hand.batch_scenes.grasp_contacts_batch`, the band
 tables' path) is the one-state closed form bit for bit, and so are the scene arrays built from it.
 """
 
 import numpy as np
 import pytest
 
-from qsplan.hands.batch_scenes import checked_scene_arrays, grasp_contacts_batch, grasp_scenes
-from qsplan.hands.segments import first_segment
-from qsplan.hands.two_finger import default_hand, finger_angles, make_two_finger_hand
-from qsplan.hands.two_finger_analytic import analytic_hand_scene, grasp_contacts, scene_from_arrays
-from qsplan.hands.two_finger_scene import hand_scene
+from qsplan.hands.paper_hand.batch_scenes import checked_scene_arrays, grasp_contacts_batch, grasp_scenes
+from qsplan.hands.paper_hand.segments import first_segment
+from qsplan.hands.paper_hand.two_finger import default_hand, finger_angles, make_two_finger_hand
+from qsplan.hands.paper_hand.analytic import analytic_hand_scene, grasp_contacts, scene_from_arrays
+from qsplan.hands.paper_hand.scene import hand_scene
 from qsplan.mechanics import SceneError
 from qsplan.planner.task.task import load_task, task_paths
 
@@ -57,7 +57,7 @@ def _paper_task_names() -> list:
 
 @pytest.mark.parametrize("name", _paper_task_names())
 def test_bundled_tasks_along_their_segments(name):
-    from qsplan.hands.grasp_geometry import grasp_configurations
+    from qsplan.hands.paper_hand.grasp_geometry import grasp_configurations
 
     task = load_task(task_paths()[name])
     if task.goal is not None and task.goal.x is None:  # a turning goal: its palm-edge slide ends at the flush instant
@@ -143,7 +143,7 @@ def test_method_is_validated():
 
 
 def test_the_manipulator_is_built_once_per_hand():
-    from qsplan.hands.two_finger_scene import hand_manipulator
+    from qsplan.hands.paper_hand.scene import hand_manipulator
 
     hand, other = default_hand(), default_hand()
     assert hand_manipulator(hand) is hand_manipulator(hand)
@@ -179,7 +179,7 @@ def _assert_batch_is_the_closed_form(hand, poses, q) -> tuple:
 def test_batched_closed_form_is_the_one_state_closed_form_bit_for_bit():
     """Every grasp of the bundled goal tasks along the palm, the same turned by 1e-9 to 1e-3 rad or lifted and
     tilted (refusals at the margins), and random polygons at their vertices of tangency."""
-    from qsplan.hands.grasp_geometry import grasp_configurations
+    from qsplan.hands.paper_hand.grasp_geometry import grasp_configurations
 
     rng = np.random.default_rng(2025)
     found = tips = total = 0
@@ -214,7 +214,7 @@ def _reaches(hand, pose) -> bool:
 def test_checked_scene_arrays_are_the_scenes_of_grasp_scenes():
     """The band tables' arrays (no object per state) are the arrays of the scenes the one-state path builds, bit
     for bit, and :func:`scene_from_arrays` rebuilds those scenes."""
-    from qsplan.hands.grasp_geometry import candidate_grasps, grasp_configurations
+    from qsplan.hands.paper_hand.grasp_geometry import candidate_grasps, grasp_configurations
 
     used = 0
     for task in _two_finger_tasks():

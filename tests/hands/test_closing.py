@@ -1,4 +1,4 @@
-"""Closing a finger of any chain onto the workpiece (qsplan.hands.closing, qsplan.hands.chain_hand).
+"""Closing a finger of any chain onto the workpiece (qsplan.hands.chains.closing, qsplan.hands.chains.hand).
 
 Checked against independent references: the paper hand's closed-form tangency (finger_angles), and
 shapely's distance and intersection of the closed link with the workpiece."""
@@ -7,11 +7,11 @@ import numpy as np
 import pytest
 from shapely.geometry import Polygon
 
-from qsplan.hands.chain_hand import chain_polygons, chain_scene, close_grasp, make_chain_hand
-from qsplan.hands.closing import close_finger, separation
+from qsplan.hands.chains.hand import chain_polygons, chain_scene, close_grasp, make_chain_hand
+from qsplan.hands.chains.closing import close_finger, separation
 from qsplan.hands.description import load_hand
-from qsplan.hands.two_finger import DEFAULT_WORKPIECE, default_hand, finger_angles, workpiece_world
-from qsplan.hands.two_finger_scene import hand_manipulator
+from qsplan.hands.paper_hand.two_finger import DEFAULT_WORKPIECE, default_hand, finger_angles, workpiece_world
+from qsplan.hands.paper_hand.scene import hand_manipulator
 from qsplan.mechanics.errors import SceneError
 
 #: The hexagon the parallel jaws hold by its side corners.

@@ -1,4 +1,5 @@
-"""The batched closing (qsplan.hands.closing_batch) against the per-state reference (qsplan.hands.closing.close_finger).
+"""The batched closing (qsplan.hands.chains.closing_batch) against the per-state reference
+(qsplan.hands.chains.closing.close_finger).
 
 Seeded random states of every bundled hand and of a hand mixing a two-link finger and a leaning jaw: the same
 contact or none, the same contact key and link feature, the same flush verdict, the closing value, point and
@@ -7,12 +8,12 @@ normal to 1e-12; the batched link poses against ``link_poses``."""
 import numpy as np
 import pytest
 
-from qsplan.hands.chain_hand import make_chain_hand
-from qsplan.hands.closing import close_finger
-from qsplan.hands.closing_batch import close_finger_batch, link_poses_batch
+from qsplan.hands.chains.hand import make_chain_hand
+from qsplan.hands.chains.closing import close_finger
+from qsplan.hands.chains.closing_batch import close_finger_batch, link_poses_batch
 from qsplan.hands.description import load_hand
-from qsplan.hands.two_finger import DEFAULT_WORKPIECE
-from qsplan.hands.workpiece import workpiece_world
+from qsplan.hands.paper_hand.two_finger import DEFAULT_WORKPIECE
+from qsplan.hands.geometry.workpiece import workpiece_world
 from qsplan.mechanics.model.manipulator import link_poses
 from tests.hands.described_cases import HEXAGON, mixed_description
 

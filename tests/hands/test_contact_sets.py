@@ -1,4 +1,4 @@
-"""Named contact sets at any workpiece pose (qsplan.hands.contact_sets) and the demo hand's pivot in closed form
+"""Named contact sets at any workpiece pose (qsplan.hands.contacts.sets) and the demo hand's pivot in closed form
 (tests/reference/paper_pivot.py): conventions, the flush instant (against an independent root and the generic
 search's), the pivot manifold, the polygon search's contacts along it."""
 
@@ -10,12 +10,12 @@ import numpy as np
 import pytest
 from scipy.optimize import brentq
 
-from qsplan.hands.contact_sets import (ContactSpec, body_ring, contact_set_scene, finger_inner_edge, finger_link,
-                                       flush_contacts, locate_contacts, palm_top_edge)  # fmt: skip
-from qsplan.hands.found_contacts import polygon_contacts
-from qsplan.hands.segments import flush_angle
-from qsplan.hands.two_finger_scene import hand_geometric_scene
-from qsplan.hands.workpiece import rotation, workpiece_world
+from qsplan.hands.contacts.sets import (ContactSpec, body_ring, contact_set_scene, finger_inner_edge, finger_link,
+                                        flush_contacts, locate_contacts, palm_top_edge)  # fmt: skip
+from qsplan.hands.contacts.found import polygon_contacts
+from qsplan.hands.paper_hand.segments import flush_angle
+from qsplan.hands.paper_hand.scene import hand_geometric_scene
+from qsplan.hands.geometry.workpiece import rotation, workpiece_world
 from qsplan.mechanics import QsplanError
 from qsplan.mechanics.model.geometric_scene import find_scene_contacts, scene_from_geometric_scene
 from qsplan.mechanics.model.manipulator import link_poses
@@ -54,7 +54,7 @@ def test_flush_instant_reproduces_the_issue_and_an_independent_root():
     lim = hand.description.joint_limits
     assert np.all((lim[:, 0] < fi.q) & (fi.q < lim[:, 1]))
     # the generic search's flush instant (Newton's method on the five gap constraints) is the same configuration
-    from qsplan.hands.pivots import pivot_formations
+    from qsplan.hands.formations.pivots import pivot_formations
 
     pivot, start = pivot_formations(hand)[0]
     assert (pivot.flush, pivot.edge, pivot.other.vertex) == ("left", fi.edge, fi.right_vertex)

@@ -1,18 +1,18 @@
-"""Described hands' generic path (qsplan.hands.described) against today's chain path, one state at a time.
+"""Described hands' generic path (qsplan.hands.described.hand) against today's chain path, one state at a time.
 
 At seeded random workpiece x and free joints of the bundled two-link hand and parallel jaws and a mixed hand, the
-batched ``grasp_states`` and ``scene_arrays`` equal :func:`qsplan.hands.chain_hand.close_grasp` (closed joints,
-contact keys, points, normals, the flush and no-contact verdicts) and :func:`qsplan.hands.chain_hand.chain_scene`
+batched ``grasp_states`` and ``scene_arrays`` equal :func:`qsplan.hands.chains.hand.close_grasp` (closed joints,
+contact keys, points, normals, the flush and no-contact verdicts) and :func:`qsplan.hands.chains.hand.chain_scene`
 (the polygon search: which states have the formation's four contacts, and their ``W_n, W_t, J_n, J_t, g_obj,
 g_man``) to 1e-12; ``dq_dx`` equals eq. 6 solved at the reference scene and finite differences of the closing."""
 
 import numpy as np
 import pytest
 
-from qsplan.hands.chain_hand import chain_scene, close_grasp
-from qsplan.hands.closing import separation
-from qsplan.hands.described_build import make_described_hand
-from qsplan.hands.formations import formation
+from qsplan.hands.chains.hand import chain_scene, close_grasp
+from qsplan.hands.chains.closing import separation
+from qsplan.hands.described.build import make_described_hand
+from qsplan.hands.formations.registry import formation
 from qsplan.hands.protocol import FLUSH, NO_CONTACT, OTHER_CONTACT, SINGULAR, ChainGrasp, FingerContact
 from qsplan.mechanics.errors import QsplanError
 from tests.hands.described_cases import chain_cases

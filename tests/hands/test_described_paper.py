@@ -1,7 +1,7 @@
 """The paper's hand two ways: its closed forms (the accelerator) and the generic path (accelerated=False).
 
 For every bundled task on the paper's hand (its finger and palm parameters, its workpiece) and every grasp of
-:func:`qsplan.hands.grasp_geometry.candidate_grasps`, at 401 workpiece positions along the palm: the same
+:func:`qsplan.hands.paper_hand.grasp_geometry.candidate_grasps`, at 401 workpiece positions along the palm: the same
 configurations (the generic closing closes within the joint limits, which the closed forms leave to the planner:
 compared inside them), the same scenes' verdicts (the closed form's check or the polygon search, against the
 generic check or the polygon search), and q, contacts, dq_dx and every scene array to 1e-9."""
@@ -9,10 +9,10 @@ generic check or the polygon search), and q, contacts, dq_dx and every scene arr
 import numpy as np
 import pytest
 
-from qsplan.hands.described_build import described_from_two_finger, make_described_hand
+from qsplan.hands.described.build import described_from_two_finger, make_described_hand
 from qsplan.hands.description import load_hand
-from qsplan.hands.grasp_geometry import candidate_grasps
-from qsplan.hands.grasps import Grasp, OnVertex, TipOnEdge
+from qsplan.hands.paper_hand.grasp_geometry import candidate_grasps
+from qsplan.hands.paper_hand.grasps import Grasp, OnVertex, TipOnEdge
 from tests.hands.described_cases import paper_task_hands
 
 #: Agreement of the two paths (m, rad, rad/m, N, N m): the closed forms and the generic closing compute the same

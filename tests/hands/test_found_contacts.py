@@ -7,7 +7,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from qsplan.hands.found_contacts import (contact_names, drawable_contacts, made_contacts, ordered_contacts,
+from qsplan.hands.contacts.found import (contact_names, drawable_contacts, made_contacts, ordered_contacts,
                                          row_contact_scene)  # fmt: skip
 from qsplan.mechanics.errors import QsplanError
 from qsplan.planner.task.task import load_task, task_paths
@@ -30,7 +30,7 @@ def test_the_canonical_order_is_the_closed_form_formations(hand):
         PIVOT.contact_names  # fmt: skip
     # palm-edge: the order of every earlier plan (palm:0, palm:1, left, right), the palm's left to right
     before = (fi.pose + [0.005, 0.0, 0.0], None)
-    from qsplan.hands.two_finger import finger_angles
+    from qsplan.hands.paper_hand.two_finger import finger_angles
 
     q = finger_angles(hand.paper, before[0])[0]
     found = ordered_contacts(hand, before[0], q)
@@ -54,7 +54,7 @@ def test_scenes_equal_the_named_contact_sets(hand):
 
 
 def test_the_contact_a_motion_makes_at_its_end(hand):
-    from qsplan.hands.two_finger import finger_angles
+    from qsplan.hands.paper_hand.two_finger import finger_angles
 
     fi = flush_instant(hand)
     near = fi.pose + [0.0005, 0.0, 0.0]
@@ -69,7 +69,7 @@ def test_the_contact_a_motion_makes_at_its_end(hand):
 
 
 def test_a_chain_hand_draws_its_grasp_contacts():
-    from qsplan.hands.interface import contacts_at
+    from qsplan.hands.described.records import contacts_at
     from tests.planner.bundled import bundled_task, planned
 
     task = bundled_task("two_link_task")

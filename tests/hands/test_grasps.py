@@ -8,15 +8,17 @@ and the polygon search (the generic scene, to round-off); the mechanics (a 4S ba
 import numpy as np
 import pytest
 
-from qsplan.hands.batch_scenes import grasp_scenes, scene_arrays
-from qsplan.hands.grasp_geometry import TIP_MARGIN, candidate_grasps, grasp_configurations, palm_range, tip_angles
-from qsplan.hands.grasps import (Grasp, OnVertex, TipOnEdge, internal_edge, internal_vertex, parse_grasp,
-                                 parse_placement, user_edge, user_vertex)  # fmt: skip
-from qsplan.hands.two_finger import DEFAULT_WORKPIECE, default_hand, finger_angle_rates, finger_angles, make_two_finger_hand
-from qsplan.hands.two_finger_analytic import grasp_contacts
-from qsplan.hands.two_finger_scene import hand_scene
+from qsplan.hands.paper_hand.batch_scenes import grasp_scenes, scene_arrays
+from qsplan.hands.paper_hand.grasp_geometry import (TIP_MARGIN, candidate_grasps, grasp_configurations, palm_range,
+                                                    tip_angles)  # fmt: skip
+from qsplan.hands.paper_hand.grasps import (Grasp, OnVertex, TipOnEdge, internal_edge, internal_vertex, parse_grasp,
+                                            parse_placement, user_edge, user_vertex)  # fmt: skip
+from qsplan.hands.paper_hand.two_finger import (DEFAULT_WORKPIECE, default_hand, finger_angle_rates, finger_angles,
+                                                make_two_finger_hand)  # fmt: skip
+from qsplan.hands.paper_hand.analytic import grasp_contacts
+from qsplan.hands.paper_hand.scene import hand_scene
 from qsplan.mechanics import SceneError
-from qsplan.hands.collision import find_collisions
+from qsplan.hands.geometry.collision import find_collisions
 
 from tests.hands.scenes import assert_same_scene
 

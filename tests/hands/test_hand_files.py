@@ -17,8 +17,8 @@ from qsplan.hands.description import (
     make_hand_description,
     two_finger_parameters,
 )
-from qsplan.hands.two_finger import default_hand, make_two_finger_hand
-from qsplan.hands.two_finger_scene import hand_manipulator
+from qsplan.hands.paper_hand.two_finger import default_hand, make_two_finger_hand
+from qsplan.hands.paper_hand.scene import hand_manipulator
 from qsplan.mechanics import SceneError
 from qsplan.mechanics.model.manipulator import link_polygons, link_poses
 

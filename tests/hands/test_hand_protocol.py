@@ -5,15 +5,15 @@ validation branch."""
 import numpy as np
 import pytest
 
-from qsplan.hands.described_build import (described_from_chain, described_from_two_finger, hand_from_metadata,
-                                    make_described_hand)  # fmt: skip
+from qsplan.hands.described.build import (described_from_chain, described_from_two_finger, hand_from_metadata,
+                                          make_described_hand)  # fmt: skip
 from qsplan.hands.description import load_hand
-from qsplan.hands.formations import ContactSlot, Formation
-from qsplan.hands.grasps import Grasp, OnVertex, TipOnEdge
-from qsplan.hands.interface import hand_metadata
-from qsplan.hands.paper_accelerator import paper_state_scene, paper_states
+from qsplan.hands.formations.registry import ContactSlot, Formation
+from qsplan.hands.paper_hand.grasps import Grasp, OnVertex, TipOnEdge
+from qsplan.hands.described.records import hand_metadata
+from qsplan.hands.paper_hand.accelerator import paper_state_scene, paper_states
 from qsplan.hands.protocol import ChainGrasp, FingerContact, GraspSceneArrays, GraspStates, Hand
-from qsplan.hands.two_finger import DEFAULT_WORKPIECE, default_hand, make_two_finger_hand
+from qsplan.hands.paper_hand.two_finger import DEFAULT_WORKPIECE, default_hand, make_two_finger_hand
 from qsplan.mechanics.errors import QsplanError, SceneError
 from qsplan.mechanics.model.scene import Scene
 from tests.hands.described_cases import chain_cases
@@ -73,7 +73,7 @@ def test_every_hand_answers_the_protocol_with_its_shapes(case):
 
 def test_metadata_round_trips(case):
     """The hand comes back; its polygon, centred again about its centroid, moves by rounding (~1e-17 m), as with
-    :func:`qsplan.hands.interface.hand_from_metadata` today."""
+    :func:`qsplan.hands.described.records.hand_from_metadata` today."""
     hand, _ = case
     meta = hand.metadata()
     again = hand_from_metadata(meta)
@@ -218,7 +218,7 @@ def test_a_goal_is_a_placement_string():
         contact.matches("corner:2", "goal_left")
 
 
-# the questions the planner asked through qsplan.hands.interface, folded into the protocol (issue 32)
+# the questions the planner asked through qsplan.hands.described.records, folded into the protocol (issue 32)
 
 def _configuration(hand, centre):
     """A closed grasp's ``(pose, q)`` and its scene inputs (the right closing joint effort-controlled)."""
@@ -234,7 +234,7 @@ def test_the_folded_questions_answer_as_the_interface_did(case):
     """Each member the planner now asks equals the interface function it replaced, asked of the same hand, exactly;
     and, to rounding, the same function asked of the hand's chain record (the polygon search, the accelerator's
     reference): the paper hand's closed forms and its description agree."""
-    from qsplan.hands import interface as old
+    from qsplan.hands.described import records as old
 
     hand, centre = case
     chain = hand.chain

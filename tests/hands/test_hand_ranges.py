@@ -14,7 +14,7 @@ import pytest
 
 from qsplan.hands.description import bundled_hands, describe_two_finger_hand, hand_from_table, load_hand
 from qsplan.hands.description.model import HAND_RANGES
-from qsplan.hands.two_finger import default_hand
+from qsplan.hands.paper_hand.two_finger import default_hand
 from qsplan.mechanics import QsplanError, SceneError
 from qsplan.mechanics.model.fields import UNIT_SLIPS, in_range
 from qsplan.planner.task.fields import TASK_RANGES

@@ -6,9 +6,9 @@ import json
 import numpy as np
 import pytest
 
-from qsplan.hands.chain_hand import chain_polygons, chain_scene, close_grasp, make_chain_hand
+from qsplan.hands.chains.hand import chain_polygons, chain_scene, close_grasp, make_chain_hand
 from qsplan.hands.description import hand_from_table, joint_frames, load_hand
-from qsplan.hands.interface import (
+from qsplan.hands.described.records import (
     JOINT_UNITS,
     contacts_at,
     description_table,
@@ -28,8 +28,8 @@ from qsplan.hands.interface import (
     palm_thickness,
     scene_at,
 )
-from qsplan.hands.two_finger import DEFAULT_WORKPIECE, default_hand, finger_angles
-from qsplan.hands.two_finger_scene import hand_manipulator, hand_polygons, hand_scene
+from qsplan.hands.paper_hand.two_finger import DEFAULT_WORKPIECE, default_hand, finger_angles
+from qsplan.hands.paper_hand.scene import hand_manipulator, hand_polygons, hand_scene
 from qsplan.mechanics import QsplanError
 
 #: The hexagon the parallel-jaw gripper holds by its side corners (m, as written).

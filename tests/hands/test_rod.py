@@ -3,8 +3,8 @@
 import numpy as np
 import pytest
 
-from qsplan.hands.paper import rod_scene
-from qsplan.hands.rod import (
+from qsplan.hands.examples.paper import rod_scene
+from qsplan.hands.examples.rod import (
     check_rod_inputs,
     make_rod_system,
     rod_closed_form,

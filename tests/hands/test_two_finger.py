@@ -7,8 +7,8 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from qsplan.hands.segments import FLUSH_CLEARANCE, first_segment, flush_angle, sample_segment
-from qsplan.hands.two_finger import (
+from qsplan.hands.paper_hand.segments import FLUSH_CLEARANCE, first_segment, flush_angle, sample_segment
+from qsplan.hands.paper_hand.two_finger import (
     CONTACT_ROLES,
     DEFAULT_WORKPIECE,
     default_hand,
@@ -17,7 +17,7 @@ from qsplan.hands.two_finger import (
     make_two_finger_hand,
     workpiece_world,
 )
-from qsplan.hands.two_finger_scene import hand_contacts, hand_geometric_scene, hand_polygons, hand_scene
+from qsplan.hands.paper_hand.scene import hand_contacts, hand_geometric_scene, hand_polygons, hand_scene
 from qsplan.mechanics import ContactMode, SceneError, check_mode, solve
 from qsplan.mechanics.bands.effort import effort_band, effort_bands
 from qsplan.mechanics.bands.guaranteed import guaranteed_band_box

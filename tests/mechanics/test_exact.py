@@ -5,7 +5,7 @@ from fractions import Fraction
 import numpy as np
 import pytest
 
-from qsplan.hands.paper import PAPER_SCENES
+from qsplan.hands.examples.paper import PAPER_SCENES
 from qsplan.mechanics import check_mode, make_scene, planted_scene, scene_from_dict, solve
 from qsplan.mechanics.model.contact import wrench_matrices
 from qsplan.mechanics.crosscheck.exact import exact_check_mode, exact_feasible_modes, solve_exact

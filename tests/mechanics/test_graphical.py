@@ -5,7 +5,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from qsplan.hands.paper import eq37_scene, eq42_scene, rod_scene
+from qsplan.hands.examples.paper import eq37_scene, eq42_scene, rod_scene
 from qsplan.mechanics import ModeError, QsplanError, enumerate_modes, scene_from_dict, wrench_matrices
 from qsplan.mechanics.muspace.graphical import (
     active_wrenches,

@@ -77,7 +77,7 @@ def _flush_scene():
 @cache
 def _slide_end():
     """The demo's last row (at rest) and its four-contact scene, the left finger held, the right torque-controlled."""
-    from qsplan.hands.interface import scene_at
+    from qsplan.hands.described.records import scene_at
 
     row = list(csv.DictReader(REFERENCE.open()))[-1]
     pose = [float(row[k]) for k in ("x_workpiece", "y_workpiece", "theta_workpiece")]

@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from qsplan.hands.paper import PAPER_SCENES
+from qsplan.hands.examples.paper import PAPER_SCENES
 from qsplan.mechanics import planted_scene, scene_from_dict, solve
 from qsplan.mechanics.crosscheck.lcp import LcpStatus, quasistatic_lcp, solve_lcp
 from qsplan.mechanics.modes.solution import relative_velocity

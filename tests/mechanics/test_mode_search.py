@@ -6,7 +6,7 @@ from itertools import combinations
 import numpy as np
 import pytest
 
-from qsplan.hands.paper import eq37_scene, eq42_scene, rod_scene
+from qsplan.hands.examples.paper import eq37_scene, eq42_scene, rod_scene
 from qsplan.mechanics import ContactMode, QsplanError, check_mode, count_modes, make_scene, planted_scene, scene_from_dict, solve
 from qsplan.mechanics.solver.breaking_sets import _Programme, equilibrium_relaxation, feasible_breaking_sets
 from qsplan.mechanics.solver.search import PRUNED, PRUNED_KINEMATIC, codes_with_breaking_sets
@@ -65,9 +65,9 @@ def test_paper_examples(mu):
 
 
 def test_two_finger_hand_scenes():
-    from qsplan.hands.segments import first_segment
-    from qsplan.hands.two_finger import default_hand
-    from qsplan.hands.two_finger_scene import hand_scene
+    from qsplan.hands.paper_hand.segments import first_segment
+    from qsplan.hands.paper_hand.two_finger import default_hand
+    from qsplan.hands.paper_hand.scene import hand_scene
 
     hand = default_hand()
     segment = first_segment(hand, duration=10.0)

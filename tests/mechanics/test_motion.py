@@ -3,9 +3,9 @@
 import numpy as np
 import pytest
 
-from qsplan.hands.paper import eq37_scene, eq42_scene
-from qsplan.hands.pushing import make_pushed_polygon, tilted_box_example
-from qsplan.hands.rod import make_rod_system, rod_initial_state
+from qsplan.hands.examples.paper import eq37_scene, eq42_scene
+from qsplan.hands.examples.pushing import make_pushed_polygon, tilted_box_example
+from qsplan.hands.examples.rod import make_rod_system, rod_initial_state
 from qsplan.mechanics import ContactMode, QsplanError, Status, check_mode, enumerate_modes, planted_scene, scene_from_dict
 from qsplan.mechanics.motion.conditions import mode_values
 from qsplan.mechanics.motion.events import rk4_step

@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from qsplan.hands.paper import eq42_scene
+from qsplan.hands.examples.paper import eq42_scene
 from qsplan.mechanics import SceneError, planted_scene, scene_from_dict, solve
 from qsplan.mechanics.muspace.maps import feasibility_map, grid_points
 

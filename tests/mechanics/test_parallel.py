@@ -10,9 +10,9 @@ from functools import partial
 import numpy as np
 import pytest
 
-from qsplan.hands.paper import eq42_scene
-from qsplan.hands.segments import first_segment, sample_segment
-from qsplan.hands.two_finger import default_hand
+from qsplan.hands.examples.paper import eq42_scene
+from qsplan.hands.paper_hand.segments import first_segment, sample_segment
+from qsplan.hands.paper_hand.two_finger import default_hand
 from qsplan.mechanics import QsplanError, scene_from_dict, solve
 from qsplan.mechanics import parallel
 from qsplan.mechanics.muspace import maps as muspace

@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from qsplan.hands.paper import eq37_scene, eq42_scene, rod_scene
+from qsplan.hands.examples.paper import eq37_scene, eq42_scene, rod_scene
 from qsplan.mechanics import ContactMode, ModeError, QsplanError, SceneError, enumerate_modes, planted_scene, scene_from_dict, solve
 from qsplan.mechanics.muspace.multilinear import (
     Multilinear,

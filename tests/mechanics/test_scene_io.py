@@ -6,7 +6,7 @@ import json
 import numpy as np
 import pytest
 
-from qsplan.hands.paper import eq42_scene, rod_scene
+from qsplan.hands.examples.paper import eq42_scene, rod_scene
 from qsplan.mechanics import SceneError, load_scene, scene_from_dict, solve
 
 RAW = {

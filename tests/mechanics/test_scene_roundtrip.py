@@ -5,7 +5,7 @@ import json
 import numpy as np
 import pytest
 
-from qsplan.hands.paper import eq37_scene, eq42_scene
+from qsplan.hands.examples.paper import eq37_scene, eq42_scene
 from qsplan.mechanics import SceneError, make_scene, planted_scene, scene_from_dict, solve
 from qsplan.mechanics.model.scene_io_write import scene_to_dict
 

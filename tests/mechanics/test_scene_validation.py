@@ -6,7 +6,7 @@ import json
 import numpy as np
 import pytest
 
-from qsplan.hands.paper import eq37_scene, eq42_scene, rod_scene
+from qsplan.hands.examples.paper import eq37_scene, eq42_scene, rod_scene
 from qsplan.mechanics import SceneError, load_scene, scene_from_dict
 from qsplan.mechanics.model.contact import FRAME_TOL, check_contact_frame, wrench_matrix
 from qsplan.mechanics.model.fields import MAX_DEPTH, MAX_FILE_BYTES, nesting_depth, read_document

@@ -60,7 +60,7 @@ def _task(hi: float = 0.4):
 def _scene(x: float, method: str):
     """The slide's scene at workpiece ``x`` (m): the left jaw force-controlled, the right one closing the grasp as
     the workpiece moves left at 1 cm/s (the grasp's closed form or the polygon search: ``method``)."""
-    from qsplan.hands.interface import scene_at
+    from qsplan.hands.described.records import scene_at
     from qsplan.planner.states.contact import contact_samples
 
     task = _task()

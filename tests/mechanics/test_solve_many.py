@@ -7,8 +7,8 @@ import numpy as np
 import pytest
 
 from qsplan.hands import hand_scene
-from qsplan.hands.paper import eq42_scene
-from qsplan.hands.two_finger import default_hand
+from qsplan.hands.examples.paper import eq42_scene
+from qsplan.hands.paper_hand.two_finger import default_hand
 from qsplan.mechanics import (
     DEFAULT_TOLERANCES,
     SceneError,

@@ -2,10 +2,10 @@
 
 Rebuilds every body of a row of ``plan.csv`` from the hand's dimensions alone (finger
 rectangles from the joint axes, lengths and widths; the palm slab; the workpiece from
-:func:`qsplan.hands.two_finger.workpiece_world` at the row's pose) and measures each
+:func:`qsplan.hands.paper_hand.two_finger.workpiece_world` at the row's pose) and measures each
 pair's overlap with shapely, so that a bug in
-:mod:`qsplan.hands.collision` cannot hide itself.  A described hand's bodies
-(:class:`qsplan.hands.chain_hand.ChainHand`) come from its description: the palm polygon and
+:mod:`qsplan.hands.geometry.collision` cannot hide itself.  A described hand's bodies
+(:class:`qsplan.hands.chains.hand.ChainHand`) come from its description: the palm polygon and
 each link's polygon placed by :func:`qsplan.mechanics.model.manipulator.link_polygons`.
 """
 
@@ -17,7 +17,7 @@ from itertools import combinations
 import numpy as np
 from shapely.geometry import Point, Polygon, box
 
-from qsplan.hands.two_finger import workpiece_world
+from qsplan.hands.paper_hand.two_finger import workpiece_world
 
 #: Depth (m) of overlap accepted: a micron (touching bodies compute as overlapping by ~1e-15 m).
 DEPTH = 1e-6

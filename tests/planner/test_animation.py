@@ -62,8 +62,8 @@ def test_sliding_directions_of_a_translated_workpiece(dx):
     """Fingers held, the workpiece moved by ``dx``: it slips by ``dx`` against every body, so each contact slides along
     its tangent the way ``dx`` projects on it (closed form)."""
     from qsplan.hands import default_hand
-    from qsplan.hands.interface import contacts_at
-    from qsplan.hands.two_finger import finger_angles
+    from qsplan.hands.described.records import contacts_at
+    from qsplan.hands.paper_hand.two_finger import finger_angles
 
     hand = default_hand()
     pose = np.array([0.0, hand.rest_height, 0.0])

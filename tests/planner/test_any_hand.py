@@ -2,7 +2,7 @@
 plots on plans of described chain hands, built here without the planner.
 
 A synthetic in-contact segment holds the fingers' free joints (each finger's joints but its last) and closes the
-last joints onto the workpiece at every row (:func:`qsplan.hands.chain_hand.close_grasp`); the velocities are
+last joints onto the workpiece at every row (:func:`qsplan.hands.chains.hand.close_grasp`); the velocities are
 finite differences, the mode follows from the kinematics, the band is
 :func:`qsplan.mechanics.bands.batched_robust.robust_bands` on the rows' scenes and the command keeps the plans' margin
 inside it (:func:`qsplan.planner.torque.command.segment_command`).
@@ -14,9 +14,9 @@ import json
 import numpy as np
 import pytest
 
-from qsplan.hands.chain_hand import chain_scene, close_grasp, make_chain_hand
+from qsplan.hands.chains.hand import chain_scene, close_grasp, make_chain_hand
 from qsplan.hands.description import load_hand, make_hand_description
-from qsplan.hands.two_finger import DEFAULT_WORKPIECE
+from qsplan.hands.paper_hand.two_finger import DEFAULT_WORKPIECE
 from qsplan.mechanics import QsplanError
 from qsplan.mechanics.bands.batched_robust import robust_bands
 from qsplan.planner.certify.certify import certify_plan, read_plan, task_from_metadata
@@ -27,7 +27,7 @@ from qsplan.planner.plan.results import ContactSegmentPlan, Plan, RegraspPlan
 from qsplan.planner.plan.timing import time_scale
 from qsplan.planner.replay.replay import replay_plan
 from qsplan.planner.search.ompl_bridge import PlanResult
-from qsplan.hands.collision import find_collisions, find_collisions_batch, shapely_collisions
+from qsplan.hands.geometry.collision import find_collisions, find_collisions_batch, shapely_collisions
 from qsplan.planner.task.task import make_task
 from qsplan.planner.torque.command import MAX_MARGIN_RESOLUTIONS, segment_command
 

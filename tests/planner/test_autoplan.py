@@ -187,8 +187,8 @@ def test_random_goal_tasks_plan_or_say_why(seed):
     QsplanError with a message; never another exception (a scene the polygons cannot give crashed the tables)."""
     from dataclasses import replace
 
-    from qsplan.hands.grasp_geometry import grasp_configurations
-    from qsplan.hands.grasps import OnVertex
+    from qsplan.hands.paper_hand.grasp_geometry import grasp_configurations
+    from qsplan.hands.paper_hand.grasps import OnVertex
     from qsplan.planner.plan.results import PlanFailure
     from qsplan.planner.plan.scripted import plan_task
 

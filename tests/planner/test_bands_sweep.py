@@ -3,8 +3,8 @@
 import numpy as np
 import pytest
 
-from qsplan.hands.segments import first_segment, sample_segment
-from qsplan.hands.two_finger import default_hand
+from qsplan.hands.paper_hand.segments import first_segment, sample_segment
+from qsplan.hands.paper_hand.two_finger import default_hand
 from qsplan.mechanics import ModeError, QsplanError, SceneError, planted_scene, solve
 from qsplan.mechanics.bands.effort import band_kinematics, effort_bands
 from qsplan.mechanics.modes.contact_mode import enumerate_modes

@@ -8,7 +8,7 @@ import shutil
 import numpy as np
 import pytest
 
-from qsplan.hands.two_finger import default_hand
+from qsplan.hands.paper_hand.two_finger import default_hand
 from qsplan.mechanics import QsplanError
 from qsplan.planner import export_plan, load_task, make_task, ompl_available, plan_task, task_paths
 from qsplan.planner.certify.certify import certify_plan, read_plan, task_from_metadata

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 from shapely.geometry import Polygon
 
-from qsplan.hands.chain_hand import chain_polygons
+from qsplan.hands.chains.hand import chain_polygons
 from qsplan.planner import load_task, plan_task, task_paths
 from qsplan.planner.task.task import make_task
 from qsplan.planner.plan.timing import quasistatic_rows
@@ -97,8 +97,8 @@ def test_inclined_parallel_jaws_slide_in_4s():
 
 def test_a_regrasp_onto_another_feature_is_planned():
     """The two-link fingers choose where they touch: the left one regrasps from a corner onto the left side."""
-    from qsplan.hands.chain_hand import close_grasp
-    from qsplan.hands.grasps import internal_edge
+    from qsplan.hands.chains.hand import close_grasp
+    from qsplan.hands.paper_hand.grasps import internal_edge
     from qsplan.planner.plan.results import RegraspPlan
     from tests.planner.bundled import bundled_task, planned
 
@@ -137,7 +137,7 @@ def test_a_goal_feature_no_finger_can_touch_is_reported():
 
 def test_the_paper_hand_file_plans_the_demo_byte_for_byte(tmp_path):
     """demo_task.toml names file = "paper_hand": the same hand, and the same plan, as the parameter form."""
-    from qsplan.hands.two_finger import TwoFingerHand
+    from qsplan.hands.paper_hand.two_finger import TwoFingerHand
     from qsplan.planner.export.plan_files import export_plan
 
     path = task_paths()["demo_task"]

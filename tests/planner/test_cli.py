@@ -7,7 +7,7 @@ import sys
 import numpy as np
 import pytest
 
-from qsplan.hands.paper import eq42_scene, rod_scene
+from qsplan.hands.examples.paper import eq42_scene, rod_scene
 from qsplan.mechanics import planted_scene, solve
 from qsplan.mechanics.model.scene_io_write import scene_to_dict
 from qsplan.planner.cli.main import main

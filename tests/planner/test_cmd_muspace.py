@@ -8,7 +8,7 @@ import sys
 import numpy as np
 import pytest
 
-from qsplan.hands.paper import eq42_scene, rod_scene
+from qsplan.hands.examples.paper import eq42_scene, rod_scene
 from qsplan.mechanics import enumerate_modes, scene_from_dict, solve
 from qsplan.mechanics.muspace.slices import mu_slice
 from qsplan.planner.cli.main import main

@@ -6,7 +6,7 @@ import sys
 
 import pytest
 
-from qsplan.hands.rod import rod_closed_form
+from qsplan.hands.examples.rod import rod_closed_form
 from qsplan.planner.cli.main import main
 
 BASE = ["simulate", "rod", "--l1", "1.0", "--l2", "0.6", "--speed", "0.1"]

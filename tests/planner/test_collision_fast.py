@@ -13,14 +13,14 @@ import pytest
 from scipy.optimize import brentq
 from shapely.geometry import MultiPoint, Point, Polygon, box
 
-from qsplan.hands.two_finger import default_hand, finger_angles, make_two_finger_hand
-from qsplan.hands.two_finger_scene import hand_polygons
+from qsplan.hands.paper_hand.two_finger import default_hand, finger_angles, make_two_finger_hand
+from qsplan.hands.paper_hand.scene import hand_polygons
 from qsplan.mechanics.errors import QsplanError, SceneError
-from qsplan.hands.collision import (CLEAR, COLLIDES, CONTACT_DEPTH_TOL, DECISION_BAND, HOUSING_QUAD_SEGS,
+from qsplan.hands.geometry.collision import (CLEAR, COLLIDES, CONTACT_DEPTH_TOL, DECISION_BAND, HOUSING_QUAD_SEGS,
                                              JOINT_HOUSING, LINK_DEPTH_TOL, UNDECIDED, body_label,
                                              collision_decisions, collision_pairs, find_collisions,
                                              find_collisions_batch, overlap_depth, shapely_collisions)  # fmt: skip
-from qsplan.hands.overlap import (convex_vertices, disk_pieces, intersection_width, make_polygons,
+from qsplan.hands.geometry.overlap import (convex_vertices, disk_pieces, intersection_width, make_polygons,
                                            separating_depth)  # fmt: skip
 from qsplan.planner.task.task import load_task, task_paths
 

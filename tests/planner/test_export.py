@@ -7,8 +7,8 @@ import math
 import numpy as np
 import pytest
 
-from qsplan.hands.segments import first_segment, sample_segment
-from qsplan.hands.two_finger import default_hand
+from qsplan.hands.paper_hand.segments import first_segment, sample_segment
+from qsplan.hands.paper_hand.two_finger import default_hand
 from qsplan.mechanics import QsplanError
 from qsplan.planner.torque.sweep import segment_bands
 from qsplan.planner.export.schedule import (

@@ -10,8 +10,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from qsplan.hands.segments import first_segment, sample_segment
-from qsplan.hands.two_finger import default_hand
+from qsplan.hands.paper_hand.segments import first_segment, sample_segment
+from qsplan.hands.paper_hand.two_finger import default_hand
 from qsplan.planner.export.plan_files import PLAN_COLUMNS, plan_columns, plan_metadata, read_plan_csv
 from qsplan.planner.export.schedule import SCHEDULE_COLUMNS
 from qsplan.planner.export.schema import (

@@ -3,7 +3,7 @@
 * A hand: one description file (``tests/data/hands/asymmetric_hand.toml``, a left finger of two joints and a
   right finger of one, which no bundled hand has); a task names it and the whole pipeline plans, exports and
   certifies it.
-* A formation: one entry of :data:`qsplan.hands.formations.FORMATIONS` (here the palm-edge formation with its
+* A formation: one entry of :data:`qsplan.hands.formations.registry.FORMATIONS` (here the palm-edge formation with its
   contacts in the reverse order, added for the test only); a task names it, and the scenes, band tables, plan,
   export and certificate follow its order, with the same physics as the default's.
 """
@@ -17,7 +17,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from qsplan.hands.formations import FORMATIONS, Formation
+from qsplan.hands.formations.registry import FORMATIONS, Formation
 from qsplan.planner.certify.certify import certify_plan
 from qsplan.planner.export.plan_files import export_plan
 from qsplan.planner.plan.scripted import plan_task

@@ -5,7 +5,7 @@ import json
 
 import pytest
 
-from qsplan.hands.paper import eq42_scene
+from qsplan.hands.examples.paper import eq42_scene
 from qsplan.mechanics import QsplanError
 from qsplan.planner.cli.main import COMMANDS, main
 from qsplan.planner.cli.options import COUNT_RANGES, EXIT_INTERRUPTED

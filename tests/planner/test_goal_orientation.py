@@ -185,7 +185,7 @@ def test_check_previews_a_turning_goal_as_the_formation_search_sees_it(tmp_path,
     """Issue 31 called a turning goal "goal (x = 0 m): not a valid configuration"; issue 32: the check shows every
     formation the search sees (where each ends, or its band) and previews the slide to the flush instant of the one
     that reaches the goal, as ``qsplan plan`` plans it."""
-    from qsplan.hands.pivots import pivot_formations
+    from qsplan.hands.formations.pivots import pivot_formations
 
     path = tilt_file(tmp_path)
     task = load_task(path)

@@ -2,7 +2,7 @@
 
 At a slide's last row the mode is judged for the motion that reaches it, which leaves out a contact it makes only
 there (it opens along that motion); at rest that contact pushes as well as any other.  One rule,
-:func:`qsplan.hands.found_contacts.hold_scene`, gives the planner's holds and the certifier's their contacts.
+:func:`qsplan.hands.contacts.found.hold_scene`, gives the planner's holds and the certifier's their contacts.
 
 Checked against an independent method: a hold is proved iff every extreme ray of the admissible motions
 ``{x : A x >= 0}`` (enumerated from the rows of ``A`` without a programme) has negative power ``p . x`` (the loads'
@@ -95,8 +95,8 @@ def flush_row(tmp_path_factory):
 def test_the_flush_instant_holds_with_the_contact_it_makes(flush_row):
     """At the slide's last row the mode leaves out one contact (made there); the hold with the four others is not
     proved at the row's torque and the hold with all five is, by the programme and by the extreme rays alike."""
-    from qsplan.hands.found_contacts import hold_scene, row_contact_scene
-    from qsplan.hands.interface import joint_names
+    from qsplan.hands.contacts.found import hold_scene, row_contact_scene
+    from qsplan.hands.described.records import joint_names
     from qsplan.planner.certify.contacts import judged_contacts
     from qsplan.planner.certify.rows import row_pose, row_q
 
@@ -125,8 +125,8 @@ def test_the_flush_instant_holds_with_the_contact_it_makes(flush_row):
 def test_the_hold_interval_ends_where_a_ray_turns(flush_row):
     """The five-contact hold's torque interval (the planner's band at the flush instant) ends where the extreme rays'
     largest power crosses zero: 1e-6 N m inside every ray loses power, 1e-6 N m outside one gains it."""
-    from qsplan.hands.found_contacts import hold_scene
-    from qsplan.hands.interface import joint_names
+    from qsplan.hands.contacts.found import hold_scene
+    from qsplan.hands.described.records import joint_names
     from qsplan.mechanics.bands.hold import MARGIN_TOL
     from qsplan.planner.certify.rows import row_pose, row_q
 
@@ -147,8 +147,8 @@ def test_the_hold_interval_ends_where_a_ray_turns(flush_row):
 def test_a_chain_hand_holds_with_the_contacts_the_polygons_show():
     """The two-link hand: a hold's scene is the contacts the polygons show, in the canonical order (one path for
     every hand), the same points and normals as its grasp's closed contacts, every joint but the effort joint held."""
-    from qsplan.hands.found_contacts import hold_scene
-    from qsplan.hands.interface import scene_at
+    from qsplan.hands.contacts.found import hold_scene
+    from qsplan.hands.described.records import scene_at
     from qsplan.planner.states.contact import contact_samples
     from qsplan.planner.task.task import load_task, task_paths
 

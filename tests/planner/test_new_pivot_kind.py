@@ -4,8 +4,8 @@
 The hand (``tests/data/hands/short_right_finger.toml``) is the paper hand with a right finger of 110 mm: at the demo
 workpiece's flush instant it cannot reach vertex 2, so the clockwise turn needs the right fingertip's corner on
 edge 1.  The kind (:class:`TipOnEdge`, written here and nowhere else) says that in one gap constraint, and one
-:data:`qsplan.hands.pivots.FINGER_FEATURES` entry (this test's monkeypatch) puts it in front of the formation search,
-the plan's names, the certifier's formation check and the replay.  With the library's own corner kind taken away
+:data:`qsplan.hands.formations.pivots.FINGER_FEATURES` entry (this test's monkeypatch) puts it in front of the formation
+search, the plan's names, the certifier's formation check and the replay.  With the library's own corner kind taken away
 and none added, the turn is refused; with the test's kind added, it is planned, exported and certified, and the
 plan's pivot is named by the test's kind.
 """
@@ -19,8 +19,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from qsplan.hands import pivots
-from qsplan.hands.manifold import VertexOnLine, gaps
+from qsplan.hands.formations import pivots
+from qsplan.hands.formations.manifold import VertexOnLine, gaps
 from qsplan.planner.certify.certify import certify_plan
 from qsplan.planner.export.plan_files import export_plan, read_plan_csv
 from qsplan.planner.plan.results import PlanFailure

@@ -5,8 +5,8 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from qsplan.hands.two_finger import default_hand, finger_angles
-from qsplan.hands.two_finger_scene import hand_scene
+from qsplan.hands.paper_hand.two_finger import default_hand, finger_angles
+from qsplan.hands.paper_hand.scene import hand_scene
 from qsplan.mechanics import QsplanError
 from qsplan.mechanics.bands.guaranteed import guaranteed_band_box
 from qsplan.mechanics.modes.contact_mode import ContactMode

@@ -9,7 +9,7 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from qsplan.hands.interface import contacts_at, joint_axes, joint_kinds, joint_names
+from qsplan.hands.described.records import contacts_at, joint_axes, joint_kinds, joint_names
 from qsplan.mechanics import SceneError
 from qsplan.planner.plan.results import ContactSegmentPlan, RegraspPlan
 from qsplan.planner.plotting.card import card_snapshots, phase_rows, plan_card
@@ -35,9 +35,9 @@ def planned(name):
 
 def every_finger_touches(plan, pose, q) -> bool:
     """The contact search finds the grasp's contact set (palm, palm, a left-finger link, a right-finger link); a
-    paper-form hand's in any formation: the palm and both fingers touch (qsplan.hands.found_contacts)."""
-    from qsplan.hands.contact_sets import finger_link
-    from qsplan.hands.found_contacts import ordered_contacts
+    paper-form hand's in any formation: the palm and both fingers touch (qsplan.hands.contacts.found)."""
+    from qsplan.hands.contacts.sets import finger_link
+    from qsplan.hands.contacts.found import ordered_contacts
 
     hand = plan.task.hand
     if getattr(hand, "paper", None) is not None:
@@ -383,7 +383,7 @@ def test_velocity_panels_draw_what_the_controller_is_sent(tmp_path):
     """Issue 31: the card drew a regrasp's velocities as steps where plan.csv and ``qsplan sample`` ramp them from rest
     to rest.  Each drawn velocity is ``qsplan sample``'s at its ticks (read from the exported plan.csv), it changes no
     faster than the task's joint acceleration on the regrasp, and integrated it follows the plan's joints."""
-    from qsplan.hands.interface import joint_names
+    from qsplan.hands.described.records import joint_names
     from qsplan.planner.export.plan_files import export_plan
     from qsplan.planner.export.sample import sample_plan
 

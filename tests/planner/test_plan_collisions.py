@@ -5,11 +5,11 @@ import json
 import numpy as np
 import pytest
 
-from qsplan.hands.two_finger import default_hand, finger_angles
+from qsplan.hands.paper_hand.two_finger import default_hand, finger_angles
 from qsplan.planner.cli.main import main
 from qsplan.planner.plan import scripted
 from qsplan.planner.plan.scripted import PlanFailure, check_configurations, plan_task
-from qsplan.hands.collision import LINK_DEPTH_TOL, find_collisions, overlap_depth
+from qsplan.hands.geometry.collision import LINK_DEPTH_TOL, find_collisions, overlap_depth
 from qsplan.planner.states.contact import check_contact_state, check_free_state, configuration_problem
 from qsplan.planner.task.task import load_task, make_task, task_paths
 

@@ -157,7 +157,7 @@ def test_the_release_is_unloaded_by_the_joint_that_bears_the_load(two_link_right
     were -0.44 to -40.8 N m) and the hold's joint is the one whose torque is largest at the slide's end over the
     friction set's vertices, read again from the certifier's own row scene (the polygon search) and the solver; it is
     held at the proved interval's least-magnitude torque, a resolution inside."""
-    from qsplan.hands.found_contacts import hold_scene
+    from qsplan.hands.contacts.found import hold_scene
     from qsplan.mechanics import solve
     from qsplan.mechanics.bands.hold import hold_torque_interval
     from qsplan.planner.certify.modes import row_scene

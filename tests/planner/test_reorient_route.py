@@ -9,8 +9,8 @@ import json
 import numpy as np
 import pytest
 
-from qsplan.hands.found_contacts import ordered_contacts, row_contact_scene
-from qsplan.hands.pivots import pivot_formations
+from qsplan.hands.contacts.found import ordered_contacts, row_contact_scene
+from qsplan.hands.formations.pivots import pivot_formations
 from qsplan.mechanics import solve_many
 from qsplan.mechanics.bands.hold import hold_torque_interval, prove_hold
 from qsplan.planner.certify.rows import friction_points
@@ -188,7 +188,7 @@ def test_mujoco_keeps_the_turning_plans_modes(run):
 def test_the_pivot_with_the_left_finger_torque_controlled(task):
     """The other candidate of the widest-first choice: the left finger torque-controlled, the right one driven; its
     transition band is bounded above (the left finger pushes inward, issue 23: <= -2.72 N m without margin)."""
-    from qsplan.hands.pivots import pivot_path
+    from qsplan.hands.formations.pivots import pivot_path
     from qsplan.planner.plan.pivot import piece_phase, pivot_rate, pivot_thetas, widest_piece
 
     pivot, start = pivot_formations(task.hand)[0]

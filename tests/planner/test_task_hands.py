@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from qsplan.hands.description import bundled_hands
-from qsplan.hands.two_finger import TwoFingerHand
+from qsplan.hands.paper_hand.two_finger import TwoFingerHand
 from qsplan.mechanics.errors import QsplanError
 from qsplan.planner.cli.main import main
 from qsplan.planner.task.task import load_task, make_task

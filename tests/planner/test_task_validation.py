@@ -86,7 +86,7 @@ def test_hostile_task_files(tmp_path, data, match):
 
 
 def test_make_task_checks_ranges_of_a_built_hand():
-    from qsplan.hands.two_finger import default_hand
+    from qsplan.hands.paper_hand.two_finger import default_hand
 
     with pytest.raises(QsplanError, match=r"limits\.workpiece_speed"):
         make_task(default_hand(), 0.0, [-0.04], workpiece_speed=1e-300)

@@ -1,6 +1,6 @@
 """The formation search that turns the workpiece (issue 32): generated formations, either direction, chains of pivots.
 
-- The generic manifold (:mod:`qsplan.hands.manifold`) against the paper hand's closed form, an independent
+- The generic manifold (:mod:`qsplan.hands.formations.manifold`) against the paper hand's closed form, an independent
   derivation (``tests/reference/paper_pivot.py``): poses, joints and their rates, and where a contact's sliding
   reverses.
 - The formations a hand and workpiece offer are generated, and named so that a reader (the certifier) can parse them.
@@ -15,8 +15,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from qsplan.hands.manifold import VertexOnLine, constraint_jacobian, gaps, sweep
-from qsplan.hands.pivots import Pivot, VertexOnFinger, pivot_formations, pivot_from_name
+from qsplan.hands.formations.manifold import VertexOnLine, constraint_jacobian, gaps, sweep
+from qsplan.hands.formations.pivots import Pivot, VertexOnFinger, pivot_formations, pivot_from_name
 from qsplan.planner.task.task import load_task, task_paths
 
 #: The demo's workpiece, and the same reflected x -> -x (its vertices kept counter-clockwise).
@@ -39,7 +39,7 @@ def _task(tmp_path, edits, name="turn.toml"):
 
 
 def test_the_generic_manifold_is_the_paper_hands_closed_form():
-    from qsplan.hands.contact_sets import finger_inner_edge, palm_top_edge
+    from qsplan.hands.contacts.sets import finger_inner_edge, palm_top_edge
     from tests.reference.paper_pivot import flush_instant, pivot_configurations
 
     hand = load_task(task_paths()["reorient_task"]).hand

@@ -15,14 +15,16 @@ closed form by :func:`pivot_configurations` (no iteration):
 * the left finger along the edge: ``q_left = psi + theta`` (``psi`` the edge's angle in the body frame, lower end to
   upper end), and the edge's line at half the finger's width from the joint on its inner side,
   ``(R v_lo + (x, y) - a_left) . m = -w`` with ``m = (-sin q_left, cos q_left)``: linear in ``x``;
-* the right finger's inner edge on its vertex: :func:`qsplan.hands.two_finger.tangency_angles` at that vertex.
+* the right finger's inner edge on its vertex: :func:`qsplan.hands.paper_hand.two_finger.tangency_angles` at that
+  vertex.
 
-Their derivatives in theta are in closed form too (``dq_left/dtheta = 1``; :func:`qsplan.hands.two_finger.tangency_rates`
-for the right finger).  The library plans every turn by the generic search (:mod:`qsplan.hands.pivots`,
-:mod:`qsplan.hands.manifold`, :mod:`qsplan.planner.plan.turning`); this module is derived apart from it and serves
-only to check it.  Its two formations are local values, not entries of the production registry
-(:data:`qsplan.hands.formations.FORMATIONS`).  The paper's form only (two single-link revolute fingers, Fig. 9).
-Units SI (m, rad).
+Their derivatives in theta are in closed form too (``dq_left/dtheta = 1``;
+:func:`qsplan.hands.paper_hand.two_finger.tangency_rates` for the right finger).  The library plans every turn by the
+generic search (:mod:`qsplan.hands.formations.pivots`, :mod:`qsplan.hands.formations.manifold`,
+:mod:`qsplan.planner.plan.turning`); this module is derived apart from it and serves only to check it.  Its two
+formations are local values, not entries of the production registry
+(:data:`qsplan.hands.formations.registry.FORMATIONS`).  The paper's form only (two single-link revolute fingers,
+Fig. 9).  Units SI (m, rad).
 """
 
 from __future__ import annotations
@@ -31,9 +33,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from qsplan.hands.contact_sets import (ContactSpec, contact_set_scene, finger_inner_edge, flush_contacts,
-                                       palm_top_edge)  # fmt: skip
-from qsplan.hands.formations import ContactSlot, Formation
+from qsplan.hands.contacts.sets import (ContactSpec, contact_set_scene, finger_inner_edge, flush_contacts,
+                                        palm_top_edge)  # fmt: skip
+from qsplan.hands.formations.registry import ContactSlot, Formation
 from qsplan.mechanics.errors import QsplanError
 from qsplan.mechanics.model.geometry import CONTACT_TOL
 
@@ -133,7 +135,7 @@ def _flush_x(paper, q_left, rotated_lo, y):
 def flush_instant(hand, edge=None) -> FlushInstant:
     """The palm-edge slide's flush instant along ``edge`` (default the longest left side), in closed form:
     ``q_left = psi``, ``x`` from the edge's line at half the finger's width from the joint."""
-    from qsplan.hands.two_finger import tangency_angles
+    from qsplan.hands.paper_hand.two_finger import tangency_angles
 
     paper = paper_form(hand)
     k, lo, _, psi = _flush_edge(paper, edge)
@@ -146,8 +148,8 @@ def flush_instant(hand, edge=None) -> FlushInstant:
 
 def pivot_configurations(hand, theta, pivot: int = 1, edge=None, right_vertex: int = 2) -> PivotConfigurations:
     """The pivot manifold (the module docstring) at angles ``theta`` (rad), in closed form."""
-    from qsplan.hands.two_finger import tangency_angles, tangency_rates
-    from qsplan.hands.workpiece import rotation
+    from qsplan.hands.paper_hand.two_finger import tangency_angles, tangency_rates
+    from qsplan.hands.geometry.workpiece import rotation
 
     paper = paper_form(hand)
     V = paper.workpiece
@@ -234,8 +236,8 @@ def pivot_band(hand, theta: float, effort_joint: str, mu_range, force_margin=Non
 
 
 def same_contacts(found, reference, tol: float = CONTACT_TOL) -> bool:
-    """Whether ``reference`` (:func:`qsplan.hands.found_contacts.polygon_contacts`) is the located contact set
-    ``found`` (:func:`qsplan.hands.contact_sets.locate_contacts`): as many contacts, each of ``found`` matching one of
+    """Whether ``reference`` (:func:`qsplan.hands.contacts.found.polygon_contacts`) is the located contact set
+    ``found`` (:func:`qsplan.hands.contacts.sets.locate_contacts`): as many contacts, each of ``found`` matching one of
     the same body within ``tol`` (m) in its point and normal."""
     if len(reference) != len(found.specs):
         return False
