@@ -20,7 +20,7 @@ Run: ``python3 benchmarks/bench_autoplan.py [--iterations N]``.
 import argparse
 import time
 
-from qsplan.planner import load_task, plan_task, task_paths
+from qsplan.planner import HoldPhase, load_task, plan_task, task_paths
 from qsplan.planner.search.ompl_search import SEQUENCE_PLANNERS, search_route
 from qsplan.planner.search.tables import band_tables, table_grid
 
@@ -175,9 +175,9 @@ def turning_rows(tasks):
             print(f"{stem:<22} {time.perf_counter() - t0:7.2f} {'':>7} {forms:5d} refused: {str(exc)[:110]}")
             continue
         secs = time.perf_counter() - t0
-        holds = [p for p in plan.segments if p.kind == "hold"]
+        holds = [p for p in plan.segments if isinstance(p, HoldPhase)]
         margin = min((hold_margin(task, h) for h in holds), default=float("nan"))
-        kinds = " ".join(p.kind if p.in_contact else "regrasp" for p in plan.phases)
+        kinds = " ".join(p.kind for p in plan.phases)
         print(f"{stem:<22} {secs:7.2f} {plan.validity_checks:7d} {forms:5d} {kinds:<34} {plan.narrowest()[2]:14.4g} "
               f"{len(holds):6d} {margin:14.4g} {plan.duration:9.2f}")  # fmt: skip
     fidelity(tasks["reorient_task"])

@@ -16,8 +16,9 @@ Subpackages, in layers (lowest first; a module imports only its own layer and lo
 Public API (loaded on first use, so ``import qsplan.planner`` stays light):
 
 * tasks: :class:`Task`, :func:`load_task`, :func:`make_task`, :func:`demo_task_path`, :func:`task_paths`
-* planning (Section 5.2, Figs. 9-13): :func:`plan_task`, :class:`Plan`, :class:`ContactSegmentPlan`,
-  :class:`RegraspPlan`, :class:`PlannerOptions`, :data:`DEFAULT_OPTIONS`; judged states
+* planning (Section 5.2, Figs. 9-13): :func:`plan_task`, :class:`Plan`; its typed phases :class:`SlidePhase`,
+  :class:`HoldPhase`, :class:`PivotPhase` (in contact: :class:`ContactSegmentPlan`) and :class:`RegraspPhase`
+  (:class:`RegraspPlan`); :class:`PlannerOptions`, :data:`DEFAULT_OPTIONS`; judged states
   :func:`check_contact_state`, :func:`check_free_state`, :class:`StateCheck`
 * the whole pipeline (plan, export, plots, re-simulation): :func:`run_plan`, :class:`PlanRun`
 * automatic planning (a start and a :class:`Goal`, no waypoints; :func:`plan_task` dispatches to it):
@@ -63,6 +64,10 @@ _LAZY = {
     "Plan": "qsplan.planner.plan.results",
     "ContactSegmentPlan": "qsplan.planner.plan.results",
     "RegraspPlan": "qsplan.planner.plan.results",
+    "SlidePhase": "qsplan.planner.plan.results",
+    "HoldPhase": "qsplan.planner.plan.results",
+    "PivotPhase": "qsplan.planner.plan.results",
+    "RegraspPhase": "qsplan.planner.plan.results",
     "PlanFailure": "qsplan.planner.plan.results",
     "StateCheck": "qsplan.planner.states.contact",
     "check_contact_state": "qsplan.planner.states.contact",

@@ -433,3 +433,71 @@ def test_pyproject_installs_every_package():
     on_disk = {name for name, path in MODULES.items() if path.name == "__init__.py"}
     assert listed == on_disk
     assert config["package-dir"] == {"qsplan": "src/qsplan", **FOLDERS.__class__({v: k for k, v in FOLDERS.items()})}
+
+
+#: The kinds of a plan's phases and of its sequence's steps (:mod:`qsplan.planner.plan.results`,
+#: :mod:`qsplan.planner.plan.steps`) and of the route search's edges: strings the files write, never a question a
+#: planner module asks (a phase says what it is by its type, its class attributes and its methods).
+PHASE_KINDS = frozenset({"slide", "hold", "pivot", "regrasp", "search"})
+
+
+def _reads_kind(node) -> bool:
+    """Whether ``node`` reads a kind: ``X.kind`` or ``getattr(X, "kind", ...)``."""
+    if isinstance(node, ast.Attribute):
+        return node.attr == "kind"
+    return (isinstance(node, ast.Call) and isinstance(node.func, ast.Name) and node.func.id == "getattr"
+            and len(node.args) >= 2 and isinstance(node.args[1], ast.Constant) and node.args[1].value == "kind")
+
+
+def _kind_strings(node) -> set:
+    """The phase kinds among the string constants ``node`` is or holds (a tuple, list, set or dict's keys)."""
+    items = (node.elts if isinstance(node, (ast.Tuple, ast.List, ast.Set)) else node.keys if isinstance(node, ast.Dict)
+             else [node])  # fmt: skip
+    return {i.value for i in items if isinstance(i, ast.Constant) and i.value in PHASE_KINDS}
+
+
+def kind_questions(source: str) -> list:
+    """``(line, code)`` of every place ``source`` asks a kind string what a phase or step is: a comparison of a kind
+    read (:func:`_reads_kind`) with a phase kind, or a dict with phase kinds for keys looked up by a kind read.  The
+    body of a class that owns a ``kind`` (its definition) may ask its own."""
+    out = []
+
+    def visit(node, owner):
+        if isinstance(node, ast.ClassDef):
+            owner = any(isinstance(b, (ast.AnnAssign, ast.Assign)) and "kind" in
+                        {getattr(t, "id", None) for t in getattr(b, "targets", [getattr(b, "target", None)])}
+                        for b in node.body)  # fmt: skip
+        if not owner and isinstance(node, ast.Compare):
+            sides = [node.left, *node.comparators]
+            if any(_reads_kind(s) for s in sides) and any(_kind_strings(s) for s in sides):
+                out.append((node.lineno, ast.unparse(node)))
+        if not owner and isinstance(node, ast.Subscript) and _reads_kind(node.slice) and _kind_strings(node.value):
+            out.append((node.lineno, ast.unparse(node)))
+        if (not owner and isinstance(node, ast.Call) and isinstance(node.func, ast.Attribute) and node.func.attr == "get"
+                and node.args and _reads_kind(node.args[0]) and _kind_strings(node.func.value)):
+            out.append((node.lineno, ast.unparse(node)))
+        for child in ast.iter_child_nodes(node):
+            visit(child, owner)
+
+    visit(ast.parse(source), False)
+    return out
+
+
+def test_the_kind_question_is_found():
+    asked = ['if ph.in_contact and ph.kind == "hold":\n    pass',
+             'count = 2 if getattr(ph, "kind", None) == "hold" else 3',
+             'x = ph.kind in ("pivot", "hold")',
+             'w = {"hold": "hold: ", "pivot": "pivot: "}.get(getattr(ph, "kind", "slide"), "")',
+             'w = {"hold": 1, "slide": 2}[ph.kind]',
+             'n = sum(s.kind != "search" for s in seq)']
+    assert [len(kind_questions(src)) for src in asked] == [1] * len(asked)
+    fine = ['if mode.kind == "3S":\n    pass', 'colour = step_colour(base, ph.kind)', 'd = {"kind": ph.kind}',
+            'class Step:\n    kind: str\n    def slides(self):\n        return self.kind == "slide"']
+    assert [kind_questions(src) for src in fine] == [[]] * len(fine)
+
+
+def test_no_planner_module_asks_a_phase_its_kind_string():
+    """Typed phases and steps (issue 32): the planner asks a phase's type or method, never its ``kind`` string."""
+    asked = [f"{name}:{line}: {code}" for name, path in MODULES.items() if name.startswith("qsplan.planner")
+             for line, code in kind_questions(path.read_text())]  # fmt: skip
+    assert asked == []

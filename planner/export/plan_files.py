@@ -90,9 +90,7 @@ def phase_contacts(ph) -> dict:
     """``contacts``: the names the mode letters of the phase's first row follow, in order; ``contact_sets``: each run
     of rows (first and last row index within the phase) with one contact list and mode (a pivot's first row judges
     the transition with the contact that lifts, the later rows without it)."""
-    from qsplan.hands.formations.registry import formation
-
-    names = ph.contacts if ph.contacts is not None else (formation(ph.formation).contact_names,) * ph.t.size
+    names = ph.row_contacts()
     return {"contacts": list(names[0]), "contact_sets": contact_runs(names, ph.modes())}
 
 

@@ -114,7 +114,7 @@ def route_phases(route) -> list:
     effort joint and direction) and ``("regrasp", from grasp, to grasp, i)``."""
     out = []
     for s in route.steps:
-        if s.kind == "regrasp":
+        if not s.is_slide:
             out.append(("regrasp", s.grasp, s.to_grasp, s.i))
             continue
         if out and out[-1][0] == "slide":

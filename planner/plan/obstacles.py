@@ -227,7 +227,7 @@ def no_route_report(task, tables, graph, starts, i_start, goals, forbidden) -> N
     routes = [r for r in (widest_route(anyband, (s, i_start), goals, forbidden) for s in starts) if r is not None]
     if routes:
         route = max(routes, key=lambda r: r.width)
-        narrow = min((s for s in route.steps if s.kind == "slide"), key=lambda s: s.width)
+        narrow = min((s for s in route.steps if s.is_slide), key=lambda s: s.width)
         row = tables.grasps[narrow.grasp]
         e, d = tables.efforts[narrow.effort], float(np.sign(narrow.to_i - narrow.i))
         x0, x1 = float(tables.x[narrow.i]), float(tables.x[narrow.to_i])
@@ -244,7 +244,7 @@ def no_route_report(task, tables, graph, starts, i_start, goals, forbidden) -> N
     if geo:
         route = geo[0]
         allowed = slide_widths(anyband)
-        step = next(st for st in route.steps if st.kind == "slide"
+        step = next(st for st in route.steps if st.is_slide
                     and allowed[st.grasp, :, int(st.to_i > st.i), min(st.i, st.to_i)].max() == -np.inf)  # fmt: skip
         row, d = tables.grasps[step.grasp], float(np.sign(step.to_i - step.i))
         x0, x1 = float(tables.x[step.i]), float(tables.x[step.to_i])

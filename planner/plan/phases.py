@@ -20,7 +20,7 @@ import numpy as np
 from qsplan.mechanics.errors import QsplanError
 
 from qsplan.planner.plan.failure import configuration_report, failure_report
-from qsplan.planner.plan.results import ContactSegmentPlan, PlanFailure, RegraspPlan
+from qsplan.planner.plan.results import PlanFailure, RegraspPhase, SlidePhase
 from qsplan.planner.search.ompl_bridge import PlannerOptions, plan_path
 from qsplan.planner.states.contact import (check_contact_state, check_free_state, configuration_problem, contact_samples,
                                            free_state_problem, mode_name)  # fmt: skip
@@ -230,7 +230,7 @@ def slip_reversal(samples, mode: str, xdot: float):
 
 
 def slide_phase(task, name, x0, x1, effort, direction, touching, comps, t0, options, progress, counters,
-                grasp=None, path=None) -> ContactSegmentPlan:  # fmt: skip
+                grasp=None, path=None) -> SlidePhase:  # fmt: skip
     """The in-contact phase sliding the workpiece from ``x0`` to ``x1`` (m) in the formation's mode: the dense sweep
     judges every sample (:func:`sweep_contact_segment`), then the commands are chosen (the largest margin kept
     along the whole segment, :func:`qsplan.planner.torque.command.plan_command`).  ``path``: a described hand's
@@ -265,8 +265,8 @@ def slide_phase(task, name, x0, x1, effort, direction, touching, comps, t0, opti
     s = np.concatenate([[0.0], np.cumsum(np.abs(np.diff(x)))])
     qd = S.qd.copy()
     qd[:, task.hand.joint_names.index(effort)] = np.nan  # the effort-controlled joint gets no velocity command
-    return ContactSegmentPlan(name, effort, mode, line[:, 0].copy(), t0 + s / speed, x, S.q.copy(), qd,
-                              band.lower.copy(), band.upper.copy(), command, margin, comps, speed, res)  # fmt: skip
+    return SlidePhase(name, effort, mode, line[:, 0].copy(), t0 + s / speed, x, S.q.copy(), qd, band.lower.copy(),
+                      band.upper.copy(), command, margin, comps, speed, res)  # fmt: skip
 
 
 def _opened(task, q, opening) -> np.ndarray:
@@ -276,7 +276,7 @@ def _opened(task, q, opening) -> np.ndarray:
 
 
 def regrasp_phase(task, name, x, q_from, q_to, t0, options, progress, counters, opening_from=None,
-                  opening_to=None) -> RegraspPlan:  # fmt: skip
+                  opening_to=None) -> RegraspPhase:  # fmt: skip
     """Both fingers release the workpiece at ``x`` (m) from joints ``q_from`` and close on it at ``q_to`` (rad or m,
     shape (n_j,)), through OMPL in joint space: each finger's closing joint opens by its :data:`OPENING` in the
     direction ``opening_from`` (per joint -1, 0 or +1, :meth:`qsplan.hands.protocol.Hand.opening`; default the paper
@@ -327,4 +327,4 @@ def regrasp_phase(task, name, x, q_from, q_to, t0, options, progress, counters, 
     t = t0 + np.concatenate([[0.0], np.cumsum(moves)])
     seg_qd = np.diff(path, axis=0) / np.maximum(np.diff(t), 1e-12)[:, None]
     qd = np.vstack([seg_qd, np.zeros((1, path.shape[1]))])
-    return RegraspPlan(name, float(x), t, path, qd, tuple(results))
+    return RegraspPhase(name, float(x), t, path, qd, tuple(results))

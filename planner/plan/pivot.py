@@ -24,7 +24,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from qsplan.planner.plan.results import ContactSegmentPlan, PlanFailure
+from qsplan.planner.plan.results import HoldPhase, PivotPhase, PlanFailure
 
 __all__ = ["AFTER_SLIDE", "IN_SEARCH", "HOLD_MIN_DURATION", "HOLD_ROWS", "HOLD_TORQUE_RATE", "PIVOT_STEP", "PivotEnd",
            "PivotGeometry", "hold_phase", "piece_phase", "pivot_geometry", "pivot_thetas", "widest_piece"]
@@ -199,7 +199,7 @@ def _chord_rates(path, i: int, other: int) -> tuple:
 
 
 def piece_phase(task, name, pivot, path, rows, effort_joint: str, rate: float, transition: bool,
-                contacts=None) -> ContactSegmentPlan:  # fmt: skip
+                contacts=None) -> PivotPhase:  # fmt: skip
     """One piece of a pivot: ``path``'s ``rows`` (indices, in order), ``effort_joint`` torque-controlled, the other
     joints driven along the manifold at turning ``rate`` (rad/s, its sign the pivot's direction); ``transition``: the
     first row is the flush instant (the lifting vertex's letter ``B``); ``contacts``: each row's contacts, when
@@ -257,12 +257,12 @@ def piece_phase(task, name, pivot, path, rows, effort_joint: str, rate: float, t
     com_rate = float(np.max(np.hypot(path.dpose[rows, 0], path.dpose[rows, 1])))
     comps = tuple(sorted({m for b in bands for m in getattr(b, "competitors", ())}))
     theta = path.theta[rows]
-    return ContactSegmentPlan(name=name, effort_joint=effort_joint, mode="S" * scenes[-1].n_contacts,
-                              x_path=path.pose[rows[[0, -1]], 0], t=np.abs(theta - theta[0]) / abs(rate),
-                              x=path.pose[rows, 0], q=path.q[rows], qd=qd, lower=lower, upper=upper, command=command,
-                              margin=margin, competitors=comps, speed=com_rate * abs(rate), planning=None,
-                              speed_scale=None, kind="pivot", pose=path.pose[rows], row_modes=tuple(modes),
-                              formation=pivot.name, contacts=tuple(tuple(s.contact_names) for s in scenes))
+    return PivotPhase(name=name, effort_joint=effort_joint, mode="S" * scenes[-1].n_contacts,
+                      x_path=path.pose[rows[[0, -1]], 0], t=np.abs(theta - theta[0]) / abs(rate), x=path.pose[rows, 0],
+                      q=path.q[rows], qd=qd, lower=lower, upper=upper, command=command, margin=margin,
+                      competitors=comps, speed=com_rate * abs(rate), planning=None, speed_scale=None,
+                      formation=pivot.name, pose=path.pose[rows], row_modes=tuple(modes),
+                      contacts=tuple(tuple(s.contact_names) for s in scenes))
 
 
 def pivot_rate(task, path, rows) -> float:
@@ -275,7 +275,7 @@ def pivot_rate(task, path, rows) -> float:
     return float(np.sign(path.theta[rows[-1]] - path.theta[rows[0]])) * min(limits)
 
 
-def widest_piece(task, name, pivot, path, rows, transition: bool, progress=None) -> ContactSegmentPlan:
+def widest_piece(task, name, pivot, path, rows, transition: bool, progress=None) -> PivotPhase:
     """:func:`piece_phase` with each closing joint torque-controlled in turn, the one whose narrowest band is widest
     (the finger not lying flush first: it keeps a tie, and when its bands are all unbounded above the other is not
     computed); the first one's failure when neither has a band."""
@@ -323,7 +323,7 @@ def held_interval(task, pose, q, effort):
     return scene, hold_torque_interval(scene, task.disturbance, margin=task.force_margin.normal)
 
 
-def hold_phase(task, name, pose, q, effort_joint, tau_from, tau_to, t0, formation: str) -> ContactSegmentPlan:
+def hold_phase(task, name, pose, q, effort_joint, tau_from, tau_to, t0, formation: str) -> HoldPhase:
     """A hold at one configuration: ``effort_joint``'s torque ramps from ``tau_from`` to ``tau_to`` (N m) at
     :data:`HOLD_TORQUE_RATE`, every other joint held; its band the proved hold interval (:func:`held_interval`).
     ``tau_from`` None: the joint is taken over at rest (the phase before had another effort joint) and starts one
@@ -356,11 +356,11 @@ def hold_phase(task, name, pose, q, effort_joint, tau_from, tau_to, t0, formatio
     lower, upper = np.full(n, lo), np.full(n, hi)
     margin = np.minimum(command - lower, upper - command)
     qd = np.where(effort[None, :], np.nan, 0.0) * np.ones((n, 1))
-    return ContactSegmentPlan(name=name, effort_joint=effort_joint, mode="R" * len(scene.contact_names),
-                              x_path=np.array([pose[0]]), t=t, x=np.full(n, pose[0]), q=np.tile(q, (n, 1)), qd=qd,
-                              lower=lower, upper=upper, command=command, margin=margin, competitors=(), speed=0.0,
-                              planning=None, speed_scale=np.zeros(n), kind="hold", pose=np.tile(pose, (n, 1)),
-                              formation=formation, contacts=(tuple(scene.contact_names),) * n)
+    return HoldPhase(name=name, effort_joint=effort_joint, mode="R" * len(scene.contact_names),
+                     x_path=np.array([pose[0]]), t=t, x=np.full(n, pose[0]), q=np.tile(q, (n, 1)), qd=qd, lower=lower,
+                     upper=upper, command=command, margin=margin, competitors=(), speed=0.0, planning=None,
+                     speed_scale=np.zeros(n), formation=formation, pose=np.tile(pose, (n, 1)),
+                     contacts=(tuple(scene.contact_names),) * n)
 
 
 def shifted(phase, dt: float):

@@ -106,11 +106,13 @@ def release_holds(plan):
     """``plan`` (time-scaled) with a release hold (the module docstring) between every slide and the regrasp that
     follows it, the later phases' times moved by its duration; its ``timing`` and, where ``sequence`` has a step per
     phase, ``sequence`` with the hold's."""
+    from qsplan.planner.plan.results import SlidePhase
+    from qsplan.planner.plan.steps import SearchSummary, route_steps
     from qsplan.planner.plan.timing import PhaseTiming
 
     task = plan.task
-    stepped = sum(s.kind != "search" for s in plan.sequence) == len(plan.phases)
-    steps = [s for s in plan.sequence if s.kind != "search"] if stepped else []
+    stepped = len(route_steps(plan.sequence)) == len(plan.phases)
+    steps = list(route_steps(plan.sequence)) if stepped else []
     phases, timing, seq, shift = [], [], [], 0.0
     for i, ph in enumerate(plan.phases):
         ph = replace(ph, t=ph.t + shift) if shift else ph
@@ -120,7 +122,7 @@ def release_holds(plan):
         if stepped:
             seq.append(steps[i])
         after = plan.phases[i + 1] if i + 1 < len(plan.phases) else None
-        if not (ph.in_contact and ph.kind == "slide" and after is not None and not after.in_contact):
+        if not (isinstance(ph, SlidePhase) and after is not None and not after.in_contact):
             continue
         found = _release_hold(task, ph, float(ph.t[-1]))
         if found is None:
@@ -134,6 +136,6 @@ def release_holds(plan):
             seq.append(step)
         shift += duration
     if stepped:
-        seq += [s for s in plan.sequence if s.kind == "search"]
+        seq += [s for s in plan.sequence if isinstance(s, SearchSummary)]
     return replace(plan, phases=tuple(phases), timing=tuple(timing) if plan.timing else plan.timing,
                    sequence=tuple(seq) if stepped else plan.sequence)

@@ -15,7 +15,8 @@ from qsplan.mechanics.errors import NoAnswerError, QsplanError
 from qsplan.planner.search.ompl_bridge import PlannerOptions
 from qsplan.planner.task.task import Task
 
-__all__ = ["ContactSegmentPlan", "Plan", "PlanFailure", "RegraspPlan"]
+__all__ = ["ContactSegmentPlan", "HoldPhase", "PivotPhase", "Plan", "PlanFailure", "RegraspPhase", "RegraspPlan",
+           "SlidePhase"]
 
 
 class PlanFailure(NoAnswerError):
@@ -33,7 +34,11 @@ class PlanFailure(NoAnswerError):
 
 @dataclass(frozen=True, slots=True, eq=False)
 class ContactSegmentPlan:
-    """An in-contact segment of a plan.
+    """An in-contact phase of a plan: the common base of :class:`SlidePhase`, :class:`HoldPhase` and
+    :class:`PivotPhase` (``isinstance(ph, ContactSegmentPlan)``: the workpiece held in a contact mode).
+
+    Calling ``ContactSegmentPlan(...)`` itself builds a :class:`SlidePhase` (the kind it built before the phases
+    were typed); what differs per kind is each type's fields, class attributes and methods, never a string to test.
 
     Attributes
     ----------
@@ -58,19 +63,14 @@ class ContactSegmentPlan:
     speed_scale : ndarray, shape (n,), or None
         The time scaling at each row (:mod:`qsplan.planner.plan.timing`): the fraction of the quasistatic speed
         commanded, 0 at rest (the first and last rows), 1 cruising; None before the time scaling.
-    kind : str
-        ``"slide"`` (the workpiece slides on its palm edge, the paper's Fig. 9), ``"hold"`` (nothing moves while the
-        effort joint's torque ramps: a certified hold) or ``"pivot"`` (the workpiece turns on a palm vertex), the
-        phase kinds of :mod:`qsplan.planner.plan.turning`.
-    pose : ndarray, shape (n, 3), or None
-        The workpiece's pose ``(x, y, theta)`` at each row (m, m, rad); None: on its palm edge at ``x``.
-    row_modes : tuple of str, or None
-        Each row's contact mode, one letter per contact the row is judged with (:attr:`contacts`); None: ``mode``
-        at every row.
     formation : str
         The registered formation (:mod:`qsplan.hands.formations.registry`) naming the phase's contacts.
-    contacts : tuple of tuple of str, or None
-        Per row, the names of the contacts its mode's letters follow, in order; None: the formation's.
+
+    Class attributes (per type): ``kind`` (``"slide"``, ``"hold"``, ``"pivot"``: the string ``plan.json`` writes as
+    ``phase_kind``, read-only), ``moves`` (False: nothing moves, the rows keep their torque ramp's times),
+    ``rest_rows_judged`` (True: the rows at rest already carry the hold proved there; a slide's are judged again by
+    the time scaling), ``state_word`` (a row's state in a title, or None: said by the motion), ``title_prefix``
+    (before the mode's name in a phase's label).
     """
 
     name: str
@@ -89,16 +89,36 @@ class ContactSegmentPlan:
     speed: float
     planning: object
     speed_scale: np.ndarray | None = None
-    kind: str = "slide"
-    pose: np.ndarray | None = None
-    row_modes: tuple | None = None
     formation: str = "palm_edge"
-    contacts: tuple | None = None
     in_contact = True  # the workpiece held in a contact mode (a class constant, not a field)
+    kind = "slide"
+    moves = True
+    rest_rows_judged = False
+    state_word = None
+    title_prefix = ""
+
+    def __new__(cls, *args, **kwargs):
+        # the base called directly builds a slide (its one kind before the phases were typed)
+        return object.__new__(SlidePhase if cls is ContactSegmentPlan else cls)
 
     @property
     def width(self) -> np.ndarray:
         return self.upper - self.lower
+
+    @property
+    def pose(self) -> np.ndarray | None:
+        """The workpiece's pose ``(x, y, theta)`` at each row (m, m, rad), or None: on its palm edge at ``x``."""
+        return None
+
+    @property
+    def row_modes(self) -> tuple | None:
+        """Each row's contact mode, or None: :attr:`mode` at every row."""
+        return None
+
+    @property
+    def contacts(self) -> tuple | None:
+        """Per row, the names of the contacts its mode's letters follow, or None: the formation's."""
+        return None
 
     def poses(self, rest_height: float) -> np.ndarray:
         """The workpiece's pose at every row (m, m, rad), shape (n, 3): :attr:`pose`, or ``(x, rest_height, 0)``."""
@@ -111,9 +131,81 @@ class ContactSegmentPlan:
         """Each row's mode letters (:attr:`row_modes`, or :attr:`mode` at every row)."""
         return tuple(self.row_modes) if self.row_modes is not None else (self.mode,) * self.t.size
 
+    def row_contacts(self) -> tuple:
+        """Per row, the names of the contacts its mode letters follow: :attr:`contacts`, or the formation's."""
+        if self.contacts is not None:
+            return tuple(self.contacts)
+        from qsplan.hands.formations.registry import formation
+
+        return (tuple(formation(self.formation).contact_names),) * self.t.size
+
 
 @dataclass(frozen=True, slots=True, eq=False)
-class RegraspPlan:
+class SlidePhase(ContactSegmentPlan):
+    """A slide: the workpiece slides on its palm edge (the paper's Fig. 9) in one contact mode, resting at ``x``.
+
+    Its rows at rest (the first and last) are judged again by the time scaling for the chord that leaves or
+    reaches them (:mod:`qsplan.planner.plan.timing`); a regrasp after it is preceded by a release hold
+    (:mod:`qsplan.planner.plan.release`).
+    """
+
+    kind = "slide"
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class HoldPhase(ContactSegmentPlan):
+    """A certified hold: nothing moves while the effort joint's torque ramps (:func:`qsplan.planner.plan.pivot.
+    hold_phase`); its rows keep the ramp's times.
+
+    Attributes
+    ----------
+    pose : ndarray, shape (n, 3), or None
+        The workpiece's pose at each row (m, m, rad); None: on its palm edge at ``x``.
+    contacts : tuple of tuple of str, or None
+        Per row, the names of the contacts its mode's letters follow; None: the formation's.
+    """
+
+    pose: np.ndarray | None = None
+    contacts: tuple | None = None
+    kind = "hold"
+    moves = False
+    rest_rows_judged = True
+    state_word = "holding"
+    title_prefix = "hold: "
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class PivotPhase(ContactSegmentPlan):
+    """A pivot (a piece of one): the workpiece turns on a palm vertex (:func:`qsplan.planner.plan.pivot.
+    piece_phase`).  The first piece's first row is the transition at the flush instant: its mode has the lifting
+    vertex's letter ``B`` (:attr:`transition`), the later rows judged without that contact.
+
+    Attributes
+    ----------
+    pose : ndarray, shape (n, 3)
+        The workpiece's pose at each row (m, m, rad).
+    row_modes : tuple of str, or None
+        Each row's contact mode, one letter per contact the row is judged with (:attr:`contacts`).
+    contacts : tuple of tuple of str, or None
+        Per row, the names of the contacts its mode's letters follow; None: the formation's.
+    """
+
+    pose: np.ndarray | None = None
+    row_modes: tuple | None = None
+    contacts: tuple | None = None
+    kind = "pivot"
+    rest_rows_judged = True
+    state_word = "pivoting"
+    title_prefix = "pivot: "
+
+    @property
+    def transition(self) -> bool:
+        """Whether the first row is the transition at the flush instant (a contact breaking: a ``B`` letter)."""
+        return "B" in self.modes()[0]
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class RegraspPhase:
     """A free-space finger motion: release and regrasp at a fixed workpiece x.
 
     Attributes
@@ -139,10 +231,14 @@ class RegraspPlan:
     planning: tuple
     speed_scale: np.ndarray | None = None
     in_contact = False  # the fingers move in free space (a class constant, not a field)
+    kind = "regrasp"
 
     def poses(self, rest_height: float) -> np.ndarray:
         """The workpiece's pose at every row (m, m, rad), shape (n, 3): resting on its palm edge at ``x``."""
         return np.tile([float(self.x), float(rest_height), 0.0], (self.t.size, 1))
+
+
+RegraspPlan = RegraspPhase  # its name before the phases were typed (users' scripts import it)
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -152,7 +248,7 @@ class Plan:
     Attributes
     ----------
     task : qsplan.planner.task.task.Task
-    phases : tuple of (ContactSegmentPlan or RegraspPlan)
+    phases : tuple of (SlidePhase, HoldPhase, PivotPhase or RegraspPhase)
     seconds : float
         Wall-clock planning time (s), OMPL and sweeps.
     validity_checks : int

@@ -7,7 +7,7 @@ frozen step per phase, and a :class:`SearchSummary`.  ``plan.json`` writes them 
 them, the keys earlier plans wrote (``x_from``, ``x``, ``from``, ``to``): extended, never renamed.
 
 Units: SI (m, s; the narrowest band in the effort joint's unit, N m or N).  Room for the next formations'
-transitions: a new step type with a ``kind`` and ``as_dict``.
+transitions: a new step type with a ``kind``, ``as_dict`` and ``realised``.
 """
 
 from __future__ import annotations
@@ -17,8 +17,8 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-__all__ = ["HoldStep", "PivotStep", "RegraspStep", "SearchSummary", "SlideStep", "realised_steps", "search_summary",
-           "step_dicts"]
+__all__ = ["HoldStep", "PivotStep", "RegraspStep", "SearchSummary", "SlideStep", "realised_steps", "route_steps",
+           "search_summary", "step_dicts"]
 
 
 def _finite(v) -> float | None:
@@ -57,6 +57,12 @@ class SlideStep:
                 "effort_joint": self.effort_joint, "narrowest_band": band, "effort_unit": self.effort_unit,
                 "x_from": self.x_from, "x_to": self.x_to}  # fmt: skip
 
+    def realised(self, phase) -> SlideStep:
+        """This step with its ends and narrowest band as ``phase`` (its slide's rows) realises them."""
+        x = np.ravel(phase.x)
+        return replace(self, narrowest_band=float(np.min(phase.upper - phase.lower)), x_from=float(x[0]),
+                       x_to=float(x[-1]))
+
 
 @dataclass(frozen=True, slots=True)
 class RegraspStep:
@@ -77,6 +83,10 @@ class RegraspStep:
     def as_dict(self) -> dict:
         return {"kind": self.kind, "x_from_m": self.x, "x_to_m": self.x, "grasp_from": self.grasp_from,
                 "grasp_to": self.grasp_to, "x": self.x, "from": self.grasp_from, "to": self.grasp_to}  # fmt: skip
+
+    def realised(self, phase) -> RegraspStep:
+        """This step: the rows of a regrasp change none of its figures."""
+        return self
 
 
 @dataclass(frozen=True, slots=True)
@@ -99,6 +109,10 @@ class HoldStep:
                 "effort_joint": self.effort_joint, "torque_from": self.torque_from, "torque_to": self.torque_to,
                 "proved_interval": [_finite(self.proved_lower), _finite(self.proved_upper)]}  # fmt: skip
 
+    def realised(self, phase) -> HoldStep:
+        """This step: a hold's figures are its rows' already (the torques ramped, the proved interval)."""
+        return self
+
 
 @dataclass(frozen=True, slots=True)
 class PivotStep:
@@ -117,6 +131,10 @@ class PivotStep:
         return {"kind": self.kind, "vertex": self.vertex, "theta_from_rad": self.theta_from,
                 "theta_to_rad": self.theta_to, "effort_joint": self.effort_joint,
                 "narrowest_band": _finite(self.narrowest_band), "effort_unit": "N m"}  # fmt: skip
+
+    def realised(self, phase) -> PivotStep:
+        """This step with its narrowest band as ``phase`` (the pivot's rows, time-scaled) realises it."""
+        return replace(self, narrowest_band=float(np.min(phase.upper - phase.lower)))
 
 
 @dataclass(frozen=True, slots=True)
@@ -166,24 +184,21 @@ def search_summary(sequence) -> SearchSummary | None:
     return next((s for s in sequence if isinstance(s, SearchSummary)), None)
 
 
+def route_steps(sequence) -> tuple:
+    """The steps of a plan's ``sequence`` (one per phase when the plan has them), without the search's summary."""
+    return tuple(s for s in sequence if not isinstance(s, SearchSummary))
+
+
 def realised_steps(sequence, phases) -> tuple:
-    """``sequence`` with each slide's ends and narrowest band, and each pivot's narrowest band, as ``phases`` (one per
-    step, in order: the plan's) realise them: the time scaling judges a slide's rows at rest again, and a
-    reorientation moves its slide's last row onto the flush instant, so the search's figures may differ from the
-    rows the plan exports (and ``plan.json`` states; the certifier checks them against the rows)."""
-    if sum(s.kind != "search" for s in sequence) != len(phases):
+    """``sequence`` with each step's figures as ``phases`` (one per step, in order: the plan's) realise them
+    (:meth:`SlideStep.realised`: a slide's ends and narrowest band; a pivot's narrowest band): the time scaling judges
+    a slide's rows at rest again, and a reorientation moves its slide's last row onto the flush instant, so the
+    search's figures may differ from the rows the plan exports (and ``plan.json`` states; the certifier checks them
+    against the rows)."""
+    if len(route_steps(sequence)) != len(phases):
         return tuple(sequence)
-    out, i = [], 0
-    for s in sequence:
-        if s.kind != "search":
-            ph, i = phases[i], i + 1
-        if s.kind in ("slide", "pivot"):
-            s = replace(s, narrowest_band=float(np.min(ph.upper - ph.lower)))
-            if s.kind == "slide":
-                x = np.ravel(ph.x)
-                s = replace(s, x_from=float(x[0]), x_to=float(x[-1]))
-        out.append(s)
-    return tuple(out)
+    realised = iter(s.realised(ph) for s, ph in zip(route_steps(sequence), phases))
+    return tuple(s if isinstance(s, SearchSummary) else next(realised) for s in sequence)
 
 
 def step_dicts(sequence) -> list:

@@ -258,14 +258,14 @@ def time_scale(plan):
     phases, timing, t0 = [], [], 0.0
     for ph in plan.phases:
         T = float(ph.t[-1] - ph.t[0])
-        if ph.in_contact and ph.kind == "hold":  # nothing moves: the rows keep their ramp's times
+        if ph.in_contact and not ph.moves:  # a hold: nothing moves, the rows keep their ramp's times
             t, v = ph.t - ph.t[0], np.zeros(ph.t.size)
             new = replace(ph, t=t0 + t, speed_scale=v)
             pieces, alpha, peak, binding = 0, 0.0, 0.0, "none (a hold: nothing moves)"
         elif ph.in_contact:
             # a slide's rows at rest are judged again for the chord that leaves or reaches them; a pivot's already are
-            lower, upper, command, margin = (_rest_bands(task, ph) if ph.kind == "slide"
-                                             else (ph.lower, ph.upper, ph.command, ph.margin))  # fmt: skip
+            lower, upper, command, margin = ((ph.lower, ph.upper, ph.command, ph.margin) if ph.rest_rows_judged
+                                             else _rest_bands(task, ph))  # fmt: skip
             t, v, qd, alpha, peak, binding = _slide(task, ph)
             new = replace(ph, t=t0 + t, qd=qd, speed_scale=v, lower=lower, upper=upper, command=command, margin=margin)
             pieces = 1

@@ -210,7 +210,13 @@ def _route(task, pivot, start, theta_goal, pieces, options, progress, planner, s
     from qsplan.planner.plan.autoplan import plan_automatic
     from qsplan.planner.plan.failure import StepReport, configuration_report
     from qsplan.planner.plan.pivot import hold_phase, shifted
-    from qsplan.planner.plan.steps import HoldStep, PivotStep, realised_steps
+    from qsplan.planner.plan.steps import (
+        HoldStep,
+        PivotStep,
+        SearchSummary,
+        realised_steps,
+        route_steps,
+    )
     from qsplan.planner.plan.timing import time_scale
 
     hand = task.hand
@@ -250,8 +256,8 @@ def _route(task, pivot, start, theta_goal, pieces, options, progress, planner, s
         t0, prev_effort, prev_tau = float(moved.t[-1]), e, float(piece.command[-1])
     rest = time_scale(Plan(task, tuple(turned), 0.0, 0, 0.0, slide.options))
     later = tuple(shifted(ph, float(end.t[-1])) for ph in rest.phases)
-    sequence = tuple(st for st in slide.sequence if st.kind != "search") + tuple(steps) + \
-        tuple(st for st in slide.sequence if st.kind == "search")  # fmt: skip
+    sequence = route_steps(slide.sequence) + tuple(steps) + \
+        tuple(st for st in slide.sequence if isinstance(st, SearchSummary))  # fmt: skip
     plan = Plan(task, timed.phases + later, time.perf_counter() - started,
                 slide.validity_checks + sum(p.t.size for p in pieces), slide.ompl_seconds, slide.options,
                 realised_steps(sequence, timed.phases + later), timed.timing + rest.timing)  # fmt: skip

@@ -25,6 +25,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from qsplan.planner.plan.results import HoldPhase, PivotPhase
 from qsplan.planner.plan.sampling import tick_times
 from qsplan.planner.plotting.hands import plan_snapshots, pivot_vertex, state_words
 from qsplan.planner.plotting.plan_panels import (
@@ -128,7 +129,6 @@ def phase_rows(plan) -> list:
             rows.append((str(i), times, f"regrasp: {who}\nopen and close again", "velocity only", "-", "-", "-"))
             continue
         word, unit = effort_words(hand, ph.effort_joint)
-        dx = float(ph.x[-1] - ph.x[0])
         mode, _ = phase_label(ph, hand)
         signs = set(np.sign(ph.command[ph.command != 0]).tolist())
         sense = "zero" if not signs else "changes sign" if len(signs) > 1 else effort_sense(hand, ph.effort_joint, *signs)
@@ -138,15 +138,25 @@ def phase_rows(plan) -> list:
         w = float(ph.width[k])
         side = "lower" if np.isinf(ph.lower).all() else "upper"
         narrow = f"{torque_text(w, unit)} at {float(ph.t[k]):.3g} s" if np.isfinite(w) else f"none: {side}\nedge unbounded"
-        th = np.degrees(ph.poses(hand.rest_height)[[0, -1], 2])  # a pivot turns; a hold moves nothing
-        on = "" if pivot_vertex(plan, i) is None else f" on vertex {pivot_vertex(plan, i)},"
-        does = {"hold": f"holds: nothing moves\nin {mode.removeprefix('hold: ')}, torque ramps",
-                "pivot": f"pivots{on} {th[0]:.3g} to {th[1]:.3g} deg\nin {mode.removeprefix('pivot: ')}"}.get(
-            ph.kind, f"slides {'left' if dx < 0 else 'right'} {abs(dx) * 1000:.3g} mm\nin {mode}")  # fmt: skip
+        does = _does(plan, i, mode.removeprefix(ph.title_prefix))
         rows.append((str(i), times, does,
                      f"{joint_title(ph.effort_joint)} {word}", f"{_range(ph.command, unit)}\n{sense}",
                      room, narrow))  # fmt: skip
     return rows
+
+
+def _does(plan, i, mode) -> str:
+    """What phase ``i`` (in contact) does, for the card's table: a slide's direction and length, a hold's ramp, a
+    pivot's vertex and angles; ``mode`` its mode in words."""
+    ph = plan.phases[i]
+    if isinstance(ph, HoldPhase):
+        return f"holds: nothing moves\nin {mode}, torque ramps"
+    if isinstance(ph, PivotPhase):
+        th = np.degrees(ph.poses(plan.task.hand.rest_height)[[0, -1], 2])
+        on = "" if pivot_vertex(plan, i) is None else f" on vertex {pivot_vertex(plan, i)},"
+        return f"pivots{on} {th[0]:.3g} to {th[1]:.3g} deg\nin {mode}"
+    dx = float(ph.x[-1] - ph.x[0])
+    return f"slides {'left' if dx < 0 else 'right'} {abs(dx) * 1000:.3g} mm\nin {mode}"
 
 
 def _letters(n):

@@ -329,9 +329,8 @@ def row_state(plan, i, k) -> tuple:
         n = ph.t.size
         approach = 0 < k < n - 1 and not _off(plan, ph, k + 1) and bool(_off(plan, ph, k - 1))
         return ("closing" if approach else "open"), off
-    kind = getattr(ph, "kind", None) if is_contact(ph) else None
-    if kind in ("pivot", "hold"):
-        return ("pivoting" if kind == "pivot" else "holding"), off
+    if is_contact(ph) and ph.state_word is not None:  # a pivot or a hold: said by its kind
+        return ph.state_word, off
     moving = np.size(ph.x) > 1 and float(np.ptp(ph.x)) > 0.0
     return ("sliding" if moving else "holding"), off
 
@@ -340,8 +339,10 @@ def pivot_vertex(plan, i):
     """The workpiece vertex (as the task writes it) phase ``i`` pivots on, from the plan's ``sequence`` (one step per
     phase, :class:`qsplan.planner.plan.steps.PivotStep`); None when the plan does not say (or phase ``i`` is no
     pivot)."""
-    steps = [s for s in plan.sequence if getattr(s, "kind", None) != "search"]
-    if len(steps) != len(plan.phases) or getattr(steps[i], "kind", None) != "pivot":
+    from qsplan.planner.plan.steps import PivotStep, route_steps
+
+    steps = route_steps(plan.sequence)
+    if len(steps) != len(plan.phases) or not isinstance(steps[i], PivotStep):
         return None
     return int(steps[i].vertex)
 
@@ -362,7 +363,7 @@ def _candidates(plan, per_segment) -> dict:
     for i, ph in enumerate(plan.phases):
         n = ph.t.size
         if is_contact(ph):  # a hold moves nothing: its ends only
-            count = 2 if getattr(ph, "kind", None) == "hold" else max(2, per_segment)
+            count = max(2, per_segment) if ph.moves else 2
             rows = np.unique(np.round(np.linspace(0, n - 1, count)).astype(int))
             out |= {(i, int(k)): 1 if k in (0, n - 1) else 2 for k in rows}
         else:

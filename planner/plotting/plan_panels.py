@@ -96,10 +96,9 @@ def phase_label(phase, hand=None) -> tuple:
         kind = ContactMode(phase.mode).kind
     except (ValueError, TypeError):
         kind = str(phase.mode)
-    first = phase.modes()[0] if hasattr(phase, "modes") else phase.mode
+    first = phase.modes()[0]
     lead = f"{ContactMode(first).kind} ({first}) then " if first != phase.mode else ""  # a pivot's transition row
-    what = {"hold": "hold: ", "pivot": "pivot: "}.get(getattr(phase, "kind", "slide"), "")
-    return (f"{what}{lead}{kind} ({phase.mode})",
+    return (f"{phase.title_prefix}{lead}{kind} ({phase.mode})",
             f"{joint_title(phase.effort_joint)} {effort_words(hand, phase.effort_joint)[0]}")
 
 
@@ -109,7 +108,7 @@ def phase_colour(phase, hand=None) -> str:
     if not is_contact(phase):
         return REGRASP
     base = finger_colour(phase.effort_joint) if hand is None else joint_colour(hand, phase.effort_joint)
-    return step_colour(base, getattr(phase, "kind", "slide"))
+    return step_colour(base, phase.kind)
 
 
 def torque_limits(segments, resolution=0.0) -> tuple:

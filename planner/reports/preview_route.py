@@ -61,7 +61,7 @@ def _route_words(task, tables, bars, route) -> tuple:
 
 
 def _narrowest(task, tables, route) -> str:
-    slides = [s for s in route.steps if s.kind == "slide"]
+    slides = [s for s in route.steps if s.is_slide]
     if not slides:
         return ""
     s = min(slides, key=lambda s: s.width)

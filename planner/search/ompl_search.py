@@ -87,8 +87,8 @@ def _route_from_states(graph, edges, states, forbidden, evaluations):
         if s is None:
             return None
         steps.extend(s)
-    widths = [s.width for s in steps if s.kind == "slide"]
-    return Route(tuple(steps), min(widths, default=np.inf), sum(s.kind == "regrasp" for s in steps), evaluations)
+    widths = [s.width for s in steps if s.is_slide]
+    return Route(tuple(steps), min(widths, default=np.inf), sum(not s.is_slide for s in steps), evaluations)
 
 
 def search_route(graph: SearchGraph, start, goals, planner: str = "widest", forbidden=frozenset(), seed: int = 1,
@@ -152,7 +152,7 @@ def search_route(graph: SearchGraph, start, goals, planner: str = "widest", forb
         steps = _motion_steps(graph, edges, *node(a), *node(b), forbidden)
         if steps is None:
             return None
-        return min((s.width for s in steps if s.kind == "slide"), default=np.inf)
+        return min((s.width for s in steps if s.is_slide), default=np.inf)
 
     class TableMotions(ob.MotionValidator):
         def checkMotion(self, a, b):

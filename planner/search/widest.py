@@ -66,6 +66,11 @@ class RouteStep:
     effort: int
     width: float
 
+    @property
+    def is_slide(self) -> bool:
+        """Whether the edge is a slide step (else a regrasp): what the route's readers ask, not the string."""
+        return self.kind == "slide"
+
 
 @dataclass(frozen=True, slots=True)
 class Route:
@@ -263,7 +268,7 @@ def widest_route(graph: SearchGraph, start, goals, forbidden=frozenset()) -> Rou
         node = prev
     steps.reverse()
     steps = _lightest_efforts(graph, edges, steps, width)
-    return Route(tuple(steps), float(width), sum(s.kind == "regrasp" for s in steps), expanded)
+    return Route(tuple(steps), float(width), sum(not s.is_slide for s in steps), expanded)
 
 
 def _lightest_efforts(graph, edges, steps, width) -> list:
@@ -278,12 +283,12 @@ def _lightest_efforts(graph, edges, steps, width) -> list:
     out, k = list(steps), 0
     while k < len(out):
         s = out[k]
-        if s.kind != "slide":
+        if not s.is_slide:
             k += 1
             continue
         d = int(s.to_i > s.i)
         end = k
-        while (end + 1 < len(out) and out[end + 1].kind == "slide" and out[end + 1].grasp == s.grasp
+        while (end + 1 < len(out) and out[end + 1].is_slide and out[end + 1].grasp == s.grasp
                and out[end + 1].effort == s.effort and int(out[end + 1].to_i > out[end + 1].i) == d):  # fmt: skip
             end += 1
         run = out[k:end + 1]

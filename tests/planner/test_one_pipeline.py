@@ -28,7 +28,7 @@ import numpy as np
 import pytest
 
 from qsplan.planner.export.plan_files import export_plan
-from qsplan.planner.plan.results import PlanFailure
+from qsplan.planner.plan.results import PlanFailure, SlidePhase
 from qsplan.planner.plan.scripted import plan_task
 from qsplan.planner.task.task import load_task, task_paths
 from tests.planner.bundled import bundled_task, planned
@@ -203,7 +203,7 @@ def test_chain_hand_runs_waypoints(tmp_path):
     task = _chain_task(tmp_path, "waypoints", "waypoints = [-0.01, 0.0]")
     assert not task.hand.accelerated
     plan = plan_task(task)
-    slides = [p for p in plan.phases if type(p).__name__ == "ContactSegmentPlan" and p.kind == "slide"]
+    slides = [p for p in plan.phases if isinstance(p, SlidePhase)]
     assert len(slides) == 2
     assert [float(np.ravel(p.x)[-1]) for p in slides] == pytest.approx([-0.01, 0.0], abs=1e-9)
     assert float(np.ravel(slides[0].x)[0]) == pytest.approx(0.0, abs=1e-12)
