@@ -3,7 +3,8 @@
 * :mod:`qsplan.hands.protocol` - the :class:`Hand` protocol the planner sees, its grasp states and scene arrays.
 * :mod:`qsplan.hands.description` - hands described by data: the description model, hand files (TOML), the paper form.
 * :mod:`qsplan.hands.described` - :class:`DescribedHand`, the one hand (any description, the batched generic path),
-  built at the door by ``as_hand``; the hand records' dispatch behind it.
+  built at the door by ``as_hand``; it hands its record's questions to the record it picked at construction (each
+  record answers for itself: :class:`~qsplan.hands.protocol.HandRecord`).
 * :mod:`qsplan.hands.chains` - serial-chain hands: the chain hand record, closing a finger (one state and batched),
   the chain's matrices at many states, closing again between segments.
 * :mod:`qsplan.hands.paper_hand` - the paper hand of Fig. 9 in closed form (the accelerator): the hand, its scenes,
@@ -93,6 +94,7 @@ _LAZY = {
     "Formation": "qsplan.hands.formations.registry",
     "formation": "qsplan.hands.formations.registry",
     "Hand": "qsplan.hands.protocol",
+    "HandRecord": "qsplan.hands.protocol",
     "GraspStates": "qsplan.hands.protocol",
     "GraspSceneArrays": "qsplan.hands.protocol",
     "ChainGrasp": "qsplan.hands.protocol",

@@ -25,7 +25,8 @@ import numpy as np
 
 from qsplan.hands.paper_hand.grasps import parse_goal
 
-__all__ = ["CONTACT_KINDS", "ChainGrasp", "FingerContact", "GraspSceneArrays", "GraspStates", "Hand", "JOINT_UNITS",
+__all__ = ["CONTACT_KINDS", "ChainGrasp", "FingerContact", "GraspSceneArrays", "GraspStates", "Hand", "HandRecord",
+           "JOINT_UNITS",
            "SlideMotion", "STATE_REASONS",
            "NO_CONTACT", "OTHER_CONTACT", "FLUSH", "NO_PLACEMENT", "SINGULAR"]
 
@@ -441,3 +442,59 @@ class Hand(Protocol):
     def metadata(self) -> dict:
         """The hand as a plan's metadata records it (:func:`qsplan.hands.described.build.hand_from_metadata` reads
         it)."""
+
+
+@runtime_checkable
+class HandRecord(Protocol):
+    """What a hand record answers for itself (issue 32): the questions a :class:`Hand` hands to its record.
+
+    One answerer per record type, picked once where a record becomes a hand (the described hand's construction,
+    :func:`qsplan.hands.described.build.record_of` for a bare record): the paper's
+    :class:`qsplan.hands.paper_hand.record.PaperRecord` (its closed forms) and a chain hand's
+    :class:`qsplan.hands.chains.record.ChainRecord` (its description, the polygon search).  Nobody asks which one it is.
+
+    Attributes
+    ----------
+    hand : TwoFingerHand or ChainHand
+        The record answered for.
+    closed_form : bool
+        Whether the paper's closed forms answer (else the polygon search).
+    workpiece : ndarray, shape (k, 2)
+    manipulator : qsplan.mechanics.model.manipulator.Manipulator
+    joint_names, joint_kinds : tuple of str
+    finger_joint_names : tuple of tuple of str
+    palm_thickness, link_width, finger_reach : float
+        m: the palm below ``y = 0``, a link's narrowest width, a finger's reach (drawing scales).
+    """
+
+    hand: object
+    closed_form: bool
+    workpiece: np.ndarray
+    manipulator: object
+    joint_names: tuple
+    joint_kinds: tuple
+    finger_joint_names: tuple
+    palm_thickness: float
+    link_width: float
+    finger_reach: float
+
+    def joint_axes(self, q) -> np.ndarray:
+        """World position (m) of each joint's frame origin at ``q`` (n_j,), shape (n_j, 2)."""
+
+    def body_polygons(self, pose, q) -> dict:
+        """World polygons (m): ``{"palm", "workpiece", <joint name>...}`` -> (k, 2)."""
+
+    def scene(self, pose, q, effort_controlled, velocity, effort=None, mu=None, method: str = "auto"):
+        """One :class:`qsplan.mechanics.Scene` (contacts palm, palm, left, right)."""
+
+    def contacts_at(self, pose, q) -> list:
+        """The grasp's contacts found in the polygons, in the scene's order."""
+
+    def range_fields(self) -> list:
+        """``[(field, value, kind)]``: the record's numbers a task checks against its plausible ranges."""
+
+    def metadata(self) -> dict:
+        """The record as an exported plan's metadata records it."""
+
+    def description_table(self) -> dict:
+        """The description in the hand-file format (refused where the record is given by parameters)."""

@@ -263,7 +263,7 @@ HAND_CLASSES = frozenset({"TwoFingerHand", "ChainHand", "DescribedHand", "Hand",
                           "TipOnEdge", "FingerContact"})
 #: Calls and attributes that branch on a hand's type or reach into its accelerator.
 HAND_TYPE_CALLS = frozenset({"is_chain_hand"})
-HAND_INTERNALS = frozenset({"accelerated", "paper", "chain", "paper_form"})
+HAND_INTERNALS = frozenset({"accelerated", "paper", "chain", "paper_form", "record"})
 
 
 def _hand_type_branches(modules=None) -> list:
@@ -304,6 +304,59 @@ def test_the_hand_type_check_finds_branches(tmp_path):
         modules[name].write_text(text)
     assert [b.split(":")[0] for b in _hand_type_branches(modules)] == ["qsplan.planner.plan.a", "qsplan.planner.plan.b",
                                                                        "qsplan.planner.plan.c"]  # fmt: skip
+
+
+#: The hand records' types (issue 32): each record answers for itself (:class:`qsplan.hands.protocol.HandRecord`), so
+#: nothing asks which of them a value is but the record modules themselves and the door that converts a bare record.
+RECORD_TYPES = frozenset({"TwoFingerHand", "ChainHand"})
+#: Where asking a record's type is allowed: ``{module: functions}`` (None: anywhere in the module).
+RECORD_TYPE_DOORS = {"qsplan.hands.paper_hand.two_finger": None, "qsplan.hands.chains.hand": None,
+                     "qsplan.hands.described.build": frozenset({"as_hand", "record_of"})}  # fmt: skip
+
+
+def _record_type_branches(modules=None) -> list:
+    """Every ``isinstance``/``issubclass`` with a hand record type (:data:`RECORD_TYPES`, by name or attribute, alone or
+    in a tuple) outside :data:`RECORD_TYPE_DOORS`, in any module of the package, as ``module:line function``."""
+    out = []
+    for name, path in (MODULES if modules is None else modules).items():
+        allowed = RECORD_TYPE_DOORS.get(name, frozenset())
+        if allowed is None:
+            continue
+
+        def visit(node, function):
+            if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef)):
+                function = node.name if function is None else function  # a nested function is its outer one's
+            if isinstance(node, ast.Call) and getattr(node.func, "id", getattr(node.func, "attr", "")) in (
+                    "isinstance", "issubclass") and len(node.args) == 2:  # fmt: skip
+                kinds = node.args[1].elts if isinstance(node.args[1], ast.Tuple) else [node.args[1]]
+                if any(getattr(k, "id", getattr(k, "attr", "")) in RECORD_TYPES for k in kinds) and \
+                        function not in allowed:  # fmt: skip
+                    out.append(f"{name}:{node.lineno} {function or '<module>'}")
+            for child in ast.iter_child_nodes(node):
+                visit(child, function)
+
+        visit(ast.parse(path.read_text(), filename=str(path)), None)
+    return out
+
+
+def test_no_isinstance_on_hand_records_past_the_door():
+    assert _record_type_branches() == []
+
+
+def test_the_record_type_check_finds_branches(tmp_path):
+    sources = {"qsplan.hands.described.records": "def f(h):\n    return isinstance(h, (int, ChainHand))\n",
+               "qsplan.hands.contacts.a": "import qsplan\nX = issubclass(T, qsplan.hands.TwoFingerHand)\n",
+               "qsplan.planner.plan.b": "def f(h):\n    def g():\n        return isinstance(h, TwoFingerHand)\n",
+               "qsplan.hands.described.build": "def as_hand(h):\n    return isinstance(h, ChainHand)\n"
+                                               "def other(h):\n    return isinstance(h, ChainHand)\n",
+               "qsplan.hands.chains.hand": "X = isinstance(1, ChainHand)\n",
+               "qsplan.hands.contacts.c": "def f(h):\n    return isinstance(h, DescribedHand) or h.closed_form\n"}  # fmt: skip
+    modules = {}
+    for name, text in sources.items():
+        modules[name] = tmp_path / f"{name}.py"
+        modules[name].write_text(text)
+    assert _record_type_branches(modules) == ["qsplan.hands.described.records:2 f", "qsplan.hands.contacts.a:2 <module>",
+                                              "qsplan.planner.plan.b:3 f", "qsplan.hands.described.build:4 other"]
 
 
 #: The module the planner asked its questions about a hand through before issue 32 (it dispatches on the hand records'

@@ -44,13 +44,12 @@ def polygon_contacts(hand, pose, q, tol: float = CONTACT_TOL) -> list:
     """
     from shapely.geometry import Polygon
 
-    from qsplan.hands.described.records import hand_body_polygons, joint_names
     from qsplan.mechanics.model.geometry import find_contacts
 
-    polys = hand_body_polygons(hand, np.asarray(pose, dtype=float), np.asarray(q, dtype=float))
+    polys = hand.body_polygons(np.asarray(pose, dtype=float), np.asarray(q, dtype=float))
     bodies = [(-1, Polygon(polys["palm"]))]
     names = {-1: "palm"}
-    for k, joint in enumerate(joint_names(hand)):
+    for k, joint in enumerate(hand.joint_names):
         if joint in polys:
             bodies.append((k, Polygon(polys[joint])))
             names[k] = joint
@@ -66,10 +65,8 @@ def ordered_contacts(hand, pose, q, tol: float = CONTACT_TOL) -> list:
     SceneError
         A body penetrating the workpiece deeper than ``tol`` (naming it), or a corner on a corner.
     """
-    from qsplan.hands.described.records import joint_axes
-
     found = polygon_contacts(hand, pose, q, tol)
-    axes = joint_axes(hand, np.asarray(q, dtype=float))
+    axes = hand.joint_axes(np.asarray(q, dtype=float))
     place = {j: (f, i) for f, chain in enumerate(_finger_joints(hand)) for i, j in enumerate(chain)}
 
     def key(c):  # the palm left to right; each finger (left, right), its links base to tip, each from its joint out
@@ -83,10 +80,8 @@ def ordered_contacts(hand, pose, q, tol: float = CONTACT_TOL) -> list:
 
 def _finger_joints(hand) -> tuple:
     """Each finger's joints (indices), base to tip: left, right."""
-    from qsplan.hands.described.records import finger_joint_names, joint_names
-
-    names = list(joint_names(hand))
-    return tuple(tuple(names.index(n) for n in chain) for chain in finger_joint_names(hand))
+    names = list(hand.joint_names)
+    return tuple(tuple(names.index(n) for n in chain) for chain in hand.finger_joint_names)
 
 
 def contact_names(hand, pose, contacts) -> tuple:
@@ -207,11 +202,9 @@ class TrackedContacts:
 
 def _polygons(hand, pose, q) -> dict:
     """``{None: workpiece, -1: palm, link: link polygon}`` in the world (m)."""
-    from qsplan.hands.described.records import hand_body_polygons, joint_names
-
-    polys = hand_body_polygons(hand, np.asarray(pose, dtype=float), np.asarray(q, dtype=float))
+    polys = hand.body_polygons(np.asarray(pose, dtype=float), np.asarray(q, dtype=float))
     out = {None: np.asarray(polys["workpiece"], float), -1: np.asarray(polys["palm"], float)}
-    out.update((k, np.asarray(polys[n], float)) for k, n in enumerate(joint_names(hand)) if n in polys)
+    out.update((k, np.asarray(polys[n], float)) for k, n in enumerate(hand.joint_names) if n in polys)
     return out
 
 

@@ -19,14 +19,13 @@ def points_scene(hand, pose, q, points, normals, links, names, effort_controlled
     """The :class:`qsplan.mechanics.Scene` of contacts at world ``points`` with ``normals`` into the workpiece (m;
     shape (n_c, 2)), each on manipulator link ``links[i]`` (-1: the palm), named ``names``; the other arguments as
     :func:`contact_set_scene`."""
-    from qsplan.hands.described.records import joint_names, manipulator_of
     from qsplan.mechanics.model.contact import point_wrench, wrench_matrices
     from qsplan.mechanics.model.manipulator import contact_jacobian, gravity_efforts
     from qsplan.mechanics.model.scene import check_finite_array, make_scene
 
     pose = check_finite_array(pose, "pose", (3,))
-    q = check_finite_array(q, "q", (len(joint_names(hand)),))
-    man, joints, n_c = manipulator_of(hand), joint_names(hand), len(names)
+    q = check_finite_array(q, "q", (len(hand.joint_names),))
+    man, joints, n_c = hand.manipulator, hand.joint_names, len(names)
     n_j = len(joints)
     e = np.asarray(effort_controlled, dtype=bool).reshape(-1)
     if e.shape != (n_j,):

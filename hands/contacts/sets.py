@@ -151,22 +151,19 @@ def _ccw(P) -> bool:
 
 def finger_link(hand, body: str) -> int:
     """The manipulator link (joint index) of a finger's last link; -1 for the palm."""
-    from qsplan.hands.described.records import finger_joint_names, joint_names
-
     if body not in BODIES:
         raise QsplanError(f"body: expected one of {', '.join(BODIES)}; got {body!r}")
     if body == "palm":
         return -1
-    return joint_names(hand).index(finger_joint_names(hand)[BODIES.index(body) - 1][-1])
+    return hand.joint_names.index(hand.finger_joint_names[BODIES.index(body) - 1][-1])
 
 
 def body_ring(hand, body: str, q) -> np.ndarray:
     """The body's polygon in the world at joint positions ``q`` (m), shape (k, 2), its rows as the hand writes them."""
-    from qsplan.hands.described.records import manipulator_of
     from qsplan.hands.geometry.workpiece import rotation
     from qsplan.mechanics.model.manipulator import link_poses
 
-    man = manipulator_of(hand)
+    man = hand.manipulator
     link = finger_link(hand, body)
     if link < 0:
         if man.base_shape is None:
@@ -196,12 +193,11 @@ def _frozen(a):
 
 
 def _configuration(hand, pose, q):
-    from qsplan.hands.described.records import joint_names
     from qsplan.hands.geometry.workpiece import workpiece_world
     from qsplan.mechanics.model.scene import check_finite_array
 
     pose = check_finite_array(pose, "pose", (3,))
-    q = check_finite_array(q, "q", (len(joint_names(hand)),))
+    q = check_finite_array(q, "q", (len(hand.joint_names),))
     return pose, q, workpiece_world(hand, pose)
 
 
@@ -358,14 +354,13 @@ def finger_inner_edge(hand, body: str) -> int:
     whose outward normal points most toward the other finger's side (world ``+x`` for the left finger, ``-x`` for
     the right one).  The paper's form (Fig. 9): the link frame's ``-y`` edge of the left finger, ``+y`` of the right;
     a jaw: its face toward the other jaw."""
-    from qsplan.hands.described.records import manipulator_of
     from qsplan.hands.geometry.workpiece import rotation
     from qsplan.mechanics.model.manipulator import link_poses
 
     link = finger_link(hand, body)
     if link < 0:
         raise QsplanError(f"body: expected 'left' or 'right'; got {body!r}")
-    man = manipulator_of(hand)
+    man = hand.manipulator
     shape = man.joints[link].link_shape
     if shape is None:
         raise QsplanError(f"body: the {body} finger's last link has no polygon")

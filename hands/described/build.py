@@ -1,5 +1,7 @@
 """Building described hands (:class:`qsplan.hands.described.hand.DescribedHand`): from a description, from today's
-records, from a plan's metadata, and the door that converts any of them (:func:`as_hand`).  Units SI (m, kg, rad).
+records, from a plan's metadata, and the door that converts any of them (:func:`as_hand`; :func:`record_of` for the
+record that answers a bare record).  The door is the one place that asks which record type a value is (issue 32):
+past it, a hand's record answers for itself.  Units SI (m, kg, rad).
 """
 
 from __future__ import annotations
@@ -11,7 +13,8 @@ import numpy as np
 from qsplan.hands.described.hand import DescribedHand
 from qsplan.mechanics.errors import QsplanError
 
-__all__ = ["as_hand", "described_from_chain", "described_from_two_finger", "hand_from_metadata", "make_described_hand"]
+__all__ = ["as_hand", "described_from_chain", "described_from_two_finger", "hand_from_metadata", "make_described_hand",
+           "record_from_metadata", "record_of"]
 
 
 def _user_maps(chain) -> tuple:
@@ -109,28 +112,57 @@ def described_from_two_finger(hand, joint_limits=None, joint_speed=None, acceler
                          chain, hand, contact_view(desc), *_user_maps(chain))  # fmt: skip
 
 
-def hand_from_metadata(meta, accelerated: bool = True) -> DescribedHand:
-    """The hand a plan's ``metadata["hand"]`` records (:meth:`DescribedHand.metadata`).
+def record_from_metadata(meta) -> object:
+    """The hand record a plan's ``metadata["hand"]`` records (:meth:`DescribedHand.metadata`): a
+    :class:`~qsplan.hands.chains.hand.ChainHand` when it holds a ``description``, else the paper's
+    :class:`~qsplan.hands.paper_hand.two_finger.TwoFingerHand` (whose palm thickness is not recorded: the default).
 
     Raises
     ------
     QsplanError
-        Naming the field (:func:`qsplan.hands.described.records.hand_from_metadata`).
+        Naming the field (``hand.description.fingers[0]...``, ``hand.workpiece_vertices_m``).
     """
-    from qsplan.hands.described.records import hand_from_metadata as recorded, is_chain_hand
+    if not isinstance(meta, dict):
+        raise QsplanError(f"hand: expected the metadata's hand table; got {type(meta).__name__}")
+    try:
+        if "description" in meta:
+            from qsplan.hands.chains.hand import make_chain_hand
+            from qsplan.hands.description.files import hand_from_table
 
-    hand = recorded(meta)
-    if is_chain_hand(hand):
-        return described_from_chain(hand, accelerated)
-    return described_from_two_finger(hand, accelerated=accelerated)
+            desc = hand_from_table(meta["description"], field="hand.description",
+                                   source=str(meta.get("description_source", "plan metadata")))  # fmt: skip
+            return make_chain_hand(desc, meta["workpiece_vertices_m"], meta["workpiece_mass_kg"], meta.get("mu", 0.2))
+        from qsplan.hands.paper_hand.two_finger import make_two_finger_hand
+
+        return make_two_finger_hand(meta["workpiece_vertices_m"], meta["workpiece_mass_kg"], meta["finger_base_m"],
+                                    meta["finger_length_m"], meta["finger_width_m"], meta["finger_mass_kg"],
+                                    meta["palm_halfwidth_m"], gravity=meta["gravity_m_s2"])  # fmt: skip
+    except KeyError as exc:
+        raise QsplanError(f"hand.{exc.args[0]}: missing from the plan's metadata") from None
+    except QsplanError as exc:
+        text = str(exc)
+        raise QsplanError(text if text.startswith("hand") else f"hand.{text}") from None
 
 
-def as_hand(hand, own_limits=None):
+def hand_from_metadata(meta, accelerated: bool = True) -> DescribedHand:
+    """The hand a plan's ``metadata["hand"]`` records (:meth:`DescribedHand.metadata`): its record
+    (:func:`record_from_metadata`) through the door (:func:`as_hand`).
+
+    Raises
+    ------
+    QsplanError
+        Naming the field (:func:`record_from_metadata`).
+    """
+    return as_hand(record_from_metadata(meta), accelerated=accelerated)
+
+
+def as_hand(hand, own_limits=None, accelerated: bool = True):
     """``hand`` as a :class:`~qsplan.hands.described.hand.DescribedHand` (the door: today's records converted once).
 
     A DescribedHand is returned as is; a :class:`~qsplan.hands.paper_hand.two_finger.TwoFingerHand` (the paper's hand by
     its parameters) or a :class:`~qsplan.hands.chains.hand.ChainHand` is converted
-    (:func:`described_from_two_finger`, :func:`described_from_chain`).
+    (:func:`described_from_two_finger`, :func:`described_from_chain`), the paper's closed forms answering where
+    ``accelerated`` and the hand has the paper's form.
     ``own_limits``: ``(ranges (n_j, 2), speeds (n_j,))`` the hand states (its file's), replacing the converted ones.
 
     Raises
@@ -138,17 +170,44 @@ def as_hand(hand, own_limits=None):
     QsplanError
         Naming ``hand`` for anything else.
     """
+    from dataclasses import replace
+
     from qsplan.hands.chains.hand import ChainHand
     from qsplan.hands.paper_hand.two_finger import TwoFingerHand
-
-    from dataclasses import replace
 
     if isinstance(hand, DescribedHand):
         out = hand
     elif isinstance(hand, TwoFingerHand):
-        out = described_from_two_finger(hand)
+        out = described_from_two_finger(hand, accelerated=accelerated)
     elif isinstance(hand, ChainHand):
-        out = described_from_chain(hand)
+        out = described_from_chain(hand, accelerated)
     else:
         raise QsplanError(f"hand: expected a DescribedHand, a TwoFingerHand or a ChainHand; got {type(hand).__name__}")
     return out if own_limits is None else replace(out, own_limits=own_limits)
+
+
+def record_of(hand):
+    """The record that answers ``hand`` (:class:`qsplan.hands.protocol.HandRecord`), as the hand records always
+    answered: a described hand's own (:attr:`DescribedHand.record`); a bare
+    :class:`~qsplan.hands.paper_hand.two_finger.TwoFingerHand` by the paper's closed forms
+    (:class:`~qsplan.hands.paper_hand.record.PaperRecord`); a bare :class:`~qsplan.hands.chains.hand.ChainHand` by its
+    description, whatever its form (:class:`~qsplan.hands.chains.record.ChainRecord`).  The door of
+    :mod:`qsplan.hands.described.records`' functions.
+
+    Raises
+    ------
+    QsplanError
+        Naming ``hand`` for anything else.
+    """
+    from qsplan.hands.chains.hand import ChainHand
+    from qsplan.hands.chains.record import ChainRecord
+    from qsplan.hands.paper_hand.record import PaperRecord
+    from qsplan.hands.paper_hand.two_finger import TwoFingerHand
+
+    if isinstance(hand, DescribedHand):
+        return hand.record
+    if isinstance(hand, TwoFingerHand):
+        return PaperRecord(hand)
+    if isinstance(hand, ChainHand):
+        return ChainRecord(hand)
+    raise QsplanError(f"hand: expected a TwoFingerHand or a ChainHand; got {type(hand).__name__}")

@@ -23,7 +23,10 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from qsplan.hands.chains.record import ChainRecord
+from qsplan.hands.description.files import description_table
 from qsplan.hands.formations.registry import FORMATIONS, Formation, formation as registered_formation
+from qsplan.hands.paper_hand.record import PaperRecord, paper_metadata
 from qsplan.hands.protocol import JOINT_UNITS
 from qsplan.mechanics.errors import QsplanError
 
@@ -63,6 +66,11 @@ class DescribedHand:
     closings : dict
         The last closings (:func:`qsplan.hands.described.states.close_states`), shared by the grasps closed at the same
         states; a cache, not part of the hand.
+    record : qsplan.hands.protocol.HandRecord
+        The record that answers the questions it is handed (body polygons, one scene, joint axes, scales, range
+        fields), picked once at construction: the paper's (:class:`~qsplan.hands.paper_hand.record.PaperRecord`)
+        where its closed forms answer (accelerated), else the chain record's
+        (:class:`~qsplan.hands.chains.record.ChainRecord`, the polygon search's reference).
     """
 
     description: object
@@ -79,6 +87,10 @@ class DescribedHand:
     user_vertices: np.ndarray
     user_edges: np.ndarray
     closings: dict = field(default_factory=dict, repr=False)
+    record: object = field(init=False, repr=False)
+
+    def __post_init__(self):
+        object.__setattr__(self, "record", PaperRecord(self.paper) if self.accelerated else ChainRecord(self.chain))
 
     def __getattr__(self, name):
         """The paper form's parameters (``finger_length``, ``finger_base``, ``pivots``, ...), read from its record: a
@@ -145,12 +157,6 @@ class DescribedHand:
         return float(lo - self.workpiece[0, 0]), float(hi - self.workpiece[1, 0])
 
     @property
-    def _record(self):
-        """The record whose implementation answers the questions below: the paper's parameters where its closed forms
-        answer (accelerated), else the chain record (the polygon search's reference)."""
-        return self.paper if self.accelerated else self.chain
-
-    @property
     def finger_joint_names(self) -> tuple:
         """``(left finger's joints, right finger's joints)``, each a tuple of names from the palm to the tip."""
         names = self.joint_names
@@ -181,37 +187,29 @@ class DescribedHand:
     @property
     def palm_thickness(self) -> float:
         """How far (m) the palm reaches below its top ``y = 0``: the paper's parameter, else ``-min y`` of the palm."""
-        from qsplan.hands.described.records import palm_thickness
-
-        return palm_thickness(self._record)
+        return self.record.palm_thickness
 
     @property
     def finger_reach(self) -> float:
         """A characteristic finger length (m): the paper's finger length; else the longer finger's sum, over its links,
         of the farthest link vertex from the link's frame origin (the scale of drawn normals, a sweep's joint step)."""
-        from qsplan.hands.described.records import finger_reach
-
-        return finger_reach(self._record)
+        return self.record.finger_reach
 
     def joint_axes(self, q) -> np.ndarray:
         """World position (m) of each joint's frame origin at ``q`` (n_j,), shape (n_j, 2): a revolute joint's axis,
         where a prismatic joint's link frame sits at ``q_i = 0``.  The paper's fingers turn about fixed pivots."""
-        from qsplan.hands.described.records import joint_axes
-
-        return joint_axes(self._record, q)
+        return self.record.joint_axes(q)
 
     def range_fields(self) -> list:
         """``[(field, value, kind)]``: the numbers a task checks against its plausible ranges: the paper's parameters
         where its closed forms answer (:meth:`qsplan.hands.paper_hand.two_finger.TwoFingerHand.range_fields`), and every
         hand's workpiece span and mass, gravity and friction
         (:meth:`qsplan.hands.chains.hand.ChainHand.range_fields`)."""
-        return self._record.range_fields()
+        return self.record.range_fields()
 
     def description_table(self) -> dict:
         """The description as a plain table in the hand-file format (:mod:`qsplan.hands.description.files`): ``name``,
         ``gravity``, ``palm``, ``fingers`` (:func:`qsplan.hands.description.files.hand_from_table` reads it back)."""
-        from qsplan.hands.described.records import description_table
-
         return description_table(self.description)
 
     def _closed_forms(self, formation) -> bool:
@@ -223,9 +221,7 @@ class DescribedHand:
 
     def body_polygons(self, pose, q) -> dict:
         """World polygons (m): ``{"palm", "workpiece", <joint name>...}`` -> (k, 2), at ``pose`` (3,) and ``q`` (n_j,)."""
-        from qsplan.hands.described.records import hand_body_polygons
-
-        return hand_body_polygons(self._record, pose, q)
+        return self.record.body_polygons(pose, q)
 
     def grasp_candidates(self, formation="palm_edge", free=None, xs=None) -> tuple:
         """The grasps the planner's tables consider.
@@ -323,27 +319,25 @@ class DescribedHand:
         """One :class:`qsplan.mechanics.Scene` (contacts palm, palm, left, right) at ``pose`` (3,) and ``q`` (n_j,).
 
         ``method``: ``"generic"`` finds the contacts in the polygons (the reference, the certifier's); ``"auto"`` lets
-        the paper's closed form find them where it can.  Parameters as :func:`qsplan.hands.described.records.scene_at`.
+        the paper's closed form find them where it can.  Parameters as :meth:`qsplan.hands.protocol.HandRecord.scene`.
         """
-        from qsplan.hands.described.records import scene_at
-
         if method not in ("auto", "generic"):
             raise QsplanError(f"method: expected 'auto' or 'generic'; got {method!r}")
-        return scene_at(self._record, pose, q, effort_controlled, velocity, effort, mu, method)
+        return self.record.scene(pose, q, effort_controlled, velocity, effort, mu, method)
 
     def collide(self, poses, q) -> np.ndarray:
         """Whether any two bodies overlap beyond their tolerance at each state (housings respected): ``poses`` (n, 3),
         ``q`` (n, n_j) -> bool (n,) (:func:`qsplan.hands.geometry.collision.find_collisions_batch`)."""
         from qsplan.hands.geometry.collision import find_collisions_batch
 
-        return find_collisions_batch(self._record, poses, q)
+        return find_collisions_batch(self.record, poses, q)
 
     def collisions(self, pose, q, first: bool = False) -> list:
         """The overlapping body pairs at ``pose`` (3,), ``q`` (n_j,), named
         (:func:`qsplan.hands.geometry.collision.find_collisions`)."""
         from qsplan.hands.geometry.collision import find_collisions
 
-        return find_collisions(self._record, pose, q, first)
+        return find_collisions(self.record, pose, q, first)
 
     def opening(self, grasp, x, q) -> np.ndarray:
         """Each joint's opening direction (-1, 0, +1), shape (n_j,), releasing ``grasp`` with the workpiece at ``x`` (m)
@@ -370,11 +364,11 @@ class DescribedHand:
         return out
 
     def metadata(self) -> dict:
-        """The hand as an exported plan's metadata records it (:func:`qsplan.hands.described.records.hand_metadata`):
-        the paper's form by its parameters (today's keys), any other hand by its description and workpiece."""
-        from qsplan.hands.described.records import hand_metadata
-
-        return hand_metadata(self.paper if self.paper is not None else self.chain)
+        """The hand as an exported plan's metadata records it: the paper's form by its parameters (today's keys,
+        :func:`qsplan.hands.paper_hand.record.paper_metadata`, accelerated or not), any other hand by its description and
+        workpiece (:meth:`qsplan.hands.chains.record.ChainRecord.metadata`: not of the paper's form, its record is the
+        chain's)."""
+        return paper_metadata(self.paper) if self.paper is not None else self.record.metadata()
 
 
 def _formation(value) -> Formation:

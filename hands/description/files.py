@@ -28,7 +28,8 @@ horizontal edge: the workpiece rests there.
 * :func:`load_hand` reads a bundled hand by name (:func:`bundled_hands`: ``paper_hand``,
   ``two_link_hand``, ``parallel_jaw``) or a file by path;
 * :func:`hand_from_table` validates a parsed table: a hand file's top level, or a task's ``[hand]``
-  table (whose workpiece keys the task names in ``extra_keys``).
+  table (whose workpiece keys the task names in ``extra_keys``);
+* :func:`description_table` writes a description back as such a table (a plan's metadata records a hand so).
 
 Errors are :class:`~qsplan.mechanics.errors.SceneError` (a ``ValueError``) in one line naming the
 field path: in a file, after the file's name (``my_hand.toml: fingers[1].joints[0].type: expected
@@ -41,11 +42,13 @@ import os
 import tomllib
 from pathlib import Path
 
+import numpy as np
+
 from qsplan.hands.description.model import HandDescription, check_unknown, make_hand_description
 from qsplan.mechanics.errors import SceneError
 from qsplan.mechanics.model.fields import MAX_DEPTH, read_text
 
-__all__ = ["HAND_KEYS", "bundled_hands", "load_hand", "hand_from_table"]
+__all__ = ["HAND_KEYS", "bundled_hands", "description_table", "load_hand", "hand_from_table"]
 
 #: The fields of a hand table (a hand file's top level).
 HAND_KEYS = ("name", "gravity", "palm", "fingers")
@@ -157,3 +160,23 @@ def load_hand(ref, base_dir=None) -> HandDescription:
         return hand_from_table(doc, field="", source=source, default_name=path.stem)
     except SceneError as exc:
         raise SceneError(f"{shown}: {exc}") from None
+
+
+def description_table(desc: HandDescription) -> dict:
+    """``desc`` as a plain table in the hand-file format: ``name``, ``gravity``, ``palm``, ``fingers``.
+
+    Numbers are Python floats (JSON and TOML keep them exactly); :func:`hand_from_table` gives the description back.
+    """
+    man = desc.manipulator
+    fingers = []
+    for finger in desc.fingers:
+        joints = []
+        for i in finger.joints:
+            j = man.joints[i]
+            joints.append({"name": j.name, "type": j.kind, "origin": [float(v) for v in j.origin],
+                           "limits": [float(v) for v in desc.joint_limits[i]], "speed": float(desc.joint_speeds[i]),
+                           "link": {"polygon": np.asarray(j.link_shape, dtype=float).tolist(),
+                                    "mass": float(j.link_mass), "com": [float(v) for v in j.link_com]}})  # fmt: skip
+        fingers.append({"name": finger.name, "joints": joints})
+    return {"name": desc.name, "gravity": float(man.gravity), "palm": {"polygon": np.asarray(desc.palm).tolist()},
+            "fingers": fingers}  # fmt: skip

@@ -160,11 +160,10 @@ def along_edges(hand, constraints, c) -> np.ndarray:
 def constraint_jacobian(hand, constraints, c) -> np.ndarray:
     """``d gaps / d c``, shape (n_k, 3 + n_j) (the module docstring's rows)."""
     from qsplan.hands.contacts.sets import finger_link
-    from qsplan.hands.described.records import manipulator_of
     from qsplan.mechanics.model.manipulator import point_jacobian
 
     c = np.asarray(c, dtype=float)
-    man = manipulator_of(hand)
+    man = hand.manipulator
     rows = []
     for k, (r, _, m, _, _) in zip(constraints, _located(hand, constraints, c)):
         n = m if k.vertex_body == "workpiece" else -m  # into the workpiece

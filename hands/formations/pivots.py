@@ -114,9 +114,8 @@ FINGER_FEATURES = {
 def _tip_corners(hand, finger: str) -> tuple:
     """The corners of a finger's last link farthest along it (its tip), as ring indices."""
     from qsplan.hands.contacts.sets import finger_link
-    from qsplan.hands.described.records import manipulator_of
 
-    shape = np.asarray(manipulator_of(hand).joints[finger_link(hand, finger)].link_shape, dtype=float)
+    shape = np.asarray(hand.manipulator.joints[finger_link(hand, finger)].link_shape, dtype=float)
     far = shape[:, 0].max()
     return tuple(int(i) for i in np.flatnonzero(np.isclose(shape[:, 0], far)))
 
@@ -273,9 +272,7 @@ def _overlap(along) -> float:
 
 
 def _palm_x(hand) -> tuple:
-    from qsplan.hands.described.records import manipulator_of
-
-    palm = np.asarray(manipulator_of(hand).base_shape, dtype=float)
+    palm = np.asarray(hand.manipulator.base_shape, dtype=float)
     top = palm[np.isclose(palm[:, 1], palm[:, 1].max()), 0]
     V = hand.workpiece
     return float(top.min() - V[0, 0]), float(top.max() - V[1, 0])
@@ -292,9 +289,7 @@ def _start_joints(hand, free) -> np.ndarray:
 def _closing_guess(hand, flush: str, edge: int, free=None) -> float:
     """A first guess of the flush finger's closing joint at its flush instant: its last link along the side (its
     absolute angle the side's, the link's inner edge facing the workpiece); a prismatic joint mid-range."""
-    from qsplan.hands.described.records import manipulator_of
-
-    man = manipulator_of(hand)
+    man = hand.manipulator
     f = 0 if flush == "left" else 1
     chain = hand.finger_joints[f]
     lim = np.asarray(hand.description.joint_limits, dtype=float)

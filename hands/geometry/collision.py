@@ -1,7 +1,7 @@
 """Collisions between the bodies of a hand's configuration: every pair of palm, links and workpiece.
 
 :func:`find_collisions` tests every pair of the hand's polygons
-(:func:`qsplan.hands.described.records.hand_body_polygons`: the palm, one polygon per link,
+(:meth:`qsplan.hands.protocol.HandRecord.body_polygons`: the palm, one polygon per link,
 the workpiece), for the paper's hand and any described chain hand alike.  Two
 bodies collide when their intersection is deeper (its narrowest width) than a
 tolerance: :data:`CONTACT_DEPTH_TOL` for the workpiece against a finger or the palm
@@ -73,7 +73,7 @@ class Collision:
 
 
 def body_label(name: str) -> str:
-    """A body of :func:`qsplan.hands.described.records.hand_body_polygons` in words: ``"left"`` -> ``"left finger"``
+    """A body of :meth:`qsplan.hands.protocol.HandRecord.body_polygons` in words: ``"left"`` -> ``"left finger"``
     (the paper's fingers), ``"left_distal"`` -> ``"left_distal link"`` (a chain hand's links)."""
     return _FIXED.get(name, f"{name} finger" if name in ("left", "right") else f"{name} link")
 
@@ -97,7 +97,7 @@ def overlap_depth(region) -> float:
 
 def collision_pairs(hand) -> tuple:
     """The pairs of bodies tested, in the order :func:`find_collisions` reports them: ``((a, b), ...)``
-    with names of :func:`qsplan.hands.described.records.hand_body_polygons` (``"palm"``, ``"workpiece"``, the links)."""
+    with names of :meth:`qsplan.hands.protocol.HandRecord.body_polygons` (``"palm"``, ``"workpiece"``, the links)."""
     man = hand_structure(hand)[0]
     return tuple(combinations(["palm", "workpiece", *(j.name for j in man.joints if j.link_shape is not None)], 2))
 
@@ -115,7 +115,8 @@ def collision_decisions(hand, poses, qs) -> np.ndarray:
 
     Parameters
     ----------
-    hand : qsplan.hands.paper_hand.two_finger.TwoFingerHand or qsplan.hands.chains.hand.ChainHand
+    hand : TwoFingerHand, ChainHand, or their answerer (:class:`qsplan.hands.protocol.HandRecord`)
+        Read for its ``manipulator`` and ``workpiece`` only.
     poses : array-like, shape (n, 3)
         Workpiece ``(x, y, theta)`` (m, m, rad).
     qs : array-like, shape (n, n_j)
@@ -169,7 +170,8 @@ def find_collisions_batch(hand, poses, qs) -> np.ndarray:
 
     Parameters
     ----------
-    hand : qsplan.hands.paper_hand.two_finger.TwoFingerHand or qsplan.hands.chains.hand.ChainHand
+    hand : TwoFingerHand, ChainHand, or their answerer (:class:`qsplan.hands.protocol.HandRecord`)
+        Read for its ``manipulator`` and ``workpiece`` only.
     poses : array-like, shape (n, 3)
         Workpiece ``(x, y, theta)`` (m, m, rad).
     qs : array-like, shape (n, n_j)
@@ -206,7 +208,7 @@ def shapely_collisions(hand, pose, q, first: bool = False, pairs=None) -> list:
 
     q = np.asarray(q, float)
     man, palm, housings, _ = hand_structure(hand)
-    # the bodies of qsplan.hands.described.records.hand_body_polygons, from the cached manipulator (building it is 2/3
+    # the bodies of HandRecord.body_polygons, from the cached manipulator (building it is 2/3
     # of the cost)
     polys = {"palm": palm if palm is not None else Polygon(), "workpiece": Polygon(workpiece_world(hand, pose))}
     polys.update((j.name, p) for j, p in zip(man.joints, link_polygons(man, q)) if p is not None)
@@ -245,7 +247,8 @@ def find_collisions(hand, pose, q, first: bool = False) -> list:
 
     Parameters
     ----------
-    hand : qsplan.hands.paper_hand.two_finger.TwoFingerHand or qsplan.hands.chains.hand.ChainHand
+    hand : TwoFingerHand, ChainHand, or their answerer (:class:`qsplan.hands.protocol.HandRecord`)
+        Read for its ``manipulator`` and ``workpiece`` only.
     pose : array-like, shape (3,)
         Workpiece ``(x, y, theta)`` (m, m, rad).
     q : array-like, shape (n_j,)

@@ -1,7 +1,7 @@
 """A hand as the collision test sees it: its bodies, the joint housings and the fast path's view (numpy).
 
 :func:`hand_structure` gives, once per hand (cached), the manipulator
-(:func:`qsplan.hands.described.records.manipulator_of`: the paper's hand or any described chain hand), the palm, the
+(``hand.manipulator``: any hand record, its answerer or a described hand), the palm, the
 housings and the :class:`FastView` that :mod:`qsplan.hands.geometry.collision` batches over states; :func:`body_frames`
 places every body at each state.  The tolerances the collision test applies are defined here, where the fast view bakes
 them in; :mod:`qsplan.hands.geometry.collision` re-exports them.  Units SI (m, rad).
@@ -118,10 +118,9 @@ def hand_structure(hand):
     """
     from shapely.geometry import Point
 
-    from qsplan.hands.described.records import manipulator_of
     from qsplan.mechanics.model.manipulator import base_polygon, link_poses
 
-    man = manipulator_of(hand)
+    man = hand.manipulator
     fixed_axes = link_poses(man, np.zeros(len(man.joints)))[:, :2]
     housings = {}
     for j, joint in enumerate(man.joints):

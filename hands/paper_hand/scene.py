@@ -11,33 +11,14 @@ ordered palm (left end, right end of the bottom edge), left finger, right finger
 
 from __future__ import annotations
 
-from functools import lru_cache
-
 import numpy as np
 
-from qsplan.hands.paper_hand.two_finger import JOINT_NAMES, TwoFingerHand, finger_angles, workpiece_world
+from qsplan.hands.paper_hand.two_finger import (JOINT_NAMES, TwoFingerHand, finger_angles, hand_manipulator,
+                                                workpiece_world)  # fmt: skip
 from qsplan.mechanics.errors import SceneError
 from qsplan.mechanics.model.friction import check_friction
 
 __all__ = ["hand_manipulator", "hand_geometric_scene", "hand_contacts", "hand_scene", "hand_polygons"]
-
-
-@lru_cache(maxsize=16)
-def hand_manipulator(hand: TwoFingerHand):
-    """The two fingers as a :class:`qsplan.mechanics.Manipulator` (joints "left", "right"; palm as the base).
-
-    Built once per hand (cached: hands and manipulators are immutable)."""
-    from qsplan.mechanics.model.manipulator import make_joint, make_manipulator
-
-    L, w = hand.finger_length, 0.5 * hand.finger_width
-    shape = [(0.0, -w), (L, -w), (L, w), (0.0, w)]
-    joints = [
-        make_joint(name, "revolute", -1, (x, 0.0, 0.0), hand.finger_mass, (0.5 * L, 0.0), shape, index=i)
-        for i, (name, x) in enumerate(zip(JOINT_NAMES, (-hand.finger_base, hand.finger_base)))
-    ]
-    P, T = hand.palm_halfwidth, hand.palm_thickness
-    palm = [(-P, -T), (P, -T), (P, 0.0), (-P, 0.0)]
-    return make_manipulator(joints, base_shape=palm, gravity=hand.gravity)
 
 
 def hand_geometric_scene(hand: TwoFingerHand, pose, q=None, effort_joint="right", velocity=0.0, effort=0.0, mu=None):

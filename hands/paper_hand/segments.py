@@ -84,9 +84,7 @@ class ManipulationSegment:
 
     @property
     def effort_index(self) -> int:
-        from qsplan.hands.described.records import joint_names
-
-        return joint_names(self.hand).index(self.effort_joint)
+        return self.hand.joint_names.index(self.effort_joint)
 
     @property
     def velocity_index(self) -> int:

@@ -21,6 +21,7 @@ All quantities are SI: m, kg, rad, rad/s, N, N m.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import lru_cache
 
 import numpy as np
 
@@ -36,6 +37,7 @@ __all__ = [
     "default_hand",
     "finger_angle_rates",
     "finger_angles",
+    "hand_manipulator",
     "make_two_finger_hand",
     "tangency_angles",
     "tangency_rates",
@@ -114,6 +116,17 @@ class TwoFingerHand:
         """Joint axes in the world (m), shape (2, 2): left, right."""
         return np.array([[-self.finger_base, 0.0], [self.finger_base, 0.0]])
 
+    @property
+    def joint_names(self) -> tuple:
+        """``("left", "right")`` (:data:`JOINT_NAMES`), as every hand record names its joints."""
+        return JOINT_NAMES
+
+    @property
+    def manipulator(self):
+        """The fingers as a :class:`~qsplan.mechanics.model.manipulator.Manipulator` (:func:`hand_manipulator`, cached):
+        the record's bodies, which the collision checks read of any hand record."""
+        return hand_manipulator(self)
+
     def range_fields(self) -> list:
         """``[(field, value, kind)]``: the numbers a task checks against its plausible ranges (``kind`` a key of
         ``qsplan.planner.task.fields.TASK_RANGES``): the finger sizes and the palm, the workpiece's span and mass, the
@@ -124,6 +137,24 @@ class TwoFingerHand:
         out.append(("hand.workpiece_mass", float(self.workpiece_mass), "mass"))
         out.append(("hand.finger_mass", float(self.finger_mass), "finger_mass"))
         return out + [("hand.gravity", float(self.gravity), "gravity"), ("hand.mu", float(self.mu), "friction")]
+
+
+@lru_cache(maxsize=16)
+def hand_manipulator(hand: TwoFingerHand):
+    """The two fingers as a :class:`qsplan.mechanics.Manipulator` (joints "left", "right"; palm as the base).
+
+    Built once per hand (cached: hands and manipulators are immutable)."""
+    from qsplan.mechanics.model.manipulator import make_joint, make_manipulator
+
+    L, w = hand.finger_length, 0.5 * hand.finger_width
+    shape = [(0.0, -w), (L, -w), (L, w), (0.0, w)]
+    joints = [
+        make_joint(name, "revolute", -1, (x, 0.0, 0.0), hand.finger_mass, (0.5 * L, 0.0), shape, index=i)
+        for i, (name, x) in enumerate(zip(JOINT_NAMES, (-hand.finger_base, hand.finger_base)))
+    ]
+    P, T = hand.palm_halfwidth, hand.palm_thickness
+    palm = [(-P, -T), (P, -T), (P, 0.0), (-P, 0.0)]
+    return make_manipulator(joints, base_shape=palm, gravity=hand.gravity)
 
 
 def _positive(value, field, unit, allow_zero=False) -> float:

@@ -5,14 +5,17 @@ validation branch."""
 import numpy as np
 import pytest
 
+from qsplan.hands.chains.hand import make_chain_hand
+from qsplan.hands.chains.record import ChainRecord
 from qsplan.hands.described.build import (described_from_chain, described_from_two_finger, hand_from_metadata,
-                                          make_described_hand)  # fmt: skip
+                                          make_described_hand, record_of)  # fmt: skip
 from qsplan.hands.description import load_hand
 from qsplan.hands.formations.registry import ContactSlot, Formation
 from qsplan.hands.paper_hand.grasps import Grasp, OnVertex, TipOnEdge
 from qsplan.hands.described.records import hand_metadata
 from qsplan.hands.paper_hand.accelerator import paper_state_scene, paper_states
-from qsplan.hands.protocol import ChainGrasp, FingerContact, GraspSceneArrays, GraspStates, Hand
+from qsplan.hands.paper_hand.record import PaperRecord
+from qsplan.hands.protocol import ChainGrasp, FingerContact, GraspSceneArrays, GraspStates, Hand, HandRecord
 from qsplan.hands.paper_hand.two_finger import DEFAULT_WORKPIECE, default_hand, make_two_finger_hand
 from qsplan.mechanics.errors import QsplanError, SceneError
 from qsplan.mechanics.model.scene import Scene
@@ -292,3 +295,16 @@ def test_a_joint_quantity_is_named():
     hand = make_described_hand(load_hand("paper_hand"), DEFAULT_WORKPIECE)
     with pytest.raises(QsplanError, match=r"quantity: expected one of q, qd, tau; got 'force'"):
         hand.joint_units("force")
+
+
+def test_every_record_answers_the_record_protocol():
+    """Each hand record's answerer has every member of :class:`qsplan.hands.protocol.HandRecord`, and a described hand
+    picks one at construction, whichever record answers it."""
+    paper, chain = default_hand(), make_chain_hand(load_hand("two_link_hand"), DEFAULT_WORKPIECE)
+    for record in (PaperRecord(paper), ChainRecord(chain), record_of(paper), record_of(chain)):
+        assert isinstance(record, HandRecord), type(record).__name__
+    assert record_of(paper).hand is paper and record_of(chain).hand is chain
+    assert isinstance(described_from_two_finger(paper).record, PaperRecord)
+    assert isinstance(described_from_two_finger(paper, accelerated=False).record, ChainRecord)
+    assert isinstance(make_described_hand(load_hand("paper_hand"), DEFAULT_WORKPIECE).record, PaperRecord)
+    assert isinstance(make_described_hand(load_hand("two_link_hand"), DEFAULT_WORKPIECE).record, ChainRecord)
