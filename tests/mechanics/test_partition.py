@@ -85,7 +85,13 @@ def test_partition_table_refuses_large_scenes_with_an_estimate(tmp_path, capsys,
     def tested(*args, **kwargs):
         raise AssertionError("a partition was tested")
 
-    monkeypatch.setattr(partition, "effort_partitions", tested)
+    # the CLI reads the package's name (``from qsplan.mechanics import ...``), which the package loads and keeps on
+    # first use: patch the package first (its real function loaded before the module's is replaced, and restored
+    # after), or a package first used here would keep the fake for the rest of the process (test_cli's partition)
+    import qsplan.mechanics as mechanics
+
+    for where in (mechanics, partition):
+        monkeypatch.setattr(where, "effort_partitions", tested)
     assert main(["partition", str(path)]) == 2
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and "(--mode LETTERS)" in err

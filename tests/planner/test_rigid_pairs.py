@@ -53,10 +53,14 @@ def test_what_is_not_a_rigid_pair(points, normals, names, why):
     assert rigid_pairs(_scene(points, normals, names)) == (), why
 
 
-def test_the_chained_turn_certifies_at_zero_friction(monkeypatch):
+def test_the_chained_turn_certifies_at_zero_friction():
     """The demo turned to -0.84 rad: at mu = 0 a pivot row's competitor BRSS (the flush pair rolled at its base and
-    slid at its tip) was left undecided by rounding; the rigid pair sets it aside, and every row is decided.  Without
-    the rule (monkeypatched away) some row is undecided again: the test can fail."""
+    slid at its tip) was left undecided by rounding; the rigid pair sets it aside, and every row is decided.
+
+    Whether rounding leaves BRSS undecided without the rule depends on the BLAS kernel (it did with OpenBLAS's Haswell
+    kernel, not with the one a fresh machine here picks by itself): the test does not ask for that.  It asks what
+    holds on every machine: at every pivot row the flush pair is a rigid pair of the row's scene, BRSS is set aside
+    by geometry, and every row is decided."""
     import tempfile
     from dataclasses import replace
     from pathlib import Path
@@ -79,6 +83,10 @@ def test_the_chained_turn_certifies_at_zero_friction(monkeypatch):
         return [k for k in rows if any(kind == "undecided" for kind, _ in modes.mode_checks(
             task, cols, k, np.zeros((1, 4)), task.force_margin.normal, np.nan, True, scenes[k])[0])]  # fmt: skip
 
+    for k in rows:
+        names = scenes[k].contact_names
+        pairs = modes.rigid_pairs(scenes[k])
+        assert (names.index("left:base"), names.index("left:tip")) in pairs, (k, names, pairs)
+        brss = "".join({"palm:1": "B", "left:base": "R"}.get(n, "S") for n in names)
+        assert structural_degeneracy([brss], pairs).tolist() == [True], (k, brss)
     assert undecided() == []
-    monkeypatch.setattr(modes, "structural_degeneracy", lambda letters, pairs: np.zeros(len(letters), bool))
-    assert undecided() != []
