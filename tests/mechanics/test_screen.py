@@ -151,7 +151,12 @@ def _plain_batch(letters, batch=DEFAULT_BATCH):
     return codes
 
 
-@pytest.mark.parametrize("n_c, n_e, seed", [(12, 9, 0), (12, 9, 7), (13, 10, 1), (14, 5, 1), (13, 13, 1)])
+@pytest.mark.parametrize("n_c, n_e, seed", [
+    (12, 9, 0), (12, 9, 7),
+    # the same comparison on larger scenes (2-4 s each): in the slow run
+    pytest.param(13, 10, 1, marks=pytest.mark.slow), pytest.param(14, 5, 1, marks=pytest.mark.slow),
+    pytest.param(13, 13, 1, marks=pytest.mark.slow),
+])  # fmt: skip
 def test_pruned_solutions_are_the_plain_paths(n_c, n_e, seed):
     """Each feasible mode's solution equals the one the plain path computes in the batch it tests that mode in."""
     scene, planted = _planted(seed, n_c, n_e)
