@@ -85,7 +85,8 @@ def run_one(name, path, n_random, keep=None, planned=None) -> dict:
     free = [r.max_path_error(~r.contact_rows) for r in runs if (~r.contact_rows).any()]
     bad = [r for r in runs if not r.ok]
     row.update(rc=0 if result.ok else 1, runs=len(runs), ok_runs=len(runs) - len(bad),
-               unresolved=sum(r.unresolved for r in runs), letters=sum(4 * int(r.contact_rows.sum()) for r in runs),
+               unresolved=sum(r.unresolved for r in runs),
+               letters=sum(len(r.contacts) * int(r.contact_rows.sum()) for r in runs),
                max_error_mm=result.max_error() * 1e3,
                max_servo_mm=max(float(r.servo_error.max(initial=0.0)) for r in runs) * 1e3,
                max_path_mm=max(r.max_path_error(r.contact_rows) for r in runs) * 1e3,

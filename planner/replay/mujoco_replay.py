@@ -9,13 +9,17 @@ applies ``tau``.  Before ``t = 0`` the grasp is loaded for :data:`PRELOAD_TIME` 
 the joints held: the plan's first row is a loaded grasp.
 
 At every row of the plan it reports the workpiece's pose error (the simulated pose against the row's) and each
-contact's interaction (palm:0, palm:1, left, right), judged over the interval from the row to the next row of
+contact's interaction, judged over the interval from the row to the next row of
 its phase (a phase's last row: from the previous one): ``B`` (broken) where the contact's mean normal force
 over the interval is under :data:`BROKEN_FORCE`, else ``S`` (sliding) where its two bodies' points that touched
 at the interval's start have slid apart, along the contact's tangent, faster than the slip MuJoCo can resolve
 there, else ``R`` (rolling).  Means matter: MuJoCo's convex contact model lets a sliding contact separate at ``mu``
 times its slip speed (micrometre hops at kHz, which no 1 kHz controller sees), so the force at one instant can be
-zero while its mean is the quasistatic one.
+zero while its mean is the quasistatic one.  The contacts are the scene's pairs
+(:func:`qsplan.planner.replay.mujoco_scene.contact_pairs`): the palm edge's four (:data:`CONTACTS`: ``palm:0``,
+``palm:1``, ``left``, ``right``, every earlier replay's letters), then ``palm:K``, the foot under each other vertex
+``K`` of the workpiece; a row's planned letters are its contacts' mapped onto them by name (:func:`pair_letters`: a
+turned workpiece on ``palm:2`` is judged on that foot's pair), a pair no planned contact is on ``B``.
 
 **The slip MuJoCo resolves** (:func:`resolvable_slip`).  MuJoCo's friction is soft: a contact that does not slide
 (its friction force inside the cone) still creeps, at ``R f / B`` (:func:`qsplan.planner.replay.mujoco_run.creep_rates`:
@@ -50,7 +54,8 @@ from qsplan.mechanics.errors import QsplanError
 
 __all__ = ["BROKEN_FORCE", "CONTACTS", "CONTROL_RATE", "POSE_TOLERANCE", "PRELOAD_TIME", "RELEASE_DRIFT",
            "RESOLVE_FACTOR", "SLIP_RESOLUTION", "MujocoReplay", "MujocoRun", "held_pairs", "letters_compared",
-           "load_mujoco", "pair_letters", "planned_pairs", "pose_errors", "replay_mujoco", "resolvable_slip"]
+           "load_mujoco", "made_pairs", "pair_letters", "planned_pairs", "pose_errors", "replay_mujoco",
+           "resolvable_slip"]
 
 #: Control rate (Hz) at which the exported commands are sampled and sent: a common joint-servo rate.
 CONTROL_RATE = 1000.0
@@ -92,7 +97,8 @@ RELEASE_DRIFT = 5e-5
 #: margin (0.05 N, every loaded contact's guaranteed minimum).
 BROKEN_FORCE = 0.01
 
-#: The paper's contacts, in the plan's mode-letter order.
+#: The palm edge's contacts, in the plan's mode-letter order: the friction vector's four coefficients and a replay's
+#: first four pairs (the scene adds ``palm:K`` under the workpiece's other vertices after them).
 CONTACTS = ("palm:0", "palm:1", "left", "right")
 
 
@@ -124,18 +130,19 @@ class MujocoRun:
         The plan's row times (s).
     phase : ndarray of int, shape (m,)
     planned, observed : ndarray of str, shape (m,)
-        The plan's mode (``free`` on regrasps) and the letters judged in MuJoCo (:data:`CONTACTS` order).
+        The plan's mode on the scene's pairs (:func:`planned_pairs`; ``free`` on regrasps) and the letters judged
+        in MuJoCo (:attr:`contacts` order).
     position_error : ndarray, shape (m,)
         Distance (m) of the workpiece's centre of mass from the row's.
     theta_error : ndarray, shape (m,)
         Its orientation error (rad).
-    normal_force, slip_speed : ndarray, shape (m, 4)
+    normal_force, slip_speed : ndarray, shape (m, n_c)
         Each contact's mean normal force (N) and mean slip speed (m/s) over the row's judged interval.
     seconds : float
         Wall time of the run.
-    planned_slip : ndarray, shape (m, 4)
+    planned_slip : ndarray, shape (m, n_c)
         The plan's own mean slip speed (m/s) over the same intervals.
-    resolvable : ndarray, shape (m, 4)
+    resolvable : ndarray, shape (m, n_c)
         The slowest slip (m/s) MuJoCo resolves there (:func:`resolvable_slip`).
     servo_error : ndarray, shape (m,)
         The share (m) of the position error the servos' measured deflection explains (:func:`pose_errors`).
@@ -144,6 +151,15 @@ class MujocoRun:
         from where it was released).
     interval : ndarray, shape (m,)
         Duration (s) of each row's judged interval.
+    contacts : tuple of str
+        The pairs' contacts, the letters' and columns' order (:func:`qsplan.planner.replay.mujoco_scene.contact_pairs`;
+        default the palm edge's four, :data:`CONTACTS`).
+    holds : ndarray of bool, shape (m,), optional
+        The rows that are holds: their written mode every letter ``R`` (:func:`planned_pairs` writes ``B`` on the
+        pairs no contact of theirs is on); default the rows whose pair letters are all ``R``.
+    made : ndarray of bool, shape (m, n_c), optional
+        The pairs whose contact the plan makes where the row's judged interval ends (:func:`made_pairs`): planned
+        open, closing over the interval; their letter is not compared where it differs from the plan's.
     """
 
     mu: np.ndarray
@@ -161,6 +177,9 @@ class MujocoRun:
     servo_error: np.ndarray
     path_error: np.ndarray
     interval: np.ndarray
+    contacts: tuple = CONTACTS
+    holds: np.ndarray | None = None
+    made: np.ndarray | None = None
 
     @property
     def contact_rows(self) -> np.ndarray:
@@ -169,10 +188,16 @@ class MujocoRun:
 
     @property
     def compared(self) -> np.ndarray:
-        """Which pair letters are compared with the plan's (:func:`letters_compared`), shape (m, 4) bool; every letter
+        """Which pair letters are compared with the plan's (:func:`letters_compared`), shape (m, n_c) bool; every letter
         of a regrasp's rows is not."""
         out = letters_compared(self.planned, self.observed, self.planned_slip, self.slip_speed, self.resolvable,
                                self.interval)  # fmt: skip
+        if self.made is not None:  # a contact made as the interval ends: its letter decides nothing where it differs
+            differ = np.zeros_like(out)
+            for k, (a, b) in enumerate(zip(self.planned, self.observed)):
+                if a != "free":
+                    differ[k, :min(len(a), len(b))] = [p != o for p, o in zip(a, b)]
+            out &= ~(np.asarray(self.made, bool) & differ)
         return out & self.contact_rows[:, None]
 
     @property
@@ -185,11 +210,11 @@ class MujocoRun:
         * the first row of a phase leaves rest: its interval's means still count the load a breaking contact had
           (MuJoCo's contacts are compliant: the pivot's vertex 0 unloads over that interval); a pair whose letter
           differs there is kept when the next row of the phase observes the planned letter;
-        * a hold (every planned letter ``R``) claims that nothing moves, not how the load is shared: five contacts
-          hold the workpiece statically indeterminately (the proof shows an equilibrium with every contact loaded;
-          the compliant model may pick one that leaves a contact without force); a pair read ``B`` by its force
-          alone is kept while it slips less than :data:`POSE_TOLERANCE` over the interval (the compliance the pose
-          check bounds).
+        * a hold (its mode every letter ``R``, :attr:`holds`) claims that nothing moves, not how the load is shared:
+          five contacts hold the workpiece statically indeterminately (the proof shows an equilibrium with every
+          contact loaded; the compliant model may pick one that leaves a contact without force); a pair read
+          ``B`` by its force alone is kept while it slips less than :data:`POSE_TOLERANCE` over the interval
+          (the compliance the pose check bounds).
         """
         compared = self.compared
         out = self.contact_rows & np.array([any(c and p != o for p, o, c in zip(a, b, cmp))
@@ -198,7 +223,7 @@ class MujocoRun:
         for k in np.flatnonzero(out):
             start = k == 0 or self.phase[k - 1] != self.phase[k]
             nxt = self.observed[k + 1] if k + 1 < m and self.phase[k + 1] == self.phase[k] else None
-            hold = set(self.planned[k]) == {"R"}
+            hold = bool(self.holds[k]) if self.holds is not None else set(self.planned[k]) == {"R"}
             out[k] = not all(p == o or not compared[k, j] or (start and nxt is not None and nxt[j] == p)
                              or (hold and o == "B" and self.slip_speed[k, j] * self.interval[k] <= POSE_TOLERANCE)
                              for j, (p, o) in enumerate(zip(self.planned[k], self.observed[k])))  # fmt: skip
@@ -219,7 +244,7 @@ class MujocoRun:
         are not kept: :attr:`mismatches`)."""
         out = []
         for k in np.flatnonzero(self.mismatches):
-            out += [(float(self.t[k]), c) for c, p, o in zip(CONTACTS, self.planned[k], self.observed[k])
+            out += [(float(self.t[k]), c) for c, p, o in zip(self.contacts, self.planned[k], self.observed[k])
                     if p != "B" and o == "B"]  # fmt: skip
         return tuple(out)
 
@@ -265,7 +290,8 @@ class MujocoRun:
         """Plain JSON (SI units in the keys)."""
         free = ~self.contact_rows
         compared = self.compared
-        return {"mu": [float(m) for m in self.mu], "modes_kept": self.modes_kept, "ok": self.ok,
+        return {"mu": [float(m) for m in self.mu], "contacts": list(self.contacts), "modes_kept": self.modes_kept,
+                "ok": self.ok,
                 "in_contact_rows": int(self.contact_rows.sum()), "mode_mismatches": int(self.mismatches.sum()),
                 "letters_not_resolvable": self.unresolved,
                 "max_position_error_m": self.max_error(),
@@ -336,31 +362,32 @@ def resolvable_slip(creep_rate, mu, normal_force, interval) -> np.ndarray:
 
     Parameters
     ----------
-    creep_rate : array-like, shape (4,)
+    creep_rate : array-like, shape (n_c,)
         (m/s)/N.
-    mu : array-like, shape (4,)
-    normal_force : array-like, shape (m, 4)
+    mu : array-like, shape (n_c,)
+        Each contact's friction.
+    normal_force : array-like, shape (m, n_c)
         Mean normal force (N) over each row's interval.
     interval : array-like, shape (m,)
         Each row's judged interval (s).
 
     Returns
     -------
-    ndarray, shape (m, 4)
+    ndarray, shape (m, n_c)
     """
     creep = np.asarray(creep_rate, float) * np.asarray(mu, float) * np.asarray(normal_force, float)
     return np.maximum(creep, SLIP_RESOLUTION / np.asarray(interval, float)[:, None])
 
 
 def letters_compared(planned, observed, planned_slip, slip, resolvable, interval) -> np.ndarray:
-    """Which pair letters MuJoCo can decide, shape (m, 4) bool: a break always (the force decides it); a sliding
-    letter of the plan (``S``) where the plan's slip exceeds :data:`RESOLVE_FACTOR` times the resolvable slip;
-    MuJoCo's ``S`` on a planned ``R`` where MuJoCo's slip does and covers more than :data:`POSE_TOLERANCE` over the
-    row's ``interval`` (s): less is the compliance of servos and contacts as the loads change (a hold's ramp moves
-    the workpiece by micrometres), which the pose check bounds; equal letters always.  Rows without a mode
-    (``free``) count as equal."""
+    """Which pair letters MuJoCo can decide, shape (m, n_c) bool (``n_c`` the pairs, ``planned_slip``'s columns): a
+    break always (the force decides it); a sliding letter of the plan (``S``) where the plan's slip exceeds
+    :data:`RESOLVE_FACTOR` times the resolvable slip; MuJoCo's ``S`` on a planned ``R`` where MuJoCo's slip does and
+    covers more than :data:`POSE_TOLERANCE` over the row's ``interval`` (s): less is the compliance of servos and
+    contacts as the loads change (a hold's ramp moves the workpiece by micrometres), which the pose check bounds;
+    equal letters always.  Rows without a mode (``free``) count as equal."""
     m = len(planned)
-    out = np.ones((m, 4), dtype=bool)
+    out = np.ones((m, np.shape(planned_slip)[1]), dtype=bool)
     for k in range(m):
         if planned[k] == "free":
             continue
@@ -398,8 +425,9 @@ def pose_errors(cols, pose, q, joints, jacobians) -> tuple:
     (:func:`held_pairs`; ``jacobians[k] = (J_pose, J_q, d)``, their rates and scene distances at the row) close, with
     the velocity-controlled and held joints where MuJoCo measured them: ``J_pose dpose = -(d + J_q dq)`` in least
     squares (the smallest move where they leave it free).  That pose is where the plan's rigid geometry puts the
-    workpiece for the joints MuJoCo reached, in the scene's bodies (``d``: a turned foot of
-    :data:`qsplan.planner.replay.mujoco_scene.FOOT_RADIUS` stands ``r (1 - cos theta)`` off the plan's corner).  A
+    workpiece for the joints MuJoCo reached, in the scene's bodies (``d``: a foot of
+    :data:`qsplan.planner.replay.mujoco_scene.FOOT_RADIUS` stands up to ``r (1 / sin(a / 2) - 1)`` above the plan's
+    corner of interior angle ``a`` as the workpiece turns, :func:`qsplan.planner.replay.mujoco_scene.foot_centres`).  A
     regrasp's rows (``free``) take that pose of the last row before them (where the workpiece was released; the
     plan's own if none): nothing should move it.
 
@@ -458,25 +486,30 @@ def _friction_vectors(task, mu, n_random, seed) -> np.ndarray:
     return m
 
 
-def pair_letters(mode: str, names) -> str:
+def pair_letters(mode: str, names, pairs=CONTACTS) -> str:
     """A row's planned letters over its contacts ``names`` (the canonical order, :mod:`qsplan.hands.contacts.found`)
-    on the scene's four pairs (:data:`CONTACTS`): ``palm:K`` on its foot, a finger's contacts on its links; a pair
-    no planned contact is on is ``B`` (open: a lifted vertex); a finger flush on an edge (two contacts) slides if
-    either does, else rolls."""
+    on the scene's pairs ``pairs`` (:func:`qsplan.planner.replay.mujoco_scene.contact_pairs`' keys; default the palm
+    edge's four, :data:`CONTACTS`), by name: ``palm:K`` on the foot under vertex ``K``, a finger's contacts on its
+    links; a pair no planned contact is on is ``B`` (open: a lifted vertex); a finger flush on an edge (two
+    contacts) slides if either does, else rolls.  A palm corner on a workpiece edge (``palm:edge``) has no pair."""
     from qsplan.hands.contacts.found import slot_of
 
-    slots = [slot_of(n, CONTACTS) for n in names]
+    slots = [slot_of(n, pairs) for n in names]
     out = []
-    for i in range(len(CONTACTS)):
+    for i in range(len(pairs)):
         mine = [m for m, j in zip(mode, slots) if j == i]
         out.append("B" if not mine else ("S" if "S" in mine else ("R" if "R" in mine else "B")))
     return "".join(out)
 
 
-def planned_pairs(cols, meta) -> np.ndarray:
-    """Each row's planned letters on the four pairs (:func:`pair_letters`): a row whose phase names its contacts
-    (``metadata.phases[i].contact_sets``, plans that turn the workpiece) mapped; any other row as written."""
+def planned_pairs(cols, meta, pairs=CONTACTS) -> np.ndarray:
+    """Each row's planned letters on the scene's pairs ``pairs`` (:func:`pair_letters`): a row whose phase names its
+    contacts (``metadata.phases[i].contact_sets``, plans that turn the workpiece) mapped; any other row as written
+    (the palm edge's four letters, :data:`CONTACTS`), ``B`` on the pairs after them (the feet under the other
+    vertices, open)."""
     planned = np.asarray(cols["mode"]).astype(str).copy()
+    pad = "B" * (len(pairs) - len(CONTACTS))
+    planned = np.array([m + pad if m != "free" and len(m) == len(CONTACTS) else m for m in planned], dtype=object)
     phases = (meta or {}).get("phases") or []
     phase = np.asarray(cols["phase"]).astype(int)
     for i, d in enumerate(phases):
@@ -484,8 +517,36 @@ def planned_pairs(cols, meta) -> np.ndarray:
         for run in d.get("contact_sets") or []:
             for k in rows[run["rows"][0]:run["rows"][1] + 1]:
                 if planned[k] != "free":
-                    planned[k] = pair_letters(planned[k], run["contacts"])
-    return planned
+                    planned[k] = pair_letters(str(cols["mode"][k]), run["contacts"], pairs)
+    return planned.astype(str)
+
+
+def made_pairs(hand, cols, meta, pairs, judged_rows) -> np.ndarray:
+    """Which pairs' contacts the plan makes where each row's judged interval ends, shape (m, n_c) bool: at a phase's
+    last row, the contacts the polygons show (:func:`qsplan.hands.contacts.found.ordered_contacts`, named as the
+    certifier names them) on a pair none of the row's planned contacts is on (:func:`planned_pairs`; ``B``).  Such a
+    contact is open along the interval and touches at its end (e.g. the edge a pivot lands on the palm); MuJoCo's
+    compliant contacts and servos close it micrometres early, so its mean force over the interval decides nothing.
+    Rows judged over other intervals, and regrasps, have none."""
+    from qsplan.hands.contacts.found import contact_names, ordered_contacts, slot_of
+
+    planned = planned_pairs(cols, meta, pairs)
+    phase = np.asarray(cols["phase"]).astype(int)
+    m = phase.size
+    out = np.zeros((m, len(pairs)), dtype=bool)
+    for b in np.flatnonzero(np.r_[phase[1:] != phase[:-1], True]):  # each phase's last row
+        if planned[b] == "free":
+            continue
+        pose = [float(cols[k][b]) for k in ("x_workpiece", "y_workpiece", "theta_workpiece")]
+        q = [float(cols[f"q_{n}"][b]) for n in hand.joint_names]
+        try:
+            found = contact_names(hand, pose, ordered_contacts(hand, pose, q))
+        except QsplanError:  # a row the polygon search refuses: nothing is made there
+            continue
+        for j in {slot_of(n, pairs) for n in found} - {None}:
+            if planned[b][j] == "B":
+                out[np.asarray(judged_rows)[:, 1] == b, j] = True
+    return out
 
 
 def replay_mujoco(plan_dir, task=None, mu=None, n_random: int = 2, seed: int = 0) -> MujocoReplay:
@@ -517,6 +578,7 @@ def replay_mujoco(plan_dir, task=None, mu=None, n_random: int = 2, seed: int = 0
     from qsplan.planner.certify.inputs import read_plan, task_from_metadata
     from qsplan.planner.export.sample import sample_plan, tick_times
     from qsplan.planner.replay.mujoco_run import MujocoSim
+    from qsplan.planner.replay.mujoco_scene import pair_friction
 
     mujoco = load_mujoco()
     cols, meta = read_plan(plan_dir)
@@ -530,7 +592,9 @@ def replay_mujoco(plan_dir, task=None, mu=None, n_random: int = 2, seed: int = 0
     t = np.asarray(cols["t"], float)
     samples = sample_plan(cols, tick_times(float(t.max()), CONTROL_RATE))
     sim = MujocoSim(mujoco, task, samples, cols, PRELOAD_TIME)
-    planned = planned_pairs(cols, meta)
+    planned = planned_pairs(cols, meta, sim.names)
+    holds = np.array([set(str(mode)) == {"R"} for mode in cols["mode"]])
+    made = made_pairs(task.hand, cols, meta, sim.names, sim.judged_rows)
     planned_slip = sim.planned_slip()
     jacobians = sim.contact_jacobians(held_pairs(planned, cols, sim.pair_joints))
     interval = np.diff(samples.t[sim.judged], axis=1)[:, 0]
@@ -539,7 +603,7 @@ def replay_mujoco(plan_dir, task=None, mu=None, n_random: int = 2, seed: int = 0
     for m in vectors:
         start = time.perf_counter()
         trace = sim.run(m)
-        resolvable = resolvable_slip(sim.creep_rate, m, trace.force, interval)
+        resolvable = resolvable_slip(sim.creep_rate, pair_friction(m, sim.names), trace.force, interval)
         letters = np.where(trace.force < BROKEN_FORCE, "B", np.where(trace.slip > resolvable, "S", "R"))
         observed = np.array(["".join(row) for row in letters])
         d = trace.pose - pose
@@ -547,7 +611,7 @@ def replay_mujoco(plan_dir, task=None, mu=None, n_random: int = 2, seed: int = 0
         runs.append(MujocoRun(np.asarray(m, float), t, np.asarray(cols["phase"]).astype(int), planned, observed,
                               np.hypot(d[:, 0], d[:, 1]), d[:, 2], trace.force, trace.slip,
                               time.perf_counter() - start, planned_slip, resolvable, servo, path,
-                              interval))  # fmt: skip
+                              interval, sim.names, holds, made))  # fmt: skip
     from qsplan.planner.replay.mujoco_scene import CONTACT_TIMECONST, PHYSICS_STEP, SERVO_OMEGA
 
     settings = {"control_rate_Hz": CONTROL_RATE, "physics_step_s": PHYSICS_STEP, "preload_s": PRELOAD_TIME,

@@ -3,11 +3,13 @@
 :class:`MujocoSim` compiles the task's scene once (:func:`qsplan.planner.replay.mujoco_scene.scene_xml`) and
 executes a plan's controller samples (:class:`qsplan.planner.export.sample.PlanSamples`) at any friction
 vector (:meth:`MujocoSim.run`), returning what the replay judges: the workpiece pose and the joints at every row and
-each paper contact's mean normal force (MuJoCo's contact sensors, summed at every physics step) and mean slip speed
+each contact's mean normal force (MuJoCo's contact sensors, summed at every physics step) and mean slip speed
 (the relative displacement, along the contact's tangent, of its bodies' points that touched at the start) over the
-row's judged interval.  :meth:`MujocoSim.planned_slip` measures the plan's own slip the same way between its rows'
-configurations, and :attr:`MujocoSim.creep_rate` is what MuJoCo's friction model lets a contact that does not slide
-creep (:mod:`qsplan.planner.replay.mujoco_replay` compares the two).
+row's judged interval.  The contacts are the scene's (:func:`qsplan.planner.replay.mujoco_scene.contact_pairs`:
+``palm:0``, ``palm:1``, ``left``, ``right``, then ``palm:K`` under the workpiece's other vertices), in that order in
+every array (:attr:`MujocoSim.names`).  :meth:`MujocoSim.planned_slip` measures the plan's own slip the same way
+between its rows' configurations, and :attr:`MujocoSim.creep_rate` is what MuJoCo's friction model lets a contact that
+does not slide creep (:mod:`qsplan.planner.replay.mujoco_replay` compares the two).
 """
 
 from __future__ import annotations
@@ -30,9 +32,10 @@ SNAPSHOT_REACH = 0.01
 NORMAL_GAP = 1e-7
 
 #: Distance (m) within which MuJoCo's collision reports a contact at a plan's row (``pair margin`` of the geometry
-#: model :meth:`MujocoSim.contact_jacobians` uses): the plan's contacts touch within the certifier's micron, and a
-#: turned foot sinks ``FOOT_RADIUS (1 - cos theta)`` (27 um at 0.75 rad) into the palm, a penetration, found at any
-#: margin; 10 um finds every planned contact and no open one of a row.
+#: model :meth:`MujocoSim.contact_jacobians` uses): the plan's contacts touch within the certifier's micron; 10 um
+#: finds every planned contact and no open one of a row.  A foot's pair adds how far the foot may stand above its
+#: corner (:func:`qsplan.planner.replay.mujoco_scene.foot_centres`: ``r (1 / sin(a / 2) - 1)``, 41 um at a right
+#: angle, when the corner's bisector points at the palm).
 CONTACT_REACH = 1e-5
 
 
@@ -44,9 +47,9 @@ class RunTrace:
     ----------
     pose : ndarray, shape (m, 3)
         The workpiece's ``(x, y, theta)`` (m, m, rad) at each row's tick.
-    force : ndarray, shape (m, 4)
-        Mean normal force (N) of palm:0, palm:1, left, right over the row's judged interval (ticks).
-    slip : ndarray, shape (m, 4)
+    force : ndarray, shape (m, n_c)
+        Mean normal force (N) of each contact (:attr:`MujocoSim.names`) over the row's judged interval (ticks).
+    slip : ndarray, shape (m, n_c)
         Their mean slip speed (m/s) over that interval: the displacement along the contact's tangent (the normal part,
         the soft contact's penetration changing, is no slip).
     q : ndarray, shape (m, n_j)
@@ -60,7 +63,7 @@ class RunTrace:
 
 
 def creep_rates(model, pairs) -> np.ndarray:
-    """Fastest creep (m/s) per newton of friction force of each paper contact that MuJoCo holds without sliding.
+    """Fastest creep (m/s) per newton of friction force of each contact that MuJoCo holds without sliding.
 
     MuJoCo's friction is soft (Computation chapter, "Soft constraint model"; Modeling, "Solver parameters:
     Friction"): a friction row of an elliptic cone has no position term, its reference acceleration is ``-B v``,
@@ -75,14 +78,14 @@ def creep_rates(model, pairs) -> np.ndarray:
     ----------
     model : mujoco.MjModel
     pairs : sequence of (int, sequence of int)
-        Each paper contact's index and its MJCF pair ids.
+        Each contact's index and its MJCF pair ids.
 
     Returns
     -------
-    ndarray, shape (4,)
-        ``v / (mu f_n)``, (m/s)/N.
+    ndarray, shape (n_c,)
+        ``v / (mu f_n)``, (m/s)/N, ``n_c`` the largest index plus one.
     """
-    out = np.zeros(4)
+    out = np.zeros(max((c for c, _ in pairs), default=-1) + 1)
     impratio = max(float(model.opt.impratio), 1e-10)
     for c, ids in pairs:
         for i in ids:
@@ -131,9 +134,11 @@ class MujocoSim:
         self.lead = -self.bias[:, 1] / self.gain  # kv / kp (s): the servo's velocity feed-forward as a position lead
         self.pairs = []  # (contact index, pair ids)
         self.geoms = []  # (contact index, [(geom1, geom2) of each of its pairs])
-        # sensordata -> each paper contact's summed normal force: the normal entry of every slot of its pairs' sensors
-        self.normal_of = np.zeros((m.nsensordata, 4))
-        for c, pair_names in enumerate(contact_pairs(task.hand).values()):
+        scene_pairs = contact_pairs(task.hand)
+        self.names = tuple(scene_pairs)  # the contacts judged, the order of every array
+        # sensordata -> each contact's summed normal force: the normal entry of every slot of its pairs' sensors
+        self.normal_of = np.zeros((m.nsensordata, len(self.names)))
+        for c, pair_names in enumerate(scene_pairs.values()):
             ids = [m.pair(p).id for p in pair_names]
             self.pairs.append((c, ids))
             self.geoms.append((c, [(int(m.pair_geom1[i]), int(m.pair_geom2[i])) for i in ids]))
@@ -171,7 +176,7 @@ class MujocoSim:
         self.cols = cols
         # each pair's finger joints (indices into samples.joints; none for the palm's)
         fingers = dict(zip(("left", "right"), task.hand.finger_joint_names))
-        self.pair_joints = [[names.index(n) for n in fingers.get(c, ())] for c in contact_pairs(task.hand)]
+        self.pair_joints = [[names.index(n) for n in fingers.get(c, ())] for c in self.names]
         self.task, self._geometry = task, None
 
     def _command(self, i: int, hold: bool = False) -> None:
@@ -191,14 +196,15 @@ class MujocoSim:
         d.ctrl[self.motor] = np.where(torque, np.nan_to_num(s.tau[i]), 0.0)
 
     def _snapshot(self, d=None, contacts: bool = True) -> tuple:
-        """Where each paper contact touches in ``d`` (default the run's data): ``(points (4, 3), body pairs (4, 2),
-        normals (4, 3), body positions, orientations)``; a contact's point is the midpoint of its nearest pair's
+        """Where each contact touches in ``d`` (default the run's data): ``(points (n_c, 3), body pairs (n_c, 2),
+        normals (n_c, 3), body positions, orientations)``; a contact's point is the midpoint of its nearest pair's
         closest points (MuJoCo's ``mj_geomDistance``), its normal MuJoCo's contact frame on that pair when
         ``contacts`` and one is active, else the closest points' direction when at least :data:`NORMAL_GAP` apart,
         else zero (undefined)."""
         mj, m = self.mj, self.model
         d = self.data if d is None else d
-        points, bodies, normals = np.zeros((4, 3)), np.zeros((4, 2), dtype=int), np.zeros((4, 3))
+        n_c = len(self.names)
+        points, bodies, normals = np.zeros((n_c, 3)), np.zeros((n_c, 2), dtype=int), np.zeros((n_c, 3))
         fromto = np.zeros(6)
         nearest = {}
         for c, geoms in self.geoms:
@@ -225,11 +231,11 @@ class MujocoSim:
     def _slide(start, end) -> np.ndarray:
         """Each contact's slip (m) from snapshot ``start`` to ``end``: the material points of its two bodies that
         touched at the start, carried by each body to the end; their separation in the plane along the contact's
-        tangent (all of it where the start has no normal), shape (4,)."""
+        tangent (all of it where the start has no normal), shape (n_c,)."""
         points, bodies, normals, x0, r0 = start
         x1, r1 = end[3], end[4]
-        out = np.zeros(4)
-        for c in range(4):
+        out = np.zeros(len(points))
+        for c in range(len(points)):
             carried = []
             for b in bodies[c]:
                 local = r0[b].T @ (points[c] - x0[b])
@@ -245,25 +251,29 @@ class MujocoSim:
         return out
 
     def _distances(self, d, pairs) -> np.ndarray:
-        """Signed distance (m) of each paper contact in ``pairs`` in ``d``: its nearest MJCF pair's."""
+        """Signed distance (m) of each contact in ``pairs`` (indices) in ``d``: its nearest MJCF pair's."""
         fromto = np.zeros(6)
         return np.array([min(self.mj.mj_geomDistance(self.model, d, g1, g2, SNAPSHOT_REACH, fromto)
                              for g1, g2 in self.geoms[c][1]) for c in pairs])  # fmt: skip
 
     def contact_jacobians(self, pairs) -> list:
-        """How the contacts ``pairs[k]`` (paper contact indices) of each row ``k`` open, at the row's planned
+        """How the contacts ``pairs[k]`` (contact indices) of each row ``k`` open, at the row's planned
         configuration: per contact point MuJoCo's collision finds there (a finger flush on an edge touches at two),
         ``n . (v_2 - v_1)`` at the point (``n`` the contact normal, from geom 1 to geom 2, ``v`` the bodies'
         velocities there, MuJoCo's ``mj_jac``) as ``(J_pose (n, 3), J_q (n, n_j), d (n,))``: its rates per unit of
         the workpiece's pose and of each joint, and its signed distance in the scene (the scene's own geometry: a
-        turned foot sinks into the palm, :func:`qsplan.planner.replay.mujoco_replay.pose_errors`); ``None`` where a
+        turned foot stands above the palm, :func:`qsplan.planner.replay.mujoco_replay.pose_errors`); ``None`` where a
         row has none."""
-        from qsplan.planner.replay.mujoco_scene import scene_xml
+        from qsplan.planner.replay.mujoco_scene import FOOT_RADIUS, foot_centres, scene_xml
 
         mj, cols = self.mj, self.cols
         if self._geometry is None:  # a model of its own: the run's contacts keep their margin of zero
-            self._geometry = mj.MjModel.from_xml_string(scene_xml(self.task))
-            self._geometry.pair_margin[:] = CONTACT_REACH
+            g = self._geometry = mj.MjModel.from_xml_string(scene_xml(self.task))
+            g.pair_margin[:] = CONTACT_REACH
+            wp = np.asarray(self.task.hand.workpiece, float)
+            stand = np.hypot(*(foot_centres(wp) - wp).T) - FOOT_RADIUS  # the most a foot stands above its corner
+            for k, h in enumerate(stand):
+                g.pair_margin[g.pair(f"palm:{k}").id] += h
         m = self._geometry
         d = mj.MjData(m)
         names = self.samples.joints
@@ -302,10 +312,10 @@ class MujocoSim:
         return out
 
     def planned_slip(self) -> np.ndarray:
-        """The plan's own mean slip speed (m/s) of each paper contact over every row's judged interval, measured as
+        """The plan's own mean slip speed (m/s) of each contact over every row's judged interval, measured as
         :meth:`run` measures MuJoCo's (:meth:`_slide`) between the planned configurations (the rows' poses and every
-        joint's ``q`` column) at the interval's end rows, shape (m, 4).  The plan's contacts touch (within the
-        certifier's micron), so the whole displacement is slip."""
+        joint's ``q`` column) at the interval's end rows.  The plan's contacts touch (within the
+        certifier's micron), so the whole displacement is slip.  Shape (m, n_c)."""
         mj, m, cols = self.mj, self.model, self.cols
         d = self.mj.MjData(m)
         names = self.samples.joints
@@ -318,18 +328,19 @@ class MujocoSim:
             d.qpos[self.qadr] = np.nan_to_num(q[k])
             mj.mj_kinematics(m, d)
             shots[int(k)] = self._snapshot(d, contacts=False)
-        out = np.zeros((t.size, 4))
+        out = np.zeros((t.size, len(self.names)))
         for r, (a, b) in enumerate(self.judged_rows):
             if b > a and t[b] > t[a]:
                 out[r] = self._slide(shots[int(a)], shots[int(b)]) / (t[b] - t[a])
         return out
 
     def run(self, mu) -> RunTrace:
-        """Execute the samples at friction ``mu`` (4,) (palm:0, palm:1, left, right) from the first row's state."""
-        from qsplan.planner.replay.mujoco_scene import MIN_MU
+        """Execute the samples at friction ``mu`` (4,) (palm:0, palm:1, left, right; each contact's:
+        :func:`qsplan.planner.replay.mujoco_scene.pair_friction`) from the first row's state."""
+        from qsplan.planner.replay.mujoco_scene import MIN_MU, pair_friction
 
         mj, m, d, s = self.mj, self.model, self.data, self.samples
-        mu = np.asarray(mu, dtype=float)
+        mu = pair_friction(mu, self.names)
         for c, ids in self.pairs:
             m.pair_friction[ids, :2] = max(float(mu[c]), MIN_MU)
         mj.mj_resetData(m, d)
@@ -343,7 +354,8 @@ class MujocoSim:
             mj.mj_step(m, d, nstep=self.n_preload)
         n_rows, n_ticks = self.row_tick.size, s.t.size
         pose, q = np.zeros((n_rows, 3)), np.zeros((n_rows, len(self.qadr)))
-        tick_force = np.zeros((n_ticks - 1, 4))  # mean normal force over the tick (N), every physics step summed
+        n_c = len(self.names)
+        tick_force = np.zeros((n_ticks - 1, n_c))  # mean normal force over the tick (N), every physics step summed
         acc = np.zeros(m.nsensordata)
         rows_at, shots = {}, {}
         for r, i in enumerate(self.row_tick):
@@ -364,7 +376,7 @@ class MujocoSim:
                 mj.mj_step(m, d)
                 acc += d.sensordata
             tick_force[i] = acc @ self.normal_of / n
-        force, slip = np.zeros((n_rows, 4)), np.zeros((n_rows, 4))
+        force, slip = np.zeros((n_rows, n_c)), np.zeros((n_rows, n_c))
         for r, (a, b) in enumerate(self.judged):
             force[r] = tick_force[a:b].mean(axis=0)
             slip[r] = self._slide(shots[a], shots[b]) / (s.t[b] - s.t[a])

@@ -8,8 +8,10 @@ is its polygon extruded :data:`DEPTH` along z, centred on z = 0.  Names (what
 * ``palm``: the palm, fixed (a box when its polygon is an axis-aligned rectangle, else a prism);
 * ``workpiece``: a planar free body, joints ``workpiece_x``, ``workpiece_y`` (m) and ``workpiece_theta`` (rad),
   so ``qpos`` is the plan's pose ``(x, y, theta)`` of its centre of mass; its polygon (the hand's internal
-  vertices) and two feet ``foot:0``, ``foot:1``: spheres of :data:`FOOT_RADIUS` whose lowest points are the
-  bottom edge's ends, where the paper's palm contacts ``palm:0`` and ``palm:1`` sit;
+  vertices) and a foot ``foot:K`` under every vertex ``K``: a sphere of :data:`FOOT_RADIUS` inside the corner,
+  touching both its edges (:func:`foot_centres`), which carries the palm contact ``palm:K`` (the certifier's name of
+  a palm contact at internal vertex ``K``, :func:`qsplan.hands.contacts.found.contact_names`): the workpiece rests
+  on any of its edges, or pivots on any vertex, on two feet or one;
 * one body per joint of the hand (its name), at the joint's origin in its parent link and turned by the
   origin's angle: a ``hinge`` about z (``q`` rad, the link's angle from the joint frame) or a ``slide`` along
   the frame's x (``q`` m), with its link polygon as geom ``link:<joint>``;
@@ -18,10 +20,12 @@ is its polygon extruded :data:`DEPTH` along z, centred on z = 0.  Names (what
   (:func:`servo_gains`; a controller sets ``a = q_ref + qd_ref kv / kp`` at each tick and ``ctrl = qd_ref``); and
   ``motor:<joint>``, a torque (N m, or N) motor.  A replay zeroes the servo's gains while the joint is
   torque-controlled;
-* contact pairs, one per paper contact, each with its own friction: ``palm:0`` (palm, ``foot:0``),
-  ``palm:1`` (palm, ``foot:1``), and per link of the left finger ``left:<joint>`` (link, workpiece), of the
-  right finger ``right:<joint>``.  No other pair collides (the certifier checks links, palm and workpiece
-  apart along the plan).  A ``contact`` sensor ``force:<pair>`` per pair reports its points' forces.
+* contact pairs, each with its own friction: ``palm:K`` (palm, ``foot:K``) per workpiece vertex, and per link of
+  the left finger ``left:<joint>`` (link, workpiece), of the right finger ``right:<joint>``.  The friction vector
+  keeps the palm edge's four coefficients (``palm:0``, ``palm:1``, ``left``, ``right``); a palm contact under
+  another vertex takes ``palm:0``'s, the rule of every replay (:func:`qsplan.planner.replay.phases.body_friction`).
+  No other pair collides (the certifier checks links, palm and workpiece apart along the plan).  A ``contact``
+  sensor ``force:<pair>`` per pair reports its points' forces.
 
 The quasistatic model has massless links where the hand file gives none: MuJoCo needs a moving body's
 mass, so such a link weighs :data:`NOMINAL_LINK_MASS` with its gravity compensated (``gravcomp``); each joint
@@ -37,16 +41,17 @@ from qsplan.hands.geometry.workpiece import polygon_inertia  # noqa: F401 (in __
 from qsplan.mechanics.errors import QsplanError
 
 __all__ = ["ARMATURE", "CONTACT_SOLIMP", "CONTACT_TIMECONST", "DEPTH", "FOOT_RADIUS", "MIN_MU", "NOMINAL_LINK_MASS",
-           "PHYSICS_STEP", "SENSOR_SLOTS", "SERVO_OMEGA", "contact_pairs", "polygon_inertia", "scene_xml",
-           "servo_gains", "start_of", "write_scene"]
+           "PHYSICS_STEP", "SENSOR_SLOTS", "SERVO_OMEGA", "contact_pairs", "foot_centres", "pair_friction",
+           "polygon_inertia", "scene_xml", "servo_gains", "start_of", "write_scene"]
 
 #: Extrusion of every body along z (m).  The motion is planar (every joint turns about z or slides in the plane),
 #: so the depth changes no force in the plane; 2 cm is a finger's thickness.
 DEPTH = 0.02
 
-#: Radius (m) of the workpiece's feet: the palm contacts of the paper's model are the bottom edge's two ends;
-#: a sphere that touches the palm at that point carries each one (with its own friction).  0.1 mm keeps the
-#: foot's outline within 0.1 mm of the corner.
+#: Radius (m) of the workpiece's feet: a palm contact of the model is a workpiece vertex on the palm; a sphere in
+#: that corner, touching both its edges (:func:`foot_centres`), carries it (with its own friction).  Its lowest
+#: point lies on an edge's line when that edge rests flat on the palm, and at most ``r (1 / sin(a / 2) - 1)`` short
+#: of the corner in any other orientation (``a`` the interior angle: 41 um at a right angle, 15 um at 120 deg).
 FOOT_RADIUS = 1e-4
 
 #: MuJoCo's time step (s): ten steps per 1 kHz control tick, so that the servos (:data:`SERVO_OMEGA`) and the
@@ -90,10 +95,45 @@ def servo_gains(kind: str) -> tuple:
 
 
 def contact_pairs(hand) -> dict:
-    """``{paper contact: (pair names)}``: ``palm:0``, ``palm:1``, ``left``, ``right`` -> the MJCF pairs carrying it."""
+    """``{contact: (pair names)}``, the contacts a replay judges and the MJCF pairs carrying each: the palm edge's
+    four first (``palm:0``, ``palm:1``, ``left``, ``right``: the friction vector's order and every earlier replay's
+    letters), then ``palm:K`` for the workpiece's other vertices ``K = 2, 3, ...`` (extended, never renamed)."""
     left, right = hand.finger_joint_names
+    more = {f"palm:{k}": (f"palm:{k}",) for k in range(2, len(hand.workpiece))}
     return {"palm:0": ("palm:0",), "palm:1": ("palm:1",), "left": tuple(f"left:{n}" for n in left),
-            "right": tuple(f"right:{n}" for n in right)}  # fmt: skip
+            "right": tuple(f"right:{n}" for n in right), **more}  # fmt: skip
+
+
+def pair_friction(mu, names) -> np.ndarray:
+    """The friction of contacts ``names`` (:func:`contact_pairs`' keys) from a friction vector ``mu`` (palm:0, palm:1,
+    left, right): :func:`qsplan.planner.replay.phases.body_friction`, the rule of every replay (a palm contact under
+    another vertex takes palm:0's)."""
+    from qsplan.planner.replay.phases import body_friction
+
+    return body_friction(names, _mu(mu))
+
+
+def foot_centres(polygon, radius: float = FOOT_RADIUS) -> np.ndarray:
+    """Centres (k, 2) of the feet of ``polygon`` (k, 2), in its frame: each on its vertex's inward bisector at
+    ``radius / sin(a / 2)`` (``a`` the interior angle), so that the sphere touches both edges of the corner.
+
+    Whichever way the workpiece turns, the foot's lowest point stands at most ``radius (1 / sin(a / 2) - 1)`` above
+    the corner's (along the bisector) and exactly on an edge's line when that edge rests flat on the palm.
+    """
+    p = np.asarray(polygon, dtype=float)
+    x, y = p[:, 0], p[:, 1]
+    ccw = float(x @ np.roll(y, -1) - np.roll(x, -1) @ y) > 0.0
+    out = np.empty_like(p)
+    for k in range(len(p)):
+        a, b = p[k - 1] - p[k], p[(k + 1) % len(p)] - p[k]
+        a, b = a / np.hypot(*a), b / np.hypot(*b)
+        turn = float(a[0] * b[1] - a[1] * b[0])  # from the next edge's direction to the previous one's
+        half = 0.5 * np.arctan2(-turn if ccw else turn, float(a @ b)) % np.pi  # half the interior angle, (0, pi)
+        # the inward bisector: the next edge's direction turned inward by half the interior angle
+        c, s = np.cos(half), np.sin(half) * (1.0 if ccw else -1.0)
+        u = np.array([c * b[0] - s * b[1], s * b[0] + c * b[1]])
+        out[k] = p[k] + radius / np.sin(half) * u
+    return out
 
 
 def _convex(polygon) -> tuple:
@@ -131,8 +171,8 @@ def scene_xml(task, mu=None, start=None) -> str:
     ----------
     task : qsplan.planner.task.task.Task
     mu : float or array-like, shape (4,), optional
-        Friction of the contacts palm:0, palm:1, left, right; default the middle of the task's friction set
-        (a replay sets each run's own).
+        Friction of the contacts palm:0, palm:1, left, right (a foot under another vertex takes palm:0's,
+        :func:`pair_friction`); default the middle of the task's friction set (a replay sets each run's own).
     start : (array-like (3,), array-like (n_j,)), optional
         The workpiece pose (m, m, rad) and joints (rad or m) of a keyframe ``start`` (a plan's first row).
 
@@ -165,10 +205,12 @@ def scene_xml(task, mu=None, start=None) -> str:
              '      <joint name="workpiece_y" type="slide" axis="0 1 0"/>',
              '      <joint name="workpiece_theta" type="hinge" axis="0 0 1"/>',
              '      <geom name="workpiece" type="mesh" mesh="workpiece" rgba="0.85 0.55 0.2 1"/>']  # fmt: skip
-    for k in (0, 1):
+    feet = foot_centres(wp)
+    palm_mu = pair_friction(mu, [f"palm:{k}" for k in range(len(wp))])
+    for k, centre in enumerate(feet):
         body.append(f'      <geom name="foot:{k}" type="sphere" size="{FOOT_RADIUS!r}" '
-                    f'pos="{_nums([wp[k, 0], wp[k, 1] + FOOT_RADIUS, 0.0])}" rgba="0.85 0.55 0.2 1"/>')  # fmt: skip
-        pairs.append((f"palm:{k}", "palm", f"foot:{k}", mu[k]))
+                    f'pos="{_nums([*centre, 0.0])}" rgba="0.85 0.55 0.2 1"/>')  # fmt: skip
+        pairs.append((f"palm:{k}", "palm", f"foot:{k}", palm_mu[k]))
     body.append("    </body>")
     # the hand: one body per joint, nested along each finger
     finger = dict(zip(hand.joint_names, hand.description.finger_of_joint))

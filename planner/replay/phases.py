@@ -69,7 +69,8 @@ def phase_rows(hand, columns, rows) -> tuple:
 def body_friction(names, mu) -> np.ndarray:
     """The friction of contacts ``names`` from the replay's vector ``mu`` (the palm edge's palm:0, palm:1, left,
     right): each contact its slot's (:func:`qsplan.hands.contacts.found.slot_of`: a finger's contacts that finger's),
-    a palm contact under another vertex palm:0's."""
+    a palm contact under another vertex palm:0's (the MuJoCo scene's feet too,
+    :func:`qsplan.planner.replay.mujoco_scene.pair_friction`)."""
     from qsplan.hands.formations.registry import formation
     from qsplan.hands.contacts.found import slot_of
 

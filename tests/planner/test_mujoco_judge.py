@@ -280,11 +280,12 @@ def test_issue_hexagon_slides_where_its_slip_slows_and_mujoco_says_so(tmp_path, 
     assert rc == 0 and doc["ok"] and len(doc["runs"]) == 16
     for run in doc["runs"]:
         last = run["rows"][-2]  # the deceleration's last interval: the left contact's planned slip at its slowest
-        assert last["planned"] == "SSSS" and last["compared"] == "1111"  # resolvable: MuJoCo compares it ...
+        assert run["contacts"] == ["palm:0", "palm:1", "left", "right"] + [f"palm:{k}" for k in range(2, 6)]
+        assert last["planned"] == "SSSS" + "B" * 4 and last["compared"] == "1" * 8  # resolvable: MuJoCo compares it ...
         v, resolvable = last["planned_slip_m_s"][2], last["resolvable_slip_m_s"][2]
         assert v < 1e-4 < RESOLVE_FACTOR * 1e-4  # ... below the former fixed 0.1 mm/s that read it "R"
         assert v > 10 * resolvable and last["slip_speed_m_s"][2] > RESOLVE_FACTOR * resolvable
-        assert last["observed"] == "SSSS"
+        assert last["observed"] == "SSSS" + "B" * 4  # the hexagon's upper feet stay off the palm
     # the plan is right there: the rigid-body replay (every mode checked) keeps 4S to the end at every vertex
     from qsplan.planner.certify.inputs import read_plan, task_from_metadata
     from qsplan.planner.replay.replay import replay_plan

@@ -45,11 +45,62 @@ def test_scene_loads_with_the_task_s_bodies_joints_and_pairs(name):
     links = hand.description.manipulator.joints
     for j in links:
         assert m.body(j.name).mass[0] > 0 and m.joint(j.name).type == (3 if j.kind == "revolute" else 2)  # hinge, slide
-    assert m.npair == 2 + len(links)
+    assert m.npair == len(hand.workpiece) + len(links)  # a foot under every workpiece vertex, a pair per link
     assert m.pair("palm:1").friction[0] == pytest.approx(0.05)
     assert m.pair(f"right:{links[-1].name}").friction[0] == pytest.approx(0.2)
     assert m.pair("palm:0").friction[0] > 0  # a coefficient of 0 is MuJoCo's smallest
     assert m.opt.gravity[1] == pytest.approx(-hand.gravity)
+
+
+def test_every_pentagon_vertex_has_a_foot_in_its_corner_and_a_pair_with_its_friction():
+    """Issue 32: a turned workpiece touches the palm with any vertex; each has a foot (a sphere touching both edges
+    of its corner: the distance from its centre to each edge's line is its radius) and a pair ``palm:K`` with the
+    friction the replays give a palm contact under vertex K (palm:0's, palm:1's, else palm:0's), and a sensor."""
+    mujoco = pytest.importorskip("mujoco")
+    from shapely.geometry import Point, Polygon
+
+    from qsplan.planner.replay.mujoco_scene import contact_pairs, foot_centres
+    from qsplan.planner.replay.phases import body_friction
+
+    task = load_task(task_paths()["pentagon_task"])
+    wp = np.asarray(task.hand.workpiece, float)
+    assert len(wp) == 5
+    mu = [0.05, 0.1, 0.15, 0.2]
+    m = mujoco.MjModel.from_xml_string(scene_xml(task, mu=mu))
+    d = mujoco.MjData(m)
+    mujoco.mj_forward(m, d)
+    assert list(contact_pairs(task.hand))[:4] == ["palm:0", "palm:1", "left", "right"]  # extended, never renamed
+    expected = body_friction([f"palm:{k}" for k in range(5)], mu)
+    assert expected.tolist() == [0.05, 0.1, 0.05, 0.05, 0.05]
+    for k, centre in enumerate(foot_centres(wp)):
+        g = m.geom(f"foot:{k}")
+        assert g.size[0] == FOOT_RADIUS and g.pos[:2] == pytest.approx(centre, abs=1e-15)
+        for a, b in ((wp[k - 1], wp[k]), (wp[k], wp[(k + 1) % 5])):  # tangent to both edges of its corner
+            e = (b - a) / np.hypot(*(b - a))
+            assert abs(e[0] * (centre - a)[1] - e[1] * (centre - a)[0]) == pytest.approx(FOOT_RADIUS, rel=1e-9)
+        assert Polygon(wp).contains(Point(centre).buffer(0.999 * FOOT_RADIUS))  # inside the corner
+        pair = m.pair(f"palm:{k}")
+        assert {int(pair.geom1[0]), int(pair.geom2[0])} == {m.geom("palm").id, g.id}
+        assert pair.friction[0] == pytest.approx(expected[k])
+        assert m.sensor(f"force:palm:{k}").id >= 0
+    assert m.npair == 5 + 2
+
+
+def test_a_foot_stands_on_an_edge_resting_flat_and_never_farther_than_its_bound():
+    """The feet of a square turned by any angle: the lowest foot's lowest point is the lowest corner's height, or
+    above it by at most ``r (1 / sin(45 deg) - 1)``; exactly at it when an edge rests flat."""
+    from qsplan.planner.replay.mujoco_scene import foot_centres
+
+    square = np.array([[0.0, 0.0], [0.05, 0.0], [0.05, 0.05], [0.0, 0.05]])
+    for reverse in (False, True):  # either vertex order
+        poly = square[::-1] if reverse else square
+        feet = foot_centres(poly)
+        for theta in np.linspace(-np.pi, np.pi, 73):
+            rot = np.array([[np.cos(theta), -np.sin(theta)], [np.sin(theta), np.cos(theta)]])
+            gap = (feet @ rot.T)[:, 1].min() - FOOT_RADIUS - (poly @ rot.T)[:, 1].min()
+            assert -1e-15 <= gap <= FOOT_RADIUS * (np.sqrt(2) - 1) + 1e-15
+            if abs(np.sin(2 * theta)) < 1e-12:
+                assert gap == pytest.approx(0.0, abs=1e-15)
 
 
 def test_start_keyframe_touches_where_the_plan_does(tmp_path):
@@ -90,9 +141,10 @@ def test_demo_replay_keeps_its_mode_at_friction_vertices(short_demo):
     assert len(r.runs) == 3 and r.engine.startswith("mujoco ")
     for run in r.runs:
         assert run.modes_kept, run.summary()
-        assert set(run.observed) == {"SSSS"} and not run.contacts_lost
+        assert set(run.observed) == {"SSSSBB"} and not run.contacts_lost  # the upper corners' feet stay open
         assert run.max_error() < 1e-5  # the servos' compliance: micrometres
-        assert np.all(run.normal_force > 0.05)  # the plan's force margin, kept in the mean
+        assert np.all(run.normal_force[:, :4] > 0.05)  # the plan's force margin, kept in the mean
+        assert np.all(run.normal_force[:, 4:] == 0.0)
 
 
 def test_replay_without_a_task_needs_plan_metadata(short_demo):
@@ -138,3 +190,29 @@ def test_cli_replays_every_vertex(short_demo, capsys):
     corners = np.array(np.meshgrid(*[[0.0, 0.2]] * 4)).reshape(4, -1).T
     assert {tuple(r["mu"]) for r in doc["runs"]} == {tuple(v) for v in corners}
     assert doc["settings"]["stops_added"] == 0
+
+
+@pytest.mark.slow
+def test_reorient_edge_lands_its_edge_on_two_feet(bundled_plan):
+    """Issue 32: ``reorient_edge_task`` pivots on vertex 1 until its edge 1 (vertices 1 -> 2) lies on the palm.  At
+    the pivot's last row the polygons show the made contact ``palm:2``; in MuJoCo vertex 2 has a foot, and over the
+    last rows its pair takes load beside ``palm:1``'s: the landed edge rests on two feet (without a foot under vertex
+    2 it would pass through the palm).  The replay keeps its modes at two friction vertices."""
+    pytest.importorskip("mujoco")
+    from qsplan.hands.contacts.found import contact_names, ordered_contacts
+    from qsplan.planner.replay.mujoco_replay import replay_mujoco
+
+    task = load_task(task_paths()["reorient_edge_task"])
+    out = bundled_plan("reorient_edge_task")
+    cols = read_plan_csv(out / "plan.csv")
+    pose = [cols[k][-1] for k in ("x_workpiece", "y_workpiece", "theta_workpiece")]
+    q = [cols[f"q_{n}"][-1] for n in task.hand.joint_names]
+    names = contact_names(task.hand, pose, ordered_contacts(task.hand, pose, q))
+    assert "palm:1" in names and "palm:2" in names  # the landed edge, as the certifier names its contacts
+    r = replay_mujoco(out, task=task, mu=[[0.0] * 4, [0.2] * 4])
+    for run in r.runs:
+        assert run.contacts[:4] == ("palm:0", "palm:1", "left", "right") and "palm:2" in run.contacts
+        assert run.ok, run.summary()
+        two, one = run.contacts.index("palm:2"), run.contacts.index("palm:1")
+        assert np.all(run.normal_force[:-2, two] < 0.01)  # off the palm until the last interval, where it lands
+        assert run.normal_force[-1, two] > 0.01 and run.normal_force[-1, one] > 0.01, run.normal_force[-3:]

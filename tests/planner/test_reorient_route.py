@@ -173,7 +173,7 @@ def test_tampered_turning_plans_are_refused(run, task, tmp_path, tamper, kind):
 @pytest.mark.slow
 def test_mujoco_keeps_the_turning_plans_modes(run):
     """The exported plan executed in MuJoCo (compliant contacts, inertia, a 1 kHz controller, no stop added) at the
-    friction box's two uniform corners: every row's planned letters on the scene's four contact pairs (the lifted
+    friction box's two uniform corners: every row's planned letters on the scene's contact pairs (the lifted
     vertex 0 open), the workpiece within 0.1 mm."""
     pytest.importorskip("mujoco")
     from qsplan.planner.replay.mujoco_replay import replay_mujoco
@@ -182,7 +182,8 @@ def test_mujoco_keeps_the_turning_plans_modes(run):
     for r in result.runs:
         assert r.modes_kept and not r.contacts_lost and r.max_error() < 1e-4
         pivot = r.phase == 2
-        assert set(r.planned[pivot][1:]) == {"BSSS"}  # palm:0 open on the pivot, the left finger's two contacts one pair
+        # palm:0 open on the pivot, the left finger's two contacts one pair, the upper feet (palm:2, palm:3) open
+        assert set(r.planned[pivot][1:]) == {"BSSSBB"}
 
 
 def test_the_pivot_with_the_left_finger_torque_controlled(task):
