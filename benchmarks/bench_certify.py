@@ -29,14 +29,14 @@ Run: ``python3 benchmarks/bench_certify.py [--repeat N] [--compare REV | --basel
 
 import argparse
 import os
-import shutil
 import subprocess
 import sys
 import tempfile
 import time
 from pathlib import Path
 
-ROOT = Path(__file__).resolve().parent.parent
+from revisions import export_revision
+
 
 #: Before issue 13's certifier and replay work (2-core machine shared with other jobs, one ``qsplan
 #: demo`` run timed in-process, the code at the commit before it): certification 16.7 s, the three
@@ -109,27 +109,6 @@ def _plots(plan, out):
     return figs
 
 
-def shadow_tree(rev, into: Path) -> Path:
-    """The repository at ``rev`` extracted under ``into``, and a folder to put first on ``PYTHONPATH`` whose
-    ``qsplan`` package maps its folders as ``pyproject.toml`` does (``qsplan.mechanics`` is ``mechanics/``, ...).
-    The compiled screen kernel, not in git, is copied from this tree when its source is the same."""
-    src = into / "tree"
-    src.mkdir()
-    archive = subprocess.run(["git", "-C", str(ROOT), "archive", rev], check=True, capture_output=True).stdout
-    subprocess.run(["tar", "-x", "-C", str(src)], input=archive, check=True)
-    pkg = into / "path" / "qsplan"
-    pkg.mkdir(parents=True)
-    for f in (src / "src" / "qsplan").iterdir():
-        (pkg / f.name).symlink_to(f)
-    for sub in ("mechanics", "hands", "planner"):
-        (pkg / sub).symlink_to(src / sub)
-    kernel = ROOT / "mechanics" / "solver"
-    if (kernel / "screen_kernel.c").read_bytes() == (src / "mechanics" / "solver" / "screen_kernel.c").read_bytes():
-        for so in kernel.glob("screen_kernel*.so"):
-            shutil.copy2(so, src / "mechanics" / "solver" / so.name)
-    return into / "path"
-
-
 def whole_commands(repeat, before, after, bytecode, work: Path):
     """``[(label, before s, after s)]``: each command's best of ``repeat`` runs, before and after interleaved.
     ``before``, ``after``: ``(python, extra environment)``."""
@@ -181,14 +160,14 @@ def main(argv=None):
         work = Path(tmp)
         if args.compare is not None:
             (work / "before").mkdir()
-            before = (sys.executable, {"PYTHONPATH": str(shadow_tree(args.compare, work / "before"))})
+            before = (sys.executable, {"PYTHONPATH": str(export_revision(args.compare, work / "before"))})
             said = f"git {args.compare}"
         else:
             before, said = (args.baseline, {}), args.baseline
         after, now = (sys.executable, {}), "this tree"
         if args.after is not None:
             (work / "after").mkdir()
-            after, now = (sys.executable, {"PYTHONPATH": str(shadow_tree(args.after, work / "after"))}), f"git {args.after}"
+            after, now = (sys.executable, {"PYTHONPATH": str(export_revision(args.after, work / "after"))}), f"git {args.after}"
         rows = whole_commands(args.repeat, before, after, args.bytecode, work)
     print(f"\nwhole commands, best of {args.repeat} (interleaved), before = {said}, after = {now}"
           f"{', bytecode cached' if args.bytecode else ', as the environment runs them'}")  # fmt: skip

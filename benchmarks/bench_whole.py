@@ -18,48 +18,19 @@ built with the C compiler when REV's source differs) and run by the same interpr
 import argparse
 import json
 import os
-import shutil
 import subprocess
 import sys
-import sysconfig
 import tempfile
 import time
 from pathlib import Path
 
-ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(Path(__file__).resolve().parent))
+
+from revisions import export_revision  # noqa: E402 (benchmarks/ on the path first)
 
 #: Issue 33's goals (s, whole command, on this 2-core machine) and its figures before (the issue's table).
 GOALS = {"demo": 2.0, "verify": 1.0, "plan reorient_task": 5.0, "modes n_c=20": 0.25}
 ISSUE_BEFORE = {"demo": "3.8-6.8", "verify": "2.2", "plan reorient_task": "13.9", "modes n_c=20": "0.29-0.39"}
-
-#: The compiled reduced screen of the mode search, relative to the package (``pyproject.toml``'s ext-module).
-_KERNEL = Path("mechanics") / "solver"
-
-
-def export_revision(rev: str, into: Path) -> Path:
-    """REV's package laid out as installed (``into/lib/qsplan``); returns the directory to put on ``PYTHONPATH``."""
-    tree = into / "tree"
-    tree.mkdir(parents=True)
-    archive = subprocess.run(["git", "-C", str(ROOT), "archive", rev, "src/qsplan", "mechanics", "hands", "planner"],
-                             check=True, capture_output=True).stdout  # fmt: skip
-    subprocess.run(["tar", "-x", "-C", str(tree)], input=archive, check=True)
-    lib = into / "lib"
-    package = lib / "qsplan"
-    shutil.copytree(tree / "src" / "qsplan", package)
-    for folder in ("mechanics", "hands", "planner"):
-        shutil.move(str(tree / folder), str(package / folder))
-    source = package / _KERNEL / "screen_kernel.c"
-    built = sorted((ROOT / _KERNEL).glob("screen_kernel*.so"))
-    if built and source.is_file() and source.read_bytes() == (ROOT / _KERNEL / "screen_kernel.c").read_bytes():
-        shutil.copy(built[0], package / _KERNEL / built[0].name)
-    elif source.is_file():  # REV's own kernel, built as setuptools would
-        suffix = sysconfig.get_config_var("EXT_SUFFIX")
-        cc = os.environ.get("CC", "cc")
-        subprocess.run([cc, "-O3", "-fno-math-errno", "-shared", "-fPIC", f"-I{sysconfig.get_paths()['include']}",
-                        str(source), "-o", str(package / _KERNEL / f"screen_kernel{suffix}")], check=True)  # fmt: skip
-    return lib
-
 
 def planted_scene(path: Path) -> None:
     """``benchmarks/bench_scale.py``'s planted scene with n_c = 20 (|tau_I| = 17) as a scene file."""

@@ -16,8 +16,9 @@ linear in ``(x, c_n, c_t, w, tau)`` once the coefficient's existence in the box 
 fits), and homogeneous in ``x``, so its strict inequalities (``v_n > 0``, ``+-v_t > 0``) may be written ``>= 1``.
 **Nothing moves** iff the rest is a solution (forces inside every friction cone of the box balance every load of
 the boxes: else the model has no solution and the workpiece accelerates) and none of the ``4^n_c`` assignments has a
-solution (every contact rolling is a motion only where ``[A; B]`` is rank deficient, which is refused).  Each is a small linear programme (:func:`solve_lp`,
-HiGHS); :func:`prove_friction_hold` asks each, every constraint **loosened** by :data:`SLACK` so that the
+solution (every contact rolling is a motion only where ``[A; B]`` is rank deficient, which is refused).  Each is a
+small linear programme (:func:`solve_lp`, HiGHS); :func:`prove_friction_hold` asks each, every constraint
+**loosened** by :data:`SLACK` so that the
 programme's own tolerances cannot hide a solution: an infeasible verdict is then one with room (conservative;
 a motion feasible only within the slack is reported as a witness, never as proved).
 
@@ -35,7 +36,7 @@ import numpy as np
 
 from qsplan.mechanics.bands.disturbance import check_wrench_box
 from qsplan.mechanics.bands.hold import MARGIN_CAP as HOLD_MARGIN_CAP
-from qsplan.mechanics.bands.hold import MARGIN_TOL, RANK_TOL, hold_matrix
+from qsplan.mechanics.bands.hold import MARGIN_TOL, RANK_TOL, hold_load, hold_matrix
 from qsplan.mechanics.errors import QsplanError
 
 __all__ = ["BEHAVIOURS", "SLACK", "FrictionHold", "prove_friction_hold"]
@@ -194,7 +195,7 @@ def prove_friction_hold(scene, mu_range, torques=None, disturbance=None, slack: 
     box = (np.zeros(3), np.zeros(3)) if wb is None else (np.array(wb.lo), np.array(wb.hi))
     A = hold_matrix(scene)
     B = np.hstack([scene.Wt.T, -scene.Jt[:, e]])
-    rest = _rest_margin(scene, mu[0], tau, box)
+    rest = _rest_margin(scene, mu[0], tau, np.zeros((1, 3)) if wb is None else wb.vertices())
     if not rest > MARGIN_TOL:
         return FrictionHold(False, f"the rest is not an equilibrium at every load of the box with the lowest friction "
                                    f"(margin {rest:.3g} N): the model has no solution there, and the workpiece "
@@ -224,7 +225,7 @@ def prove_friction_hold(scene, mu_range, torques=None, disturbance=None, slack: 
     return FrictionHold(True, "proved", programmes=count + 1, rest_margin=rest)
 
 
-def _rest_margin(scene, mu_lo, tau, box) -> float:
+def _rest_margin(scene, mu_lo, tau, wrenches) -> float:
     """The rest's margin (N): over the vertices of the wrench box and the ramp's ends, the least ``t`` such that
     forces exist balancing the load (eqs. 2-3 at zero motion) with every ``c_n >= t`` and ``mu_lo c_n - |c_t| >= t``
     (inside every friction cone of the box: the lowest coefficient is the narrowest cone; ``c_t = 0`` where it is 0,
@@ -239,29 +240,29 @@ def _rest_margin(scene, mu_lo, tau, box) -> float:
     M = np.vstack([np.hstack([scene.Wn, scene.Wt]), np.hstack([scene.Jn[:, e].T, scene.Jt[:, e].T])])
     sigma = np.linalg.svd(M, compute_uv=False)
     sigma_min = float(sigma[-1]) if sigma.size >= min(M.shape) and sigma[-1] > RANK_TOL * sigma[0] else 0.0
-    worst = np.inf
-    corners = list(product(*zip(box[0], box[1])))
-    for w in corners:
-        for t_e in (tau[0], tau[1]):
-            load = np.concatenate([-(scene.g_obj + np.asarray(w)), np.asarray(t_e) - scene.g_man[e]])
-            # variables (c_n, c_t, t): maximise t
-            n = 2 * n_c + 1
-            c = np.zeros(n)
-            c[-1] = -1.0
-            ub = []
-            for i in range(n_c):
+    # the programme over (c_n, c_t, t), the same at every vertex but for its load: maximise t
+    n = 2 * n_c + 1
+    c = np.zeros(n)
+    c[-1] = -1.0
+    ub = []
+    for i in range(n_c):
+        row = np.zeros(n)
+        row[i], row[-1] = -1.0, 1.0  # t <= c_n
+        ub.append(row)
+        if mu_lo[i] > 0:
+            for s in (1.0, -1.0):  # t <= mu_lo c_n - s c_t: inside the narrowest cone, with room
                 row = np.zeros(n)
-                row[i], row[-1] = -1.0, 1.0  # t <= c_n
+                row[i], row[n_c + i], row[-1] = -mu_lo[i], s, 1.0
                 ub.append(row)
-                if mu_lo[i] > 0:
-                    for s in (1.0, -1.0):  # t <= mu_lo c_n - s c_t: inside the narrowest cone, with room
-                        row = np.zeros(n)
-                        row[i], row[n_c + i], row[-1] = -mu_lo[i], s, 1.0
-                        ub.append(row)
-            A_eq = np.hstack([M, np.zeros((M.shape[0], 1))])
-            # a contact whose lowest coefficient is 0 pushes without friction (c_t = 0 exactly: no cone to be inside)
-            free = [(None, None)] * n_c + [(None, None) if m > 0 else (0.0, 0.0) for m in mu_lo]
-            r = solve_lp(c, np.array(ub), np.zeros(len(ub)), A_eq, load, bounds=free + [(None, HOLD_MARGIN_CAP)])
+    A_ub, A_eq = np.array(ub), np.hstack([M, np.zeros((M.shape[0], 1))])
+    # a contact whose lowest coefficient is 0 pushes without friction (c_t = 0 exactly: no cone to be inside)
+    bounds = [(None, None)] * n_c + [(None, None) if m > 0 else (0.0, 0.0) for m in mu_lo] + [(None, HOLD_MARGIN_CAP)]
+    worst = np.inf
+    for w in wrenches:
+        for t_e in tau:
+            p = hold_load(scene, t_e, w)  # (g_obj + w, tau - g_man,e): the forces balance (-(g_obj + w), tau - g_man,e)
+            load = np.concatenate([-p[:3], p[3:]])
+            r = solve_lp(c, A_ub, np.zeros(len(ub)), A_eq, load, bounds=bounds)
             if r.status != 0:
                 return -np.inf
             residual = float(np.linalg.norm(M @ r.x[:-1] - load))

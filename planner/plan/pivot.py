@@ -323,11 +323,12 @@ def held_interval(task, pose, q, effort):
     return scene, hold_torque_interval(scene, task.disturbance, margin=task.force_margin.normal)
 
 
-def hold_phase(task, name, pose, q, effort_joint, tau_from, tau_to, t0, formation: str) -> HoldPhase:
+def hold_phase(task, name, pose, q, effort_joint, tau_from, tau_to, t0, formation: str, held=None) -> HoldPhase:
     """A hold at one configuration: ``effort_joint``'s torque ramps from ``tau_from`` to ``tau_to`` (N m) at
     :data:`HOLD_TORQUE_RATE`, every other joint held; its band the proved hold interval (:func:`held_interval`).
     ``tau_from`` None: the joint is taken over at rest (the phase before had another effort joint) and starts one
-    torque resolution inside the proved interval.  ``formation``: the name the phase is recorded under.
+    torque resolution inside the proved interval.  ``formation``: the name the phase is recorded under.  ``held``:
+    :func:`held_interval` at this configuration with ``effort_joint`` torque-controlled, when the caller has it.
 
     Raises
     ------
@@ -338,7 +339,7 @@ def hold_phase(task, name, pose, q, effort_joint, tau_from, tau_to, t0, formatio
     from qsplan.planner.plan.failure import configuration_report
 
     effort = np.array(task.hand.joint_names) == effort_joint
-    scene, (lo, hi) = held_interval(task, pose, q, effort)
+    scene, (lo, hi) = held_interval(task, pose, q, effort) if held is None else held
     if tau_from is None:  # the effort joint taken over at rest: from a resolution inside the proved interval
         tau_from = float(min(lo + task.torque_resolution, tau_to)) if np.isfinite(lo) else float(tau_to)
     proofs = [prove_hold(scene, torques=[t], disturbance=task.disturbance) for t in (tau_from, tau_to)]

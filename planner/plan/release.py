@@ -86,13 +86,14 @@ def _release_hold(task, slide, t0):
     for joint in release_joint(task, slide):
         effort = np.array(task.hand.joint_names) == joint
         try:  # no hold proved with this joint (or its scene not built): the next one
-            lo, hi = held_interval(task, pose, q, effort)[1]
+            held = held_interval(task, pose, q, effort)
+            lo, hi = held[1]
             target = release_torque(lo, hi, task.torque_resolution)
             if not np.isfinite(target):
                 continue
             start = float(slide.command[-1]) if joint == slide.effort_joint else target
             hold = hold_phase(task, f"release hold at x = {pose[0]:.4g} m", pose, q, joint, start, target, t0,
-                              slide.formation)  # fmt: skip
+                              slide.formation, held=held)  # fmt: skip
         except (PlanFailure, QsplanError):
             continue
         # on the palm edge: the formation's contacts, named as the slide's rows name them

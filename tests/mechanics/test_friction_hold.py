@@ -37,7 +37,7 @@ EDGE = 0.02
 WITNESS_TOL = 1e-5
 
 
-def _pushed(height, push, pusher_mu=False):
+def _pushed(height, push):
     """The block on the floor under (-a, 0), (a, 0), its centre of mass at (0, a), pushed along +x at (-a, height)
     by a horizontal prismatic pusher with force ``push`` (N); contacts: floor left, floor right, pusher."""
     a = A_HALF

@@ -1,6 +1,6 @@
 """The bundled tasks planned once per test run (test helper).
 
-``plan_task`` of a bundled task is deterministic (the same plan, byte for byte, every run), so the tests that read a
+``plan_task`` of a bundled task is deterministic (the same plan every run in one environment), so the tests that read a
 bundled task's plan share one: :func:`planned` plans it the first time a test asks and returns the same
 :class:`~qsplan.planner.plan.results.Plan` afterwards, or raises the same
 :class:`~qsplan.planner.plan.results.PlanFailure` for a task without a plan.  Under pytest-xdist the workers of one

@@ -11,31 +11,15 @@
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 from qsplan.planner.plan.release import release_torque
 from qsplan.planner.search.widest import SearchGraph, least_effort, slide_efforts, slide_widths, widest_route
 
-#: The task of ``benchmarks/mujoco_tasks/two_link_right.toml``.
-TASK = """
-name = "two-link hand: the demo's quadrilateral 2 cm right, friction [0.05, 0.3]"
-[hand]
-file = "two_link_hand"
-workpiece = [[0.0, 0.0], [0.080, 0.0], [0.085, 0.080], [0.008, 0.100]]
-workpiece_mass = 0.2
-[motion]
-start_x = 0.0
-[goal]
-x = 0.02
-[friction]
-range = [0.05, 0.3]
-shared = false
-[controller]
-torque_resolution = 0.02
-[start]
-left_proximal = 1.4
-right_proximal = 1.74
-"""
+#: The task (``benchmarks/mujoco_tasks/two_link_right.toml``: the MuJoCo sweep's file, read, not copied).
+TASK = Path(__file__).resolve().parents[2] / "benchmarks" / "mujoco_tasks" / "two_link_right.toml"
 
 
 def test_release_torque_is_the_least_magnitude_a_resolution_inside():
@@ -140,12 +124,10 @@ def test_the_segment_takes_the_lightest_joint_of_equal_routes():
 @pytest.fixture(scope="module")
 def two_link_right(tmp_path_factory):
     """``(task, run)``: ``two_link_right`` planned, certified and exported (no plots, no re-simulation)."""
-    import tomllib
-
     from qsplan.planner.pipeline.run import run_plan
-    from qsplan.planner.task.task import task_from_record
+    from qsplan.planner.task.task import load_task
 
-    task = task_from_record(tomllib.loads(TASK))
+    task = load_task(TASK)
     run = run_plan(task, tmp_path_factory.mktemp("two_link_right") / "out", verify=0, plots="none")
     return task, run
 
