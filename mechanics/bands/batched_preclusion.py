@@ -104,16 +104,29 @@ def _vertices(bk: BatchKinematics, lo, hi) -> np.ndarray:
     return mu
 
 
+def _grouped(parts) -> list:
+    """``[(job indices, stacked arrays)]``: the jobs' arrays ``parts`` (one tuple per job) concatenated along the state
+    axis over the jobs whose arrays have one shape past it, in job order."""
+    groups = {}
+    for j, arrays in enumerate(parts):
+        groups.setdefault(tuple(a.shape[1:] for a in arrays), []).append(j)
+    return [(js, tuple(np.concatenate([parts[j][i] for j in js]) for i in range(len(parts[js[0]])))) for js in groups.values()]
+
+
 def _root_cells(jobs, lo, hi, shared: bool, box=None) -> list:
-    """Control values of the root cell and the rows at its friction points, per job ``(batch, bk)``:
-    ``(det (S, K), N0, N1 (S, K, R), s0, s1 (S, P, R), scale (S, P))``; with a wrench box ``box`` at each of its
-    vertices, wrench-major (:class:`qsplan.mechanics.bands.cells.FrictionCells`' order)."""
+    """Control values of the root cell and the rows at its friction points, the jobs ``(batch, bk)`` whose cells have
+    one shape stacked: ``[(job indices, (det (m, K), N0, N1 (m, K, R), s0, s1 (m, P, R), scale (m, P)))]``, ``m`` the
+    states of those jobs in job order; with a wrench box ``box`` at each of its vertices, wrench-major
+    (:class:`qsplan.mechanics.bands.cells.FrictionCells`' order).  Box friction stacks the jobs' rows before the
+    wrench vertices multiply them (elementwise: the same numbers, ``W`` times less to copy)."""
     loads = box is not None
     verts = None if box is None else box.vertices()
     if not shared:
-        rows = batch_rows_many([(b, bk, _vertices(bk, lo, hi)) for b, bk in jobs], loads=loads)
-        rows = rows if box is None else [wrench_vertex_rows(*r, verts) for r in rows]
-        return [(det, s0 * det[..., None], s1 * det[..., None], s0, s1, scale) for s0, s1, det, scale in rows]
+        out = []
+        for js, rows in _grouped(batch_rows_many([(b, bk, _vertices(bk, lo, hi)) for b, bk in jobs], loads=loads)):
+            s0, s1, det, scale = rows if box is None else wrench_vertex_rows(*rows, verts)
+            out.append((js, (det, s0 * det[..., None], s1 * det[..., None], s0, s1, scale)))
+        return out
     nodes = [shared_nodes(bk.mode, lo, hi) for _, bk in jobs]
     at_nodes = batch_rows_many([(b, bk, np.repeat(nd[:, None], b.n_c, axis=1)) for (b, bk), nd in zip(jobs, nodes)], loads=loads)
     a, b = np.array([lo]), np.array([hi])
@@ -140,11 +153,12 @@ def _root_cells(jobs, lo, hi, shared: bool, box=None) -> list:
             N0, N1, det_c, _ = wrench_vertex_rows(N0, N1, det_c, None, N2, verts)
             p0, p1, _, scale = wrench_vertex_rows(*point_rows, verts)
         out.append((det_c, N0, N1, p0, p1, scale))
-    return out
+    return _grouped(out)
 
 
-def _root_search(cell, lo_, hi_, flip, atol, tol):
-    """The first step of the per-state search at every state: ``(value, resolved)`` (S,) each."""
+def _root_search(cell, lo_, hi_, flip, atol, tol, wrenches=1):
+    """The first step of the per-state search at every state: ``(value, resolved)`` (S,) each (``wrenches``: the wrench
+    vertices of the cells' control points, :func:`~qsplan.mechanics.bands.preclusion.cell_lower_bounds`)."""
     det, N0, N1, pl, pu, pok = cell
     sign = -1.0 if flip else 1.0
     if flip:
@@ -152,34 +166,30 @@ def _root_search(cell, lo_, hi_, flip, atol, tol):
     lo2, hi2, at2 = lo_[:, None], hi_[:, None], atol[:, None]
     feas = pok & (pl <= pu) & (np.maximum(pl, lo2) <= np.minimum(pu, hi2) + at2)
     incumbent = np.min(np.where(feas, np.clip(pl, lo2, hi2), np.inf), axis=1)
-    lb, _ = cell_lower_bounds(det, N0, sign * N1, lo_, hi_, tol)
+    lb, _ = cell_lower_bounds(det, N0, sign * N1, lo_, hi_, tol, wrenches)
     possible = lb < np.inf
     done = possible & (lb >= np.minimum(incumbent, hi_) - atol)
     floor = np.where(done, lb, np.inf)
     return sign * np.minimum(incumbent, floor), ~(possible & ~done)
 
 
-def _root_searches(cells, gl, gh, atol, tol):
-    """Both searches of the root cell (the smallest possible effort, then the largest above it) for every job,
-    the jobs whose cells have one shape stacked: ``(low, upper, resolved)`` per job, (S,) each (``upper`` meaningful
-    where ``low`` is finite or ``-inf``, and the search resolved)."""
-    groups = {}
-    for j, (det, N0, _, s0, _, _) in enumerate(cells):
-        groups.setdefault((det.shape[1], N0.shape[2], s0.shape[1]), []).append(j)
-    out = [None] * len(cells)
-    for js in groups.values():
-        det, N0, N1, s0, s1, scale = (np.concatenate([cells[j][i] for j in js]) for i in range(6))
+def _root_searches(groups, gl, gh, atol, tol, wrenches=1):
+    """Both searches of the root cell (the smallest possible effort, then the largest above it) for every job, the
+    jobs whose cells have one shape stacked (:func:`_root_cells`' groups): ``(low, upper, resolved)`` per job, (S,)
+    each (``upper`` meaningful where ``low`` is finite or ``-inf``, and the search resolved)."""
+    out = [None] * len(gl)
+    for js, (det, N0, N1, s0, s1, scale) in groups:
         g_lo, g_hi, at = (np.concatenate([v[j] for j in js]) for v in (gl, gh, atol))
         m, P, R = s0.shape
         pl, pu, pok = point_bands(s0.reshape(-1, R), s1.reshape(-1, R), scale.reshape(-1), tol)
         cell = (det, N0, N1, pl.reshape(m, P), pu.reshape(m, P), pok.reshape(m, P))
-        low, ok1 = _root_search(cell, g_lo, g_hi, False, at, tol)
+        low, ok1 = _root_search(cell, g_lo, g_hi, False, at, tol, wrenches)
         # the largest possible effort, above the smallest: only where that exists (elsewhere the hull is empty or
         # the per-state search takes over, whatever this search says)
         more = ok1 & (low != np.inf)
         up, resolved = low.copy(), ok1.copy()
         if more.any():
-            neg_up, ok2 = _root_search(tuple(c[more] for c in cell), -g_hi[more], -low[more], True, at[more], tol)
+            neg_up, ok2 = _root_search(tuple(c[more] for c in cell), -g_hi[more], -low[more], True, at[more], tol, wrenches)
             up[more] = np.where(neg_up != -np.inf, neg_up, low[more])  # nothing above low within atol: the point low
             resolved[more] = ok2
         at_ = 0
@@ -242,7 +252,8 @@ def competitor_hulls(batch: StateBatch, kin: dict, comps, lo, hi, g_lo, g_hi, sh
     gl = [g_lo[live] for _, live in lives]
     gh = [g_hi[live] for _, live in lives]
     atol = [rtol * np.maximum(np.maximum(finite(a), finite(b)), 1.0) for a, b in zip(gl, gh)]
-    found = _root_searches(_root_cells(jobs, c_lo, c_hi, c_shared, box), gl, gh, atol, tol)
+    W = 1 if box is None else len(box.vertices())  # the cells' wrench vertices (cell_lower_bounds takes them so)
+    found = _root_searches(_root_cells(jobs, c_lo, c_hi, c_shared, box), gl, gh, atol, tol, W)
     for (c, live), (low, up, resolved), a, b in zip(lives, found, gl, gh):
         h = out[c]
         bounded = resolved & (low != np.inf)

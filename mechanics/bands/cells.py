@@ -60,6 +60,7 @@ class FrictionCells:
         n_c = scene.n_contacts
         self.n_c = n_c
         self.wfree = [] if box is None else list(box.free)
+        self.wrench_blocks = 2 ** len(self.wfree)  # the control points' wrench vertices (wrench-major blocks)
         wlo, whi = ([], []) if box is None else (np.array(box.lo)[self.wfree], np.array(box.hi)[self.wfree])
         if shared:
             nodes = shared_nodes(mk.mode, lo, hi)

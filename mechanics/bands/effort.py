@@ -310,21 +310,58 @@ def coulomb_columns(mode: ContactMode, idx, contact, mu_rows, sol) -> np.ndarray
     return np.stack(out, axis=-2)
 
 
+#: Rows x friction points from which :func:`intersect_rows` folds the rows column by column: numpy's reductions along
+#: a short last axis (a mode has 1 to 3 n_c rows) cost ~10x an elementwise pass per element, so large batches (the
+#: band tables': ~10^5) take r elementwise passes instead; small ones (a per-state search's cells) keep the fewer calls.
+#: Both give the same numbers (a maximum, a minimum and a conjunction do not depend on the order of their terms).
+#: (``np.putmask`` stands for ``np.where`` there: the same values, but no branch per element, which a mask as
+#: unpredictable as the rows' signs makes ~5x slower.)
+COLUMNS_FROM = 2048
+
+
 def intersect_rows(s0, s1, scale, tol: Tolerances):
     """Band edges of ``s0 + tau s1 >= 0`` over rows, per mu row: lower, upper, ok (N,).
 
-    ``s0, s1`` (N, r) and ``scale`` (N,) are :func:`band_rows`' output.
+    ``s0, s1`` (N, r) and ``scale`` (N,) are :func:`band_rows`' output.  A row the effort does not move (its slope at
+    most ``tol.force`` of the largest) bounds nothing and must hold as it is (within ``tol.force * scale``).  Edges
+    are never a negative zero (the same bits whatever the order the rows are folded in, :data:`COLUMNS_FROM`).
     """
     ftol = tol.force * scale[:, None]
-    big = np.max(np.abs(s1), axis=1, keepdims=True)
-    flat = np.abs(s1) <= tol.force * big  # effort does not move this row (relative to the mode's largest slope)
+    if s0.size < COLUMNS_FROM:
+        big = np.max(np.abs(s1), axis=1, keepdims=True)
+        flat = np.abs(s1) <= tol.force * big  # effort does not move this row (relative to the mode's largest slope)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            edge = -s0 / s1
+        lower = np.max(np.where(~flat & (s1 > 0), edge, -np.inf), axis=1)
+        upper = np.min(np.where(~flat & (s1 < 0), edge, np.inf), axis=1)
+        flat_ok = np.all(~flat | (s0 >= -ftol), axis=1)
+        ok = flat_ok & (lower <= upper) & np.all(np.isfinite(s0), axis=1)
+        return lower + 0.0, upper + 0.0, ok
+    return _intersect_columns(s0, s1, -ftol[:, 0], tol)
+
+
+def _intersect_columns(s0, s1, neg_ftol, tol: Tolerances):
+    """:func:`intersect_rows`' answer folded column by column (elementwise passes only; the same numbers)."""
+    a1 = np.abs(s1)
+    big = a1[:, 0]
+    for j in range(1, s1.shape[1]):
+        big = np.maximum(big, a1[:, j])
+    big = tol.force * big
+    lower, upper, ok = None, None, None
     with np.errstate(divide="ignore", invalid="ignore"):
-        edge = -s0 / s1
-    lower = np.max(np.where(~flat & (s1 > 0), edge, -np.inf), axis=1)
-    upper = np.min(np.where(~flat & (s1 < 0), edge, np.inf), axis=1)
-    flat_ok = np.all(~flat | (s0 >= -ftol), axis=1)
-    ok = flat_ok & (lower <= upper) & np.all(np.isfinite(s0), axis=1)
-    return lower, upper, ok
+        for j in range(s1.shape[1]):
+            c0, c1 = s0[:, j], s1[:, j]
+            moves = ~(a1[:, j] <= big)  # not flat (NaN slopes count as moving, as in intersect_rows)
+            lo_j = -c0 / c1  # the edge, kept where the row bounds from below (np.where's value, without its branches)
+            up_j = lo_j.copy()
+            np.putmask(lo_j, ~(moves & (c1 > 0)), -np.inf)
+            np.putmask(up_j, ~(moves & (c1 < 0)), np.inf)
+            ok_j = (moves | (c0 >= neg_ftol)) & np.isfinite(c0)
+            if j == 0:
+                lower, upper, ok = lo_j, up_j, ok_j
+            else:
+                lower, upper, ok = np.maximum(lower, lo_j), np.minimum(upper, up_j), ok & ok_j
+    return lower + 0.0, upper + 0.0, ok & (lower <= upper)
 
 
 def effort_bands(scene: Scene, mode: ContactMode, mu_rows, tol: Tolerances = DEFAULT_TOLERANCES, *, force_margin=None,

@@ -119,10 +119,18 @@ class CompetitorTorques:
     cells: int = 0
 
 
-def cell_lower_bounds(det, N0, N1, g_lo, g_hi, tol: Tolerances):
+def cell_lower_bounds(det, N0, N1, g_lo, g_hi, tol: Tolerances, wrenches: int = 1):
     """Smallest effort in ``[g_lo, g_hi]`` each cell may admit (inf: none), shape (m,).
 
     ``g_lo, g_hi``: floats, or arrays of shape (m,) (one interval per cell: the batched path).
+
+    ``wrenches``: the control points come in that many blocks, one per vertex of the cell's wrench part, wrench-major
+    (:class:`qsplan.mechanics.bands.cells.FrictionCells`' order), over which ``det`` and ``N1`` repeat (they do not
+    depend on the wrench, eq. 26).  Where ``det`` keeps its sign, every step of the per-row bound below is a
+    correctly rounded operation monotone in ``a = sgn(det) N0`` (a difference, then a quotient by a fixed slope), so
+    the smallest ``start`` and the largest ``end`` of a row over the blocks sit at the block where ``a`` is largest,
+    bit for bit: the bound is computed on each row's largest ``a`` over the blocks (``wrenches`` times fewer values;
+    the same answer as ``wrenches=1``).  The cells where ``det`` changes sign take every control point.
     """
     m, K, R = N0.shape
     g_lo, g_hi = (np.broadcast_to(np.asarray(g, dtype=float), (m,))[:, None] for g in (g_lo, g_hi))
@@ -138,11 +146,19 @@ def cell_lower_bounds(det, N0, N1, g_lo, g_hi, tol: Tolerances):
     with np.errstate(divide="ignore", invalid="ignore"):
         # --- det keeps its sign: per-row union of half-lines
         sg = np.where(neg, -1.0, 1.0)[:, None, None]
-        a, b = sg * N0, sg * N1
+        if wrenches > 1:  # each row's largest a over the wrench blocks (the docstring): the same bound
+            F = K // wrenches
+            a = sg * N0[:, :F]
+            for w in range(1, wrenches):
+                a = np.maximum(a, sg * N0[:, w * F : (w + 1) * F])
+            b = sg * N1[:, :F]
+        else:
+            a, b = sg * N0, sg * N1
         flat = np.abs(b) <= tol.force * bscale
-        edge = (-e - a) / b
-        start = np.where(~flat & (b > 0), edge, np.inf)  # [start, inf)
-        end = np.where(~flat & (b < 0), edge, -np.inf)  # (-inf, end]
+        start = (-e - a) / b  # [start, inf) where b > 0 (np.putmask: np.where's values without a branch per element)
+        end = start.copy()  # (-inf, end] where b < 0
+        np.putmask(start, flat | ~(b > 0), np.inf)
+        np.putmask(end, flat | ~(b < 0), -np.inf)
         lo_r = start.min(axis=1)  # (m, R)
         up_r = end.max(axis=1)
         whole = np.any(flat & (a >= -e), axis=1) | (up_r >= lo_r)
@@ -219,7 +235,7 @@ def _search(cells: FrictionCells, lo_, hi_, flip, atol, budget, tol):
         feas = pok & (pl <= pu) & (np.maximum(pl, lo_) <= np.minimum(pu, hi_) + atol)
         if feas.any():
             incumbent = min(incumbent, float(np.min(np.where(feas, np.clip(pl, lo_, hi_), np.inf))))
-        lb, steady = cell_lower_bounds(det, N0, sign * N1, lo_, hi_, tol)
+        lb, steady = cell_lower_bounds(det, N0, sign * N1, lo_, hi_, tol, cells.wrench_blocks)
         target = min(incumbent, hi_) - atol  # no proof needed above it: where a certificate's work ends
         if used > CERTIFY_AFTER and proofs < MAX_CERTIFICATES and np.any(steady & (lb < target)):
             lb, n = certified_lower_bounds(det, N0, sign * N1, lb, target, steady, tol, MAX_CERTIFICATES - proofs)
