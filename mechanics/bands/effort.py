@@ -324,7 +324,7 @@ def intersect_rows(s0, s1, scale, tol: Tolerances):
 
     ``s0, s1`` (N, r) and ``scale`` (N,) are :func:`band_rows`' output.  A row the effort does not move (its slope at
     most ``tol.force`` of the largest) bounds nothing and must hold as it is (within ``tol.force * scale``).  Edges
-    are never a negative zero (the same bits whatever the order the rows are folded in, :data:`COLUMNS_FROM`).
+    are never a negative zero, and NaN is numpy's own (:func:`_canonical`).
     """
     ftol = tol.force * scale[:, None]
     if s0.size < COLUMNS_FROM:
@@ -336,8 +336,14 @@ def intersect_rows(s0, s1, scale, tol: Tolerances):
         upper = np.min(np.where(~flat & (s1 < 0), edge, np.inf), axis=1)
         flat_ok = np.all(~flat | (s0 >= -ftol), axis=1)
         ok = flat_ok & (lower <= upper) & np.all(np.isfinite(s0), axis=1)
-        return lower + 0.0, upper + 0.0, ok
+        return _canonical(lower), _canonical(upper), ok
     return _intersect_columns(s0, s1, -ftol[:, 0], tol)
+
+
+def _canonical(edge):
+    """Band edges with one zero and one NaN (no negative zero, numpy's NaN): the same bits whichever order the rows
+    were folded in (:data:`COLUMNS_FROM`)."""
+    return np.where(np.isnan(edge), np.nan, edge + 0.0)
 
 
 def _intersect_columns(s0, s1, neg_ftol, tol: Tolerances):
@@ -361,7 +367,7 @@ def _intersect_columns(s0, s1, neg_ftol, tol: Tolerances):
                 lower, upper, ok = lo_j, up_j, ok_j
             else:
                 lower, upper, ok = np.maximum(lower, lo_j), np.minimum(upper, up_j), ok & ok_j
-    return lower + 0.0, upper + 0.0, ok & (lower <= upper)
+    return _canonical(lower), _canonical(upper), ok & (lower <= upper)
 
 
 def effort_bands(scene: Scene, mode: ContactMode, mu_rows, tol: Tolerances = DEFAULT_TOLERANCES, *, force_margin=None,

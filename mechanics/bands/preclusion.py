@@ -126,36 +126,43 @@ def cell_lower_bounds(det, N0, N1, g_lo, g_hi, tol: Tolerances, wrenches: int = 
 
     ``wrenches``: the control points come in that many blocks, one per vertex of the cell's wrench part, wrench-major
     (:class:`qsplan.mechanics.bands.cells.FrictionCells`' order), over which ``det`` and ``N1`` repeat (they do not
-    depend on the wrench, eq. 26).  Where ``det`` keeps its sign, every step of the per-row bound below is a
-    correctly rounded operation monotone in ``a = sgn(det) N0`` (a difference, then a quotient by a fixed slope), so
-    the smallest ``start`` and the largest ``end`` of a row over the blocks sit at the block where ``a`` is largest,
-    bit for bit: the bound is computed on each row's largest ``a`` over the blocks (``wrenches`` times fewer values;
-    the same answer as ``wrenches=1``).  The cells where ``det`` changes sign take every control point.
+    depend on the wrench, eq. 26).  Every quantity below is then a correctly rounded difference ``(+-e - N0)`` divided
+    by a slope the blocks share, reduced by a maximum or a minimum over the control points, or a comparison of ``N0``
+    with ``+-e``: each monotone in ``N0``, so its extreme over the blocks sits at the block where ``N0`` is largest or
+    smallest, bit for bit.  The bound is computed on each row's largest and smallest ``N0`` over the blocks (``e``,
+    the magnitudes' largest, too): ``wrenches`` times fewer values, the same answer as ``wrenches=1``.
     """
     m, K, R = N0.shape
     g_lo, g_hi = (np.broadcast_to(np.asarray(g, dtype=float), (m,))[:, None] for g in (g_lo, g_hi))
-    fin0, fin1 = np.isfinite(N0).reshape(m, K * R), np.isfinite(N1).reshape(m, K * R)  # per cell, flat: faster reductions
+    if wrenches > 1:  # each row's extremes over the wrench blocks (the docstring): the same bound
+        K //= wrenches
+        blocks = [N0[:, w * K : (w + 1) * K] for w in range(wrenches)]
+        hi0, lo0 = blocks[0], blocks[0]
+        for x in blocks[1:]:  # NaN and infinities kept (np.maximum and np.minimum propagate NaN)
+            hi0, lo0 = np.maximum(hi0, x), np.minimum(lo0, x)
+        N1 = N1[:, :K]
+    else:
+        hi0 = lo0 = N0
+    fin0 = (np.isfinite(hi0) & np.isfinite(lo0)).reshape(m, K * R)  # per cell, flat: faster reductions
+    fin1 = np.isfinite(N1).reshape(m, K * R)
     finite = np.all(np.isfinite(det), axis=1) & np.all(fin0, axis=1) & np.all(fin1, axis=1)
     pos, neg = np.all(det > 0, axis=1), np.all(det < 0, axis=1)
     steady = finite & (pos | neg)
     # the largest magnitudes (non-finite values counted as 0, so no NaN is left to skip: max, not nanmax)
-    e = tol.force * np.max(np.abs(np.where(fin0, N0.reshape(m, K * R), 0.0)), axis=1)[:, None, None]  # (m,1,1)
+    big = np.abs(np.where(fin0, hi0.reshape(m, K * R), 0.0))
+    if wrenches > 1:
+        big = np.maximum(big, np.abs(np.where(fin0, lo0.reshape(m, K * R), 0.0)))
+    e = tol.force * np.max(big, axis=1)[:, None, None]  # (m,1,1)
     e = np.maximum(e, 1e-300)
     bscale = np.max(np.abs(np.where(fin1, N1.reshape(m, K * R), 0.0)), axis=1)[:, None, None]
-    out = np.full(m, np.inf)
     with np.errstate(divide="ignore", invalid="ignore"):
-        # --- det keeps its sign: per-row union of half-lines
+        # --- det keeps its sign: per-row union of half-lines (np.putmask: np.where's values, without its branch per
+        # element, which masks as unpredictable as the rows' signs make ~5x slower)
         sg = np.where(neg, -1.0, 1.0)[:, None, None]
-        if wrenches > 1:  # each row's largest a over the wrench blocks (the docstring): the same bound
-            F = K // wrenches
-            a = sg * N0[:, :F]
-            for w in range(1, wrenches):
-                a = np.maximum(a, sg * N0[:, w * F : (w + 1) * F])
-            b = sg * N1[:, :F]
-        else:
-            a, b = sg * N0, sg * N1
+        a = sg * np.where(neg[:, None, None], lo0, hi0)  # sgn(det) N0, each row's largest over the wrench blocks
+        b = sg * N1
         flat = np.abs(b) <= tol.force * bscale
-        start = (-e - a) / b  # [start, inf) where b > 0 (np.putmask: np.where's values without a branch per element)
+        start = (-e - a) / b  # [start, inf) where b > 0
         end = start.copy()  # (-inf, end] where b < 0
         np.putmask(start, flat | ~(b > 0), np.inf)
         np.putmask(end, flat | ~(b < 0), -np.inf)
@@ -175,18 +182,23 @@ def cell_lower_bounds(det, N0, N1, g_lo, g_hi, tol: Tolerances, wrenches: int = 
         sub = np.flatnonzero(finite & ~steady)
         straddle_lb = np.full(m, np.inf)
         if sub.size:
-            a, b, e, bscale, gl, gh = N0[sub], N1[sub], e[sub], bscale[sub], g_lo[sub], g_hi[sub]
+            # N_r > e (Pos) asks it of the row's smallest N0, N_q < -e (Neg) of its largest
+            a_pos, a_neg, b, e, bscale, gl, gh = lo0[sub], hi0[sub], N1[sub], e[sub], bscale[sub], g_lo[sub], g_hi[sub]
             flat = np.abs(b) <= tol.force * bscale
             up_pos = ~flat & (b > 0)
             dn_pos = ~flat & (b < 0)
-            hi_k = (e - a) / b  # a + tau b > e: tau above it where b > 0, below where b < 0
-            p_lo = np.max(np.where(up_pos, hi_k, -np.inf), axis=1)  # (m, R)
-            p_up = np.min(np.where(dn_pos, hi_k, np.inf), axis=1)
-            p_up = np.where(np.any(flat & (a <= e), axis=1), -np.inf, p_up)
-            lo_k = (-e - a) / b  # a + tau b < -e: tau below it where b > 0, above where b < 0
-            n_lo = np.max(np.where(dn_pos, lo_k, -np.inf), axis=1)
-            n_up = np.min(np.where(up_pos, lo_k, np.inf), axis=1)
-            n_up = np.where(np.any(flat & (a >= -e), axis=1), -np.inf, n_up)
+            p_lo = (e - a_pos) / b  # a + tau b > e: tau above it where b > 0, below where b < 0
+            p_up = p_lo.copy()
+            np.putmask(p_lo, ~up_pos, -np.inf)
+            np.putmask(p_up, ~dn_pos, np.inf)
+            p_lo, p_up = p_lo.max(axis=1), p_up.min(axis=1)  # (m, R)
+            p_up = np.where(np.any(flat & (a_pos <= e), axis=1), -np.inf, p_up)
+            n_lo = (-e - a_neg) / b  # a + tau b < -e: tau below it where b > 0, above where b < 0
+            n_up = n_lo.copy()
+            np.putmask(n_lo, ~dn_pos, -np.inf)
+            np.putmask(n_up, ~up_pos, np.inf)
+            n_lo, n_up = n_lo.max(axis=1), n_up.min(axis=1)
+            n_up = np.where(np.any(flat & (a_neg >= -e), axis=1), -np.inf, n_up)
             E_lo = np.maximum(p_lo[:, :, None], n_lo[:, None, :])  # (m, R, R): Pos_r & Neg_q
             E_up = np.minimum(p_up[:, :, None], n_up[:, None, :])
             offdiag = ~np.eye(R, dtype=bool)[None]
