@@ -19,6 +19,12 @@ on a shared machine is noisy: take the best of several ``--repeat``.
 Usage, from the repository root::
 
     python3 benchmarks/bench_scale.py [--contacts 12 16 20] [--repeat 3] [--workers N] [--compare-upto 16]
+
+``--programmes`` prints instead, for the same rows, the breaking sets' equilibrium programmes
+(``mechanics/solver/breaking_sets.py``) solved in-process by HiGHS (the plain path, ``compiled=False``)
+and by the compiled kernel, without and with witnesses (the search's setting): programmes solved, best
+cpu seconds of ``--repeat``, sets kept and the modes in them (what the screen then visits).  Nothing
+there is asserted.
 """
 
 import argparse
@@ -71,6 +77,29 @@ def run_command(path: Path, workers):
     return elapsed, json.loads(proc.stdout), proc.stderr.strip()
 
 
+def programmes_table(rows, repeat: int, seed: int) -> int:
+    """The breaking-set programmes of each row: HiGHS against the compiled kernel, in-process, cpu seconds."""
+    from qsplan.mechanics.solver.breaking_sets import feasible_breaking_sets
+    from qsplan.mechanics.solver.search import modes_with_breaking_sets
+
+    print(f"breaking-set programmes (in-process, best cpu s of {repeat}), planted scenes, seed {seed}")
+    print(f"{'n_c':>4} {'|tau_I|':>7} {'solver':>9} {'witnesses':>9} {'programmes':>10} {'cpu s':>7} {'us each':>8} "
+          f"{'sets kept':>9} {'modes kept':>11}")  # fmt: skip
+    for n_c, n_e in rows:
+        scene, _ = bench_scene(n_c, n_e, seed)
+        for compiled in (False, True):
+            for witnesses in (False, True):
+                best = float("inf")
+                for _ in range(repeat):
+                    t = time.process_time()
+                    sets, solved = feasible_breaking_sets(scene, witnesses=witnesses, compiled=compiled)
+                    best = min(best, time.process_time() - t)
+                modes = modes_with_breaking_sets(n_c, scene.dof, sets)
+                print(f"{n_c:>4} {n_e:>7} {'compiled' if compiled else 'HiGHS':>9} {str(witnesses):>9} {solved:>10} "
+                      f"{best:>7.3f} {1e6 * best / max(solved, 1):>8.0f} {len(sets):>9} {modes:>11}", flush=True)  # fmt: skip
+    return 0
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--contacts", type=int, nargs="+", help="n_c values (|tau_I| = n_c - 3); default 12 16 20")
@@ -78,8 +107,11 @@ def main(argv=None) -> int:
     ap.add_argument("--workers", type=int, default=None, help="passed to qsplan modes (default: all cores)")
     ap.add_argument("--compare-upto", type=int, default=16, help="compare with solve(search='all') up to this n_c")
     ap.add_argument("--seed", type=int, default=SEED)
+    ap.add_argument("--programmes", action="store_true", help="the breaking-set programmes, HiGHS and compiled")
     args = ap.parse_args(argv)
     rows = [(n, n - 3) for n in args.contacts] if args.contacts else DEFAULT_ROWS
+    if args.programmes:
+        return programmes_table(rows, args.repeat, args.seed)
 
     print(f"qsplan modes FILE --json --stats (subprocess, best of {args.repeat}), planted scenes, seed {args.seed}, "
           f"{os.cpu_count()} cores")  # fmt: skip

@@ -22,6 +22,7 @@ from qsplan.mechanics.modes.contact_mode import count_modes
 from qsplan.mechanics.numerics import DEFAULT_TOLERANCES, Tolerances
 from qsplan.mechanics.solver.batch import DEFAULT_BATCH, solve_batches
 from qsplan.mechanics.solver.result import SolveResult
+from qsplan.mechanics.solver.screen import compiled_relax
 from qsplan.mechanics.solver.search import all_breaking_sets, screen_all_seconds, search_solve
 
 __all__ = ["SEARCH_MIN_MODES", "AUTO_PROGRAMME_SHARE", "MODE_SECONDS_PER_CONSTRAINT", "PROGRAMME_SECONDS",
@@ -38,9 +39,11 @@ SEARCH_MIN_MODES = 20_000
 #: dof = 4 (n_c = 12), 6.3 us at dof = 6 (n_c = 16), 17 us at dof = 12 (n_c = 12).
 MODE_SECONDS_PER_CONSTRAINT = 1.4e-6
 
-#: Seconds of one breaking-set programme (highspy, warm-started): 0.19-0.95 ms measured at n_c = 12-16,
-#: ~0.3 ms at n_c = 20.
-PROGRAMME_SECONDS = 4e-4
+#: Seconds of one breaking-set programme, with the level's joins and witness checks around it: with
+#: the compiled kernel 20-35 us measured at n_c = 12, 35-55 us at n_c = 16, 65-100 us at n_c = 20
+#: (planted scenes, dof = n_c); with highspy alone (warm-started) 0.19-0.95 ms at n_c = 12-16, ~0.3 ms
+#: at n_c = 20.
+PROGRAMME_SECONDS = 1e-4 if compiled_relax is not None else 4e-4
 
 #: Seconds of screening every mode (no programme) under which ``search="auto"`` does so: the
 #: programmes would cost about as much (importing highspy alone takes ~13 ms, the first levels'

@@ -28,6 +28,16 @@ singular.  (The tolerance relative to ``F`` is not a convex condition: a
 programme with ``F`` as a variable can always make ``F`` large enough to accept
 anything, so some cap is needed.)  HiGHS's own tolerances only loosen the
 programme further.
+
+The programmes are solved by the compiled kernel (``relax`` in ``screen_kernel.c``, ~65 us a set
+at n_c = 20 against ~0.4 ms with HiGHS) when it is built: Phase 1 of a small dense simplex on
+the cones written with nonnegative columns (:meth:`EquilibriumRelaxation.columns`).  It decides
+nothing on trust: a set is kept when the basic solution, recomputed from the data, balances the
+loads within :data:`RELAX_RESIDUAL`, and pruned only when its last multipliers pass as a Farkas
+certificate checked from the data: every force in the widened cones that balances the loads
+would need normal forces summing to more than :data:`PROOF_RATIO` times the largest load (beyond
+:data:`FORCE_RATIO`'s cap above).  Any other outcome falls back to HiGHS (``compiled=False``:
+HiGHS for every set, the reference).
 """
 
 from __future__ import annotations
@@ -39,11 +49,19 @@ from qsplan.mechanics.numerics import DEFAULT_TOLERANCES, Tolerances
 from qsplan.mechanics.parallel import chunk_count, map_chunks, split_range
 from qsplan.mechanics.model.scene import Scene
 from qsplan.mechanics.quiet import quiet_highs
+from qsplan.mechanics.solver.screen import compiled_relax
 
 __all__ = [
     "CONE_WIDENING",
     "FORCE_RATIO",
+    "PROOF_RATIO",
+    "RELAX_RESIDUAL",
+    "RELAX_PIVOTS_PER_ROW",
+    "RELAX_PRICE_TOL",
+    "RELAX_PIVOT_TOL",
+    "CERTIFICATE_MARGIN",
     "MIN_LP_CHUNK",
+    "MIN_COMPILED_CHUNK",
     "MAX_LEVEL_SETS",
     "WITNESS_ZERO",
     "EquilibriumRelaxation",
@@ -65,6 +83,40 @@ FORCE_RATIO = 1e6
 #: Fewest candidate breaking sets (one programme of ~0.5 ms each with highspy) worth a chunk in
 #: another process (~0.1 s of work, several times a local pool's start-up).
 MIN_LP_CHUNK = 200
+
+#: The same with the compiled kernel (~65 us a set at n_c = 20): ~0.3 s of work a chunk.
+MIN_COMPILED_CHUNK = 5000
+
+#: The compiled programme's proof of infeasibility: a Farkas certificate whose rounding-level
+#: violations (~1e-15) would let only forces with normal components summing to more than this many
+#: times the largest load balance the loads.  1e9 is ``1 / Tolerances.force``'s default: at such
+#: forces the reference's own Coulomb tolerance (``tol.force * F``) is as large as the loads, so its
+#: verdict there means nothing (and it is 1e3 times :data:`FORCE_RATIO`, whose argument already sets
+#: aside modes with forces over 1e6 loads).  Measured at n_c = 20: the certificates of nearly feasible
+#: sets (margin ~3e-4 of the loads) prove 1e10-1e11; none fell short of 1e9.
+PROOF_RATIO = 1e9
+
+#: Largest equilibrium residual (in units of the largest load, as the rows) of a basic solution the
+#: compiled programme calls feasible: 1e-9, far above its rounding (~1e-14 measured at n_c = 20) and
+#: far below the widening (4e-3); calling a set feasible only keeps it, which is always safe.
+RELAX_RESIDUAL = 1e-9
+
+#: The compiled programme gives up (HiGHS decides) after this many pivots per equilibrium row:
+#: measured ~1-2 per row; the cap only guards against cycling that Bland's rule did not break.
+RELAX_PIVOTS_PER_ROW = 50
+
+#: A column enters the compiled programme's basis when it lowers the phase-1 objective by more than
+#: this per unit of its norm: above the rounding of a dot product of O(1) terms (~1e-15), and small
+#: enough that the multipliers left violate the certificate by no more (see :data:`PROOF_RATIO`).
+RELAX_PRICE_TOL = 1e-11
+
+#: Entries of a basis direction smaller than this are not pivots of the compiled programme (the
+#: ratio test skips them): same order as :data:`RELAX_PRICE_TOL`, for the same reason.
+RELAX_PIVOT_TOL = 1e-11
+
+#: A Farkas certificate's margin must exceed its rounding: this times ``|y|_1 max(1, |r|_inf)``,
+#: some 1e6 above the rounding of the dot products it sums.
+CERTIFICATE_MARGIN = 1e-9
 
 
 #: With ``witnesses``, a force "vanishes" at a contact when both its components are within this
@@ -121,6 +173,47 @@ class EquilibriumRelaxation:
         self.A_ub = rows.reshape(3 * n, 2 * n)
         w = CONE_WIDENING * max(1.0, float(np.max(scene.mu, initial=0.0))) * tol.force * FORCE_RATIO
         self.b_ub = np.full(3 * n, w)
+        self.mu = np.asarray(scene.mu, dtype=float)
+        self._columns = None
+
+    def columns(self) -> dict:
+        """The widened cones with nonnegative columns, for the compiled programme (cached).
+
+        Every widened cone ``{c_n >= -w, |c_t| <= w + mu c_n}`` is exactly ``base + z_1 (1, mu) +
+        z_2 (1, -mu) + z_3 (0, 1)``, ``z >= 0``: for ``mu < 1`` with ``base = (-w, -w (1 - mu))``
+        (a corner) and ``z_3 <= 2 w (1 - mu)`` (the segment ``c_n = -w``); for ``mu >= 1`` the row
+        ``c_n >= -w`` is implied, ``base = (-w / mu, 0)`` (the apex) and there is no ``z_3``.
+
+        Returns
+        -------
+        dict of contiguous arrays: ``G`` (N, dof) the columns' equilibrium rows, ``ub`` (N,)
+        (inf: none), ``gnorm`` (N,), ``owner`` (N,) int32 contacts, ``dir`` (N, 2) the force per
+        unit, ``shift`` (n_c, dof) each base's rows, ``base`` (n_c, 2), ``b`` (dof,).
+        """
+        if self._columns is None:
+            n, w, mu = self.n_contacts, float(self.b_ub[0]) if self.b_ub.size else 0.0, self.mu
+            wide = mu >= 1.0
+            base = np.where(wide[:, None], np.stack([-w / np.maximum(mu, 1.0), 0.0 * mu], 1),
+                            np.stack([-w + 0.0 * mu, -w * (1.0 - mu)], 1))  # fmt: skip
+            owner, dirs, ub = [], [], []
+            for i in range(n):
+                owner += [i, i]
+                dirs += [(1.0, mu[i]), (1.0, -mu[i])]
+                ub += [np.inf, np.inf]
+                if not wide[i]:
+                    owner.append(i)
+                    dirs.append((0.0, 1.0))
+                    ub.append(2.0 * w * (1.0 - mu[i]))
+            owner = np.array(owner, dtype=np.int32)
+            dirs = np.array(dirs, dtype=float).reshape(-1, 2)
+            En, Et = self.A_eq[:, 0::2], self.A_eq[:, 1::2]
+            G = np.ascontiguousarray((En[:, owner] * dirs[:, 0] + Et[:, owner] * dirs[:, 1]).T)
+            self._columns = dict(
+                G=G, ub=np.array(ub, dtype=float), gnorm=np.maximum(np.linalg.norm(G, axis=1), 1e-300), owner=owner,
+                dir=np.ascontiguousarray(dirs), shift=np.ascontiguousarray((En * base[:, 0] + Et * base[:, 1]).T),
+                base=np.ascontiguousarray(base), b=np.ascontiguousarray(self.b_eq, dtype=float),
+            )  # fmt: skip
+        return self._columns
 
 
 def equilibrium_relaxation(scene: Scene, tol: Tolerances = DEFAULT_TOLERANCES) -> EquilibriumRelaxation:
@@ -200,10 +293,35 @@ def admits_equilibrium(rel: EquilibriumRelaxation, breaking) -> bool:
     return _Programme(rel)(breaking)
 
 
+def _decide(rel: EquilibriumRelaxation, sets, compiled: bool) -> list:
+    """``(admits, force or None)`` of every set: the compiled programme first (when ``compiled``), HiGHS
+    for the sets it leaves undecided (and for all of them without it)."""
+    if rel.trivial:  # c = 0 balances the loads: every set admits it (no programme, no HiGHS import)
+        return [(True, np.zeros(2 * rel.n_contacts)) for _ in sets]
+    out = [None] * len(sets)
+    if compiled and sets:
+        cols, n = rel.columns(), rel.n_contacts
+        masks = np.zeros((len(sets), n), dtype=np.uint8)
+        masks[np.repeat(np.arange(len(sets)), [len(B) for B in sets]), [i for B in sets for i in B]] = 1
+        raw, forces = compiled_relax(
+            cols["G"], cols["ub"], cols["gnorm"], cols["owner"], cols["dir"], cols["shift"], cols["base"], cols["b"],
+            masks, n, cols["G"].shape[1], cols["G"].shape[0], RELAX_PIVOTS_PER_ROW * cols["G"].shape[1],
+            RELAX_PRICE_TOL, RELAX_PIVOT_TOL, RELAX_RESIDUAL, CERTIFICATE_MARGIN, PROOF_RATIO,
+        )  # fmt: skip
+        status = np.frombuffer(raw, dtype=np.int8)
+        forces = np.frombuffer(forces, dtype=float).reshape(len(sets), 2 * n)
+        for k, st in enumerate(status):
+            if st >= 0:
+                out[k] = (True, forces[k].copy()) if st == 1 else (False, None)
+    if any(v is None for v in out):
+        programme = _Programme(rel)
+        out = [programme.solve(B) if v is None else v for B, v in zip(sets, out)]
+    return out
+
+
 def _lp_chunk(job):
-    rel, sets = job
-    programme = _Programme(rel)
-    return [programme.solve(s) for s in sets]
+    rel, sets, compiled = job
+    return _decide(rel, sets, compiled)
 
 
 def breaking_set_sizes(n_c: int, dof: int) -> tuple[int, int]:
@@ -230,12 +348,13 @@ def _candidates(level: list[tuple], feasible: set, cap: int) -> list[tuple] | No
     return out
 
 
-def _check_sets(rel, sets, workers, scheduler) -> list:
+def _check_sets(rel, sets, workers, scheduler, compiled=False) -> list:
     """``(admits, force or None)`` of every set, on local processes or a cluster when there are many."""
-    n_chunks = chunk_count(len(sets), MIN_LP_CHUNK, workers=workers, scheduler=scheduler)
+    least = MIN_COMPILED_CHUNK if compiled else MIN_LP_CHUNK
+    n_chunks = chunk_count(len(sets), least, workers=workers, scheduler=scheduler)
     if n_chunks == 1 and scheduler is None:
-        return _lp_chunk((rel, sets))
-    jobs = [(rel, sets[lo:hi]) for lo, hi in split_range(len(sets), n_chunks)]
+        return _decide(rel, sets, compiled)
+    jobs = [(rel, sets[lo:hi], compiled) for lo, hi in split_range(len(sets), n_chunks)]
     return [ok for part in map_chunks(_lp_chunk, jobs, workers=workers, scheduler=scheduler) for ok in part]
 
 
@@ -257,7 +376,8 @@ def _witnessed(cands: list, vanish: list) -> np.ndarray:
 
 
 def feasible_breaking_sets(scene: Scene, tol: Tolerances = DEFAULT_TOLERANCES, *, workers=1, scheduler=None,
-                           max_programmes: int | None = None, witnesses: bool = False, on_level=None):  # fmt: skip
+                           max_programmes: int | None = None, witnesses: bool = False, on_level=None,
+                           compiled: bool | None = None):  # fmt: skip
     """Breaking sets of the scene's modes that admit equilibrium, level by level (Apriori).
 
     Parameters
@@ -276,6 +396,11 @@ def feasible_breaking_sets(scene: Scene, tol: Tolerances = DEFAULT_TOLERANCES, *
     on_level : callable, optional
         ``on_level(sets)`` with each level's sets as soon as they are known (sizes of the scene's
         modes only), so that their modes can be screened while the next level's programmes run.
+    compiled : bool or None
+        Solve the programmes with the compiled kernel, HiGHS only for those it leaves undecided
+        (None: when it is built); False: HiGHS for every set, the reference.  Both prune only
+        sets proven infeasible (module docstring); they may differ on sets HiGHS leaves undecided
+        (kept).
 
     Returns
     -------
@@ -288,8 +413,9 @@ def feasible_breaking_sets(scene: Scene, tol: Tolerances = DEFAULT_TOLERANCES, *
     n_c, dof = scene.n_contacts, scene.dof
     lo, hi = breaking_set_sizes(n_c, dof)
     rel = equilibrium_relaxation(scene, tol)
+    compiled = compiled_relax is not None if compiled is None else bool(compiled and compiled_relax is not None)
     zero = WITNESS_ZERO * float(rel.b_ub[0]) if rel.b_ub.size else 0.0
-    ok, force = _Programme(rel).solve(())
+    ok, force = _decide(rel, [()], compiled)[0]
     level, programmes, out = [()], 1, []
     vanish = [_vanishing(force, zero)] if witnesses and force is not None else []
     if not ok:
@@ -319,7 +445,7 @@ def feasible_breaking_sets(scene: Scene, tol: Tolerances = DEFAULT_TOLERANCES, *
         todo = [c for c, k in zip(cands, known) if not k]
         if max_programmes is not None and programmes + len(todo) > max_programmes:
             return None, programmes
-        verdicts = dict(zip(todo, _check_sets(rel, todo, workers, scheduler))) if todo else {}
+        verdicts = dict(zip(todo, _check_sets(rel, todo, workers, scheduler, compiled))) if todo else {}
         programmes += len(todo)
         level = [c for c, k in zip(cands, known) if k or verdicts[c][0]]
         if witnesses:

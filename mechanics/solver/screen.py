@@ -33,14 +33,15 @@ from qsplan.mechanics.model.scene import Scene
 from qsplan.mechanics.numerics import Tolerances, hadamard_ratio
 
 #: The interface of ``screen_kernel.c`` this module calls (its ``ABI``): a stale build is not used.
-KERNEL_ABI = 1
+#: 2: ``relax``, the breaking sets' equilibrium relaxation (:mod:`qsplan.mechanics.solver.breaking_sets`).
+KERNEL_ABI = 2
 
 try:  # compiled by `pip install .`; the numpy reference below when it is missing
-    from qsplan.mechanics.solver.screen_kernel import ABI as _built_abi, screen as compiled_screen
-except ImportError:  # pragma: no cover - a build without a C compiler
-    compiled_screen, _built_abi = None, None
+    from qsplan.mechanics.solver.screen_kernel import ABI as _built_abi, relax as compiled_relax, screen as compiled_screen
+except ImportError:  # pragma: no cover - a build without a C compiler (or one older than ``relax``)
+    compiled_screen, compiled_relax, _built_abi = None, None, None
 if _built_abi != KERNEL_ABI:  # pragma: no cover - an editable install not rebuilt after a change
-    compiled_screen = None
+    compiled_screen = compiled_relax = None
 
 __all__ = [
     "KEEP",

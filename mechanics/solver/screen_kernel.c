@@ -36,6 +36,8 @@ typedef struct {
     int *A, *Bc, *rolling;
     double *Z, *x0, *TZ, *tx, *tznorm;   /* Z (dof, r), TZ (nA, r) */
     double *NB, *y0, c0norm2;            /* null basis (2nA, nS), particular force (2nA), its norm^2 */
+    double *KS, *hS, *KSnorm;            /* per sign (xi = +1 then -1) and contact of A: the row c_t + mu xi c_n
+                                          * of the sliding system in w (nS), its right-hand side, 1 / its norm */
     /* depth-first elimination: per level, rows (nA + b) x r coefficients and constants, the row chosen,
      * its pivot column, and the coordinate of u each free column stands for */
     int rows;
@@ -253,6 +255,19 @@ static void setup_equilibrium(Ctx *c)
     for (int j = 0; j < m2; j++)
         c->c0norm2 += c->y0[j] * c->y0[j];
     null_basis(Q2, c->beta, m2, dof, c->NB, tmp);
+    int nS = c->nS;
+    for (int sg = 0; sg < 2; sg++)
+        for (int s = 0; s < nA; s++) {
+            double mx = c->mu[c->A[s]] * (sg == 0 ? 1.0 : -1.0), nn = 0.0;
+            const double *Nn = c->NB + (size_t)s * nS, *Nt = c->NB + (size_t)(nA + s) * nS;
+            double *row = c->KS + ((size_t)sg * nA + s) * nS;
+            for (int q = 0; q < nS; q++) {
+                row[q] = Nt[q] + mx * Nn[q];
+                nn += row[q] * row[q];
+            }
+            c->hS[sg * nA + s] = -(c->y0[nA + s] + mx * c->y0[s]);
+            c->KSnorm[sg * nA + s] = nn > 0 ? 1.0 / sqrt(nn) : 0.0;
+        }
     c->eq_ok = 1;
 }
 
@@ -262,6 +277,7 @@ static int coulomb_prunes(Ctx *c, const double *u)
     int nA = c->nA, r = c->r, nS = c->nS;
     double *K = c->K, *h = c->h;
     int k = 0;
+    double ratio = 1.0;
     for (int s = 0; s < nA; s++) {
         if (c->rolling[s])
             continue;
@@ -270,23 +286,15 @@ static int coulomb_prunes(Ctx *c, const double *u)
             vt += c->TZ[s * r + q] * u[q];
         if (!(fabs(vt) > c->slip))
             return 0; /* xi (eq. 16) not certain: the reference decides */
-        double mx = c->mu[c->A[s]] * (vt > 0 ? 1.0 : -1.0);
-        const double *Nn = c->NB + (size_t)s * nS, *Nt = c->NB + (size_t)(nA + s) * nS;
-        for (int q = 0; q < nS; q++)
-            K[k * nS + q] = Nt[q] + mx * Nn[q];
-        h[k] = -(c->y0[nA + s] + mx * c->y0[s]);
+        int at = (vt > 0 ? 0 : nA) + s;
+        if (c->KSnorm[at] == 0.0)
+            return 0;
+        memcpy(K + (size_t)k * nS, c->KS + (size_t)at * nS, sizeof(double) * nS);
+        h[k] = c->hS[at];
+        ratio *= c->KSnorm[at];
         k++;
     }
     /* one LU with partial pivoting: the determinant for the guard, then the solve */
-    double ratio = 1.0;
-    for (int i = 0; i < nS; i++) {
-        double nn = 0.0;
-        for (int q = 0; q < nS; q++)
-            nn += K[i * nS + q] * K[i * nS + q];
-        if (nn == 0.0)
-            return 0;
-        ratio /= sqrt(nn);
-    }
     for (int j = 0; j < nS; j++) {
         int p = j;
         double best = fabs(K[j * nS + j]);
@@ -458,15 +466,46 @@ static int descend(Ctx *c, int j, int last, double ratio)
         }
         return 0;
     }
-    if (f == 2) { /* the leaves in pairs (i, l): a 2 x 2 system fixes the last two coordinates (Cramer) */
+    if (f == 2) { /* the leaves in pairs (i, l): row l cuts line i (row i = 0) at its vertex */
         const double *cB = coef + (size_t)nA * r, *dB = cst + nA;
         const int *cm = c->colmap + (size_t)j * r;
         double vm = c->vmargin;
         for (int i = last + 1; i < nA - 1; i++) {
             double a0 = coef[(size_t)i * r], a1 = coef[(size_t)i * r + 1], ci = cst[i];
-            double ri = ratio * c->inv_tznorm[i];
+            double ri = ratio * c->inv_tznorm[i], aa = a0 * a0 + a1 * a1;
+            /* line i: t = p + s d, p = -ci a / |a|^2, d = (-a1, a0); v_n >= -vmargin on all of B (eq. 15)
+             * <=> lo <= s <= hi, as at f == 1.  (|a| = 0: every pair below is singular, emitted untested.) */
+            double p0 = aa > 0 ? -ci * a0 / aa : 0.0, p1 = aa > 0 ? -ci * a1 / aa : 0.0, lo = -INFINITY, hi = INFINITY;
+            for (int k = 0; k < b; k++) {
+                double c0 = cB[(size_t)k * r], c1 = cB[(size_t)k * r + 1];
+                double ck = a0 * c1 - a1 * c0, dk = dB[k] + vm + c0 * p0 + c1 * p1, tk = -dk / ck;
+                if (ck > 0)
+                    lo = tk > lo ? tk : lo;
+                else if (ck < 0)
+                    hi = tk < hi ? tk : hi;
+                else if (dk < 0)
+                    lo = INFINITY; /* every vertex on the line penetrates */
+            }
             c->rolling[i] = 1;
             c->n_total += nA - 1 - i;
+            if (!(lo <= hi)) { /* no vertex on line i keeps B out of penetration: only the untrusted pairs stay */
+                for (int l = i + 1; l < nA; l++) {
+                    double det = a0 * coef[(size_t)l * r + 1] - a1 * coef[(size_t)l * r];
+                    if (ri * fabs(det) * c->inv_tznorm[l] >= c->red_sing) {
+                        c->n_kin++;
+                        continue;
+                    }
+                    c->rolling[l] = 1;
+                    int rc = emit(c);
+                    c->rolling[l] = 0;
+                    if (rc) {
+                        c->rolling[i] = 0;
+                        return rc;
+                    }
+                }
+                c->rolling[i] = 0;
+                continue;
+            }
             for (int l = i + 1; l < nA; l++) {
                 double b0 = coef[(size_t)l * r], b1 = coef[(size_t)l * r + 1], cl = cst[l];
                 double det = a0 * b1 - a1 * b0, rat = ri * fabs(det) * c->inv_tznorm[l];
@@ -476,16 +515,13 @@ static int descend(Ctx *c, int j, int last, double ratio)
                     rc = emit(c);
                     c->rolling[l] = 0;
                 } else {
-                    double id = 1.0 / det, t0 = (a1 * cl - b1 * ci) * id, t1 = (b0 * ci - a0 * cl) * id;
-                    int k = 0;
-                    while (k < b && !(dB[k] + cB[(size_t)k * r] * t0 + cB[(size_t)k * r + 1] * t1 < -vm))
-                        k++;
-                    if (k < b) {
+                    double sv = -(b0 * p0 + b1 * p1 + cl) / det; /* b.(p + s d) + cl = 0, b.d = det */
+                    if (sv < lo || sv > hi) {
                         c->n_kin++;
                     } else {
                         c->rolling[l] = 1;
-                        c->u[cm[0]] = t0;
-                        c->u[cm[1]] = t1;
+                        c->u[cm[0]] = p0 - sv * a1;
+                        c->u[cm[1]] = p1 + sv * a0;
                         vertex(c, j - 1, c->u);
                         rc = survivor(c, c->u);
                         c->rolling[l] = 0;
@@ -605,6 +641,9 @@ static PyObject *screen(PyObject *self, PyObject *args)
     c.tx = malloc(d * nc);
     c.tznorm = malloc(d * nc);
     c.NB = malloc(d * 2 * nc * 2 * nc);
+    c.KS = malloc(d * 2 * nc * 2 * nc);
+    c.hS = malloc(d * 2 * nc);
+    c.KSnorm = malloc(d * 2 * nc);
     c.y0 = malloc(d * 2 * nc);
     c.coef = malloc(d * (dof + 1) * nc * dof);
     c.cst = malloc(d * (dof + 1) * nc);
@@ -619,7 +658,7 @@ static PyObject *screen(PyObject *self, PyObject *args)
     c.K = malloc(d * mat);
     c.h = malloc(d * (dof + 2 * nc));
     c.y = malloc(d * (dof + 2 * nc));
-    if (!(c.A && c.Bc && c.rolling && c.code && c.Z && c.x0 && c.TZ && c.tx && c.tznorm && c.NB && c.y0 &&
+    if (!(c.A && c.Bc && c.rolling && c.code && c.Z && c.x0 && c.TZ && c.tx && c.tznorm && c.NB && c.KS && c.hS && c.KSnorm && c.y0 &&
           c.coef && c.cst && c.inv_tznorm && c.path_i && c.path_p && c.colmap && c.qr && c.q && c.beta && c.u && c.K && c.h && c.y)) {
         PyErr_NoMemory();
         goto done;
@@ -637,10 +676,263 @@ static PyObject *screen(PyObject *self, PyObject *args)
         result = Py_BuildValue("(NLLL)", codes, c.n_kin, c.n_coul, c.n_total);
 done:
     free(c.A); free(c.Bc); free(c.rolling); free(c.code); free(c.Z); free(c.x0); free(c.TZ);
-    free(c.tx); free(c.tznorm); free(c.NB); free(c.y0); free(c.coef); free(c.cst); free(c.inv_tznorm); free(c.path_i); free(c.path_p); free(c.colmap); free(c.qr); free(c.q); free(c.beta);
+    free(c.tx); free(c.tznorm); free(c.NB); free(c.KS); free(c.hS); free(c.KSnorm); free(c.y0); free(c.coef); free(c.cst); free(c.inv_tznorm); free(c.path_i); free(c.path_p); free(c.colmap); free(c.qr); free(c.q); free(c.beta);
     free(c.u); free(c.K); free(c.h); free(c.y); free(c.out);
     PyBuffer_Release(&M); PyBuffer_Release(&drive); PyBuffer_Release(&E);
     PyBuffer_Release(&rhs); PyBuffer_Release(&mu); PyBuffer_Release(&masks);
+    return result;
+}
+
+/* ---- The equilibrium relaxation of breaking sets (breaking_sets.py), one small dense simplex per set ----
+ *
+ * Every contact i outside the breaking set carries a force in its widened cone, written with nonnegative
+ * columns: c_i = base_i + sum_j z_j dir_j (rays (1, +-mu) unbounded; for mu < 1 a segment column bounded
+ * by ub_j).  The equilibrium rows read G z = r, r = b - sum_i shift_i (shift_i = E_i base_i).  Phase 1 of
+ * a bounded primal simplex (artificials on every row, dense basis inverse, Dantzig pricing, Bland's rule
+ * after a run of degenerate pivots) decides it.  The verdict never trusts the tableau:
+ *   feasible (1): the basic solution, recomputed from the columns, balances r within feas_tol (the force
+ *     is returned: a witness);
+ *   infeasible (0): y, the last simplex multipliers, is checked as a Farkas certificate from the data:
+ *     M = y.r - sum over bounded columns of max(0, y.G_j) ub_j must exceed cert_margin * |y|_1 * max(1,
+ *     |r|_inf), and every balancing z then has sum_j viol_j z_j >= M over the unbounded columns
+ *     (viol_j = max(0, y.G_j)), so it needs ray coefficients summing to M / max viol_j at least: proven
+ *     when that is >= proof_ratio (or no violation at all);
+ *   unknown (-1): anything else (iteration cap, a weak certificate): the caller decides another way. */
+typedef struct {
+    int m, N, nc, maxit;
+    const double *G, *ub, *gnorm, *dir, *shift, *base, *b;
+    const int *owner;
+    double dtol, ptol, feas_tol, cert_margin, proof_ratio;
+    /* work */
+    int *cols, *state, *bv;
+    double *Binv, *xB, *cB, *y, *alpha, *r, *z;
+} Relax;
+
+static double dotm(const double *a, const double *b, int m)
+{
+    double s = 0.0;
+    for (int l = 0; l < m; l++)
+        s += a[l] * b[l];
+    return s;
+}
+
+static int relax_one(Relax *p, const unsigned char *mask, double *force)
+{
+    int m = p->m, na = 0;
+    double *Binv = p->Binv, *xB = p->xB, *cB = p->cB, *y = p->y, *alpha = p->alpha, *r = p->r;
+    for (int j = 0; j < p->N; j++)
+        if (!mask[p->owner[j]]) {
+            p->cols[na++] = j;
+            p->state[j] = 0; /* 0 at its lower bound, 1 at its upper bound, 2 basic */
+        }
+    memcpy(r, p->b, sizeof(double) * m);
+    for (int i = 0; i < p->nc; i++)
+        if (!mask[i])
+            for (int l = 0; l < m; l++)
+                r[l] -= p->shift[(size_t)i * m + l];
+    memset(Binv, 0, sizeof(double) * m * m);
+    for (int k = 0; k < m; k++) {
+        Binv[k * m + k] = r[k] >= 0 ? 1.0 : -1.0; /* artificial k: column sign(r_k) e_k, value |r_k| */
+        xB[k] = fabs(r[k]);
+        p->bv[k] = -1;
+        cB[k] = 1.0;
+    }
+    int it, degenerate = 0, bland = 0;
+    for (it = 0; it < p->maxit; it++) {
+        for (int l = 0; l < m; l++)
+            y[l] = 0.0;
+        for (int k = 0; k < m; k++)
+            if (cB[k] != 0.0)
+                for (int l = 0; l < m; l++)
+                    y[l] += cB[k] * Binv[k * m + l];
+        int enter = -1;
+        double best = 0.0;
+        for (int q = 0; q < na; q++) {
+            int j = p->cols[q];
+            if (p->state[j] == 2)
+                continue;
+            double yg = dotm(y, p->G + (size_t)j * m, m);
+            double gain = (p->state[j] == 0 ? yg : -yg) / p->gnorm[j]; /* objective decrease per unit step */
+            if (gain > p->dtol && (bland ? enter < 0 : gain > best)) {
+                best = gain;
+                enter = j;
+            }
+        }
+        if (enter < 0)
+            break;
+        const double *g = p->G + (size_t)enter * m;
+        for (int k = 0; k < m; k++)
+            alpha[k] = dotm(Binv + (size_t)k * m, g, m);
+        double sgn = p->state[enter] == 0 ? 1.0 : -1.0, theta = p->ub[enter];
+        int leave = -1, to_upper = 0;
+        for (int k = 0; k < m; k++) {
+            double a = sgn * alpha[k], t;
+            if (a > p->ptol) {
+                t = xB[k] > 0 ? xB[k] / a : 0.0;
+                if (t < theta) {
+                    theta = t;
+                    leave = k;
+                    to_upper = 0;
+                }
+            } else if (a < -p->ptol && p->bv[k] >= 0 && isfinite(p->ub[p->bv[k]])) {
+                double room = p->ub[p->bv[k]] - xB[k];
+                t = room > 0 ? room / -a : 0.0;
+                if (t < theta) {
+                    theta = t;
+                    leave = k;
+                    to_upper = 1;
+                }
+            }
+        }
+        if (!isfinite(theta))
+            return -1; /* unbounded: impossible in phase 1 but for rounding */
+        for (int k = 0; k < m; k++)
+            xB[k] -= sgn * theta * alpha[k];
+        if (leave < 0) { /* the entering column reaches its other bound first */
+            p->state[enter] = 1 - p->state[enter];
+            continue;
+        }
+        int out = p->bv[leave];
+        if (out >= 0)
+            p->state[out] = to_upper;
+        xB[leave] = p->state[enter] == 0 ? theta : p->ub[enter] - theta;
+        p->bv[leave] = enter;
+        cB[leave] = 0.0;
+        p->state[enter] = 2;
+        double *row = Binv + (size_t)leave * m, inv = 1.0 / alpha[leave];
+        for (int l = 0; l < m; l++)
+            row[l] *= inv;
+        for (int k = 0; k < m; k++) {
+            double f = alpha[k];
+            if (k == leave || f == 0.0)
+                continue;
+            double *dst = Binv + (size_t)k * m;
+            for (int l = 0; l < m; l++)
+                dst[l] -= f * row[l];
+        }
+        degenerate = theta <= p->ptol ? degenerate + 1 : 0;
+        if (degenerate > m)
+            bland = 1;
+    }
+    if (it >= p->maxit)
+        return -1;
+    /* the verdict from the data: the basic solution's residual, else y as a Farkas certificate */
+    double *z = p->z, res = 0.0;
+    for (int q = 0; q < na; q++) {
+        int j = p->cols[q];
+        z[j] = p->state[j] == 1 ? p->ub[j] : 0.0;
+    }
+    for (int k = 0; k < m; k++)
+        if (p->bv[k] >= 0) {
+            double v = xB[k] > 0 ? xB[k] : 0.0, u = p->ub[p->bv[k]];
+            z[p->bv[k]] = v < u ? v : u;
+        }
+    for (int l = 0; l < m; l++) {
+        double s = r[l];
+        for (int q = 0; q < na; q++) {
+            int j = p->cols[q];
+            s -= p->G[(size_t)j * m + l] * z[j];
+        }
+        res = fmax(res, fabs(s));
+    }
+    if (res <= p->feas_tol) {
+        for (int i = 0; i < p->nc; i++) {
+            force[2 * i] = mask[i] ? 0.0 : p->base[2 * i];
+            force[2 * i + 1] = mask[i] ? 0.0 : p->base[2 * i + 1];
+        }
+        for (int q = 0; q < na; q++) {
+            int j = p->cols[q], i = p->owner[j];
+            force[2 * i] += z[j] * p->dir[2 * j];
+            force[2 * i + 1] += z[j] * p->dir[2 * j + 1];
+        }
+        return 1;
+    }
+    double M = dotm(y, r, m), viol = 0.0, ynorm = 0.0, rmax = 1.0;
+    for (int l = 0; l < m; l++) {
+        ynorm += fabs(y[l]);
+        rmax = fmax(rmax, fabs(r[l]));
+    }
+    for (int q = 0; q < na; q++) {
+        int j = p->cols[q];
+        double yg = dotm(y, p->G + (size_t)j * m, m);
+        if (yg <= 0)
+            continue;
+        if (isfinite(p->ub[j]))
+            M -= yg * p->ub[j];
+        else
+            viol = fmax(viol, yg);
+    }
+    if (M > p->cert_margin * ynorm * rmax && (viol == 0.0 || M >= p->proof_ratio * viol))
+        return 0;
+    return -1;
+}
+
+static PyObject *relax(PyObject *self, PyObject *args)
+{
+    (void)self;
+    Py_buffer G, ub, gnorm, owner, dir, shift, base, b, masks;
+    Relax p;
+    memset(&p, 0, sizeof p);
+    if (!PyArg_ParseTuple(args, "y*y*y*y*y*y*y*y*y*iiiiddddd", &G, &ub, &gnorm, &owner, &dir, &shift, &base, &b,
+                          &masks, &p.nc, &p.m, &p.N, &p.maxit, &p.dtol, &p.ptol, &p.feas_tol, &p.cert_margin,
+                          &p.proof_ratio))
+        return NULL;
+    PyObject *result = NULL;
+    size_t d = sizeof(double);
+    int nc = p.nc, m = p.m, N = p.N;
+    if (nc < 1 || m < 1 || N < 0 || G.len != (Py_ssize_t)(N * m * d) || ub.len != (Py_ssize_t)(N * d) ||
+        gnorm.len != ub.len || owner.len != (Py_ssize_t)(N * sizeof(int)) || dir.len != (Py_ssize_t)(2 * N * d) ||
+        shift.len != (Py_ssize_t)(nc * m * d) || base.len != (Py_ssize_t)(2 * nc * d) || b.len != (Py_ssize_t)(m * d) ||
+        masks.len % nc != 0) {
+        PyErr_SetString(PyExc_ValueError, "relax: arrays of the wrong size for n_c, rows and columns");
+        goto done;
+    }
+    for (int j = 0; j < N; j++)
+        if (((const int *)owner.buf)[j] < 0 || ((const int *)owner.buf)[j] >= nc) {
+            PyErr_SetString(PyExc_ValueError, "relax: a column's contact out of range");
+            goto done;
+        }
+    p.G = G.buf;
+    p.ub = ub.buf;
+    p.gnorm = gnorm.buf;
+    p.owner = owner.buf;
+    p.dir = dir.buf;
+    p.shift = shift.buf;
+    p.base = base.buf;
+    p.b = b.buf;
+    Py_ssize_t n_sets = masks.len / nc;
+    p.cols = malloc(sizeof(int) * (N + 1));
+    p.state = malloc(sizeof(int) * (N + 1));
+    p.bv = malloc(sizeof(int) * m);
+    p.Binv = malloc(d * m * m);
+    p.xB = malloc(d * m);
+    p.cB = malloc(d * m);
+    p.y = malloc(d * m);
+    p.alpha = malloc(d * m);
+    p.r = malloc(d * m);
+    p.z = malloc(d * (N + 1));
+    PyObject *status = PyBytes_FromStringAndSize(NULL, n_sets);
+    PyObject *forces = PyBytes_FromStringAndSize(NULL, (Py_ssize_t)(n_sets * 2 * nc * d));
+    if (!(p.cols && p.state && p.bv && p.Binv && p.xB && p.cB && p.y && p.alpha && p.r && p.z && status && forces)) {
+        Py_XDECREF(status);
+        Py_XDECREF(forces);
+        PyErr_NoMemory();
+        goto done;
+    }
+    signed char *st = (signed char *)PyBytes_AS_STRING(status);
+    double *fo = (double *)PyBytes_AS_STRING(forces);
+    memset(fo, 0, (size_t)n_sets * 2 * nc * d);
+    Py_BEGIN_ALLOW_THREADS
+    for (Py_ssize_t s = 0; s < n_sets; s++)
+        st[s] = (signed char)relax_one(&p, (const unsigned char *)masks.buf + s * nc, fo + (size_t)s * 2 * nc);
+    Py_END_ALLOW_THREADS
+    result = Py_BuildValue("(NN)", status, forces);
+done:
+    free(p.cols); free(p.state); free(p.bv); free(p.Binv); free(p.xB); free(p.cB); free(p.y); free(p.alpha);
+    free(p.r); free(p.z);
+    PyBuffer_Release(&G); PyBuffer_Release(&ub); PyBuffer_Release(&gnorm); PyBuffer_Release(&owner);
+    PyBuffer_Release(&dir); PyBuffer_Release(&shift); PyBuffer_Release(&base); PyBuffer_Release(&b);
+    PyBuffer_Release(&masks);
     return result;
 }
 
@@ -650,6 +942,11 @@ static PyMethodDef methods[] = {
      "-> (codes: bytes, pruned_kinematic, pruned_coulomb, modes)\n\n"
      "The reduced screen of qsplan.mechanics.solver.screen.screen_set for every breaking set (a row of masks,\n"
      "uint8, 1 = breaking), compiled; codes holds the kept modes' letter codes, n_c bytes each, in order."},
+    {"relax", relax, METH_VARARGS,
+     "relax(G, ub, gnorm, owner, dir, shift, base, b, masks, n_c, m, N, maxit, dtol, ptol, feas_tol, cert_margin,\n"
+     "      proof_ratio) -> (status: bytes of int8, forces: bytes of float64 (s, 2 n_c))\n\n"
+     "The equilibrium relaxation of qsplan.mechanics.solver.breaking_sets for every breaking set (a row of masks):\n"
+     "1 feasible (its force returned), 0 proven infeasible (a checked Farkas certificate), -1 undecided."},
     {NULL, NULL, 0, NULL}};
 
 static struct PyModuleDef module = {PyModuleDef_HEAD_INIT, "screen_kernel",
@@ -659,7 +956,7 @@ static struct PyModuleDef module = {PyModuleDef_HEAD_INIT, "screen_kernel",
 PyMODINIT_FUNC PyInit_screen_kernel(void)
 {
     PyObject *m = PyModule_Create(&module);
-    if (m && PyModule_AddIntConstant(m, "ABI", 1) < 0) {
+    if (m && PyModule_AddIntConstant(m, "ABI", 2) < 0) {
         Py_DECREF(m);
         return NULL;
     }
