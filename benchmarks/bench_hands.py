@@ -18,12 +18,23 @@ checks (a configuration with one effort joint and one direction: a scene and a g
 the whole (geometry + bands), as ``benchmarks/bench_plan.py`` counts the band tables'.  Best of ``--repeat``
 passes (the machine is shared).  ``before`` is the figure of the issue: the chain hands' per-state polygon
 searches (``benchmarks/bench_plan.py``, issue 15).  The last line measures, at the same time, the figure the paper
-hand's ``before`` comes from: today's band tables of ``qsplan demo`` (:func:`qsplan.planner.search.tables.band_tables`).
+hand's ``before`` comes from: today's band tables of ``qsplan demo`` (:func:`qsplan.planner.search.tables.band_tables`,
+the inertial wrench box of the task on).
+
+With ``--compare REV`` (a git revision: its package exported beside this tree, :func:`revisions.export_revision`), that
+last line is measured for REV and this tree in the same run, each in its own process, interleaved ``--rounds`` times
+(the machine's speed drifts between minutes), best of ``--repeat`` band tables per process, best over the rounds, and
+printed as a table with their ratio: ``python3 benchmarks/bench_hands.py --compare HEAD~3 [--rounds 5] [--tables-only]``.
 """
 
 import argparse
+import os
+import subprocess
+import sys
+import tempfile
 import time
 import tomllib
+from pathlib import Path
 
 import numpy as np
 
@@ -33,6 +44,12 @@ from qsplan.mechanics.bands.batched import LazyScenes, batch_from_arrays
 from qsplan.mechanics.bands.batched_robust import robust_band_arrays
 
 from bench_plan import table_rate  # the demo tables' rate, measured as bench_plan.py measures it
+from revisions import export_revision
+
+HERE = Path(__file__).resolve().parent
+
+#: What a process of :func:`compare_tables` runs: the demo tables' rate (checks/s) and checks, as the last line.
+_TABLE_RATE = "import sys; sys.path.insert(0, {here!r}); from bench_plan import table_rate; print(*table_rate({repeat}))"
 
 #: Half the span (m) of the workpiece x judged: that of ``qsplan demo``'s band tables (the last line's).
 SPAN = 0.06
@@ -113,11 +130,49 @@ def bands(hand, judged):
     return checks
 
 
+def compare_tables(rev: str, repeat: int, rounds: int) -> dict:
+    """The demo tables' rate (checks/s, best) and checks of git revision ``rev`` (``before``) and of this tree
+    (``after``): a process per side and round, the sides interleaved; each process takes the best of ``repeat``."""
+    with tempfile.TemporaryDirectory(prefix="qsplan-bench-") as tmp:
+        before = dict(os.environ)
+        before["PYTHONPATH"] = os.pathsep.join(filter(None, [str(export_revision(rev, Path(tmp) / "rev")),
+                                                             before.get("PYTHONPATH")]))  # fmt: skip
+        sides = {"before": before, "after": dict(os.environ)}
+        best = {side: (0.0, 0) for side in sides}
+        code = _TABLE_RATE.format(here=str(HERE), repeat=repeat)
+        for i in range(rounds):
+            for side, env in sides.items():
+                out = subprocess.run([sys.executable, "-c", code], env=env, cwd=tmp, check=True, capture_output=True, text=True)
+                rate, checks = out.stdout.split()
+                best[side] = max(best[side], (float(rate), int(checks)))
+            print(f"round {i + 1} of {rounds} done", file=sys.stderr, flush=True)
+    return best
+
+
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--step", type=float, default=5e-4, help="grid step of the workpiece x (m)")
     ap.add_argument("--repeat", type=int, default=3, help="passes (best taken)")
+    ap.add_argument("--compare", metavar="REV", help="the demo tables' line for git revision REV too, interleaved")
+    ap.add_argument("--rounds", type=int, default=5, help="with --compare: processes per side, interleaved (best taken)")
+    ap.add_argument("--tables-only", action="store_true", help="only the demo tables' line (and --compare's table)")
     args = ap.parse_args(argv)
+    if args.compare:
+        best = compare_tables(args.compare, args.repeat, args.rounds)
+        (b, n), (a, m) = best["before"], best["after"]
+        print(f"paper_hand: band tables of qsplan demo (inertial box on), checks/s, best of {args.rounds} processes x "
+              f"{args.repeat} tables, interleaved")  # fmt: skip
+        print(f"{'side':<28} {'checks':>7} {'checks/s':>9} {'ms/table':>9} {'target':>7}")
+        print(f"{'before (' + args.compare + ')':<28} {n:7d} {b:9.0f} {1e3 * n / b:9.1f} {'10,000':>7}")
+        print(f"{'after (this tree)':<28} {m:7d} {a:9.0f} {1e3 * m / a:9.1f} {'10,000':>7}")
+        print(f"{'ratio after / before':<28} {'':>7} {a / b:9.2f}")
+        if args.tables_only:
+            return
+        print()
+    elif args.tables_only:
+        rate, checks = table_rate(args.repeat)
+        print(f"{'paper_hand: band tables today':<28} {checks:7d} {rate:9.0f}")
+        return
     print(f"{'hand':<28} {'grasps':>6} {'states':>7} {'valid':>6} {'states/s':>9} {'checks':>7} {'checks/s':>9} "
           f"{'before':>8} {'target':>7}")  # fmt: skip
     for label, name, hand, free in hand_cases():

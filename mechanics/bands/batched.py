@@ -30,7 +30,13 @@ from dataclasses import dataclass
 import numpy as np
 
 from qsplan.mechanics.bands.batched_modes import BatchKinematics, batch_kinematics, batch_rows_many
-from qsplan.mechanics.bands.disturbance import check_wrench_box, loaded_reason, worst_over_wrenches, wrench_vertex_rows
+from qsplan.mechanics.bands.disturbance import (
+    check_wrench_box,
+    loaded_reason,
+    worst_over_wrenches,
+    wrench_vertex_parts,
+    wrench_vertex_rows,
+)
 from qsplan.mechanics.bands.effort import Band, check_force_margin, check_one_effort_joint, intersect_rows
 from qsplan.mechanics.bands.guaranteed import shared_band_from_rows, shared_band_over_wrenches, shared_nodes
 from qsplan.mechanics.errors import SceneError
@@ -303,9 +309,13 @@ def box_band_arrays(batch: StateBatch, bk: BatchKinematics, lo, hi, tol: Toleran
     of int, the index of the reason in :data:`BOX_REASONS` (``lo, hi`` checked, ``force_margin`` a ForceMargin,
     ``disturbance`` a WrenchBox or None: the vertices of the friction box times the wrench box)."""
     rows = batch_rows(batch, bk, box_vertices(bk.mode, lo, hi), force_margin, disturbance is not None)
-    s0, s1, det, scale = rows if disturbance is None else wrench_vertex_rows(*rows, disturbance.vertices())
+    det = rows[2]  # per friction vertex: the wrench does not move it
     steady = np.all(det > 0, axis=1) | np.all(det < 0, axis=1)
-    lower, upper, ok = _intersect(s0, s1, scale, tol)
+    if disturbance is None:
+        lower, upper, ok = _intersect(rows[0], rows[1], rows[3], tol)
+    else:  # the rows at every (wrench, friction) vertex pair, wrench-major, s1 shared (not repeated)
+        s0, s1, scale = wrench_vertex_parts(rows[0], rows[1], rows[3], rows[4], disturbance.vertices())
+        lower, upper, ok = (x.reshape(batch.size, -1) for x in intersect_rows(s0, s1, scale, tol))
     lo_, up_ = lower.max(axis=1), upper.min(axis=1)
     why = np.select([~bk.ok, ~steady, ~ok.all(axis=1), lo_ > up_], [1, 2, 3, 4], 0)
     return lo_, up_, why

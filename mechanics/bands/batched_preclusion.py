@@ -5,7 +5,7 @@ competing mode at every state of a :class:`qsplan.mechanics.bands.batched.StateB
 with its own effort interval.  The branch and bound starts from one root cell (the whole friction
 set); its control values, point bands and lower bounds are computed for all (competitor, state)
 pairs at once, by the reference's own functions
-(:func:`~qsplan.mechanics.bands.preclusion.cell_lower_bounds`,
+(:func:`~qsplan.mechanics.bands.preclusion.extreme_lower_bounds`,
 :func:`~qsplan.mechanics.bands.preclusion.point_bands`,
 :func:`~qsplan.mechanics.bands.guaranteed.bernstein_matrix`; the rows of every competitor in one
 factorisation, :func:`qsplan.mechanics.bands.batched_modes.batch_rows_many`).  Where the root cell
@@ -25,16 +25,17 @@ import numpy as np
 
 from qsplan.mechanics.bands.batched import StateBatch, take_states
 from qsplan.mechanics.bands.batched_modes import BatchKinematics, batch_kinematics, batch_rows_many
-from qsplan.mechanics.bands.disturbance import check_wrench_box, wrench_vertex_rows
+from qsplan.mechanics.bands.disturbance import check_wrench_box, wrench_vertex_parts, wrench_vertex_rows
 from qsplan.mechanics.bands.guaranteed import bernstein_matrix, shared_coordinate, shared_coordinates, shared_nodes
 from qsplan.mechanics.bands.preclusion import (
     MAX_CELLS,
     PRECLUSION_RTOL,
     CompetitorTorques,
-    cell_lower_bounds,
     competitor_torques,
+    extreme_lower_bounds,
     friction_set,
     point_bands,
+    wrench_extremes,
 )
 from qsplan.mechanics.errors import SceneError
 from qsplan.mechanics.modes.contact_mode import mode_from_letters
@@ -115,17 +116,27 @@ def _grouped(parts) -> list:
 
 def _root_cells(jobs, lo, hi, shared: bool, box=None) -> list:
     """Control values of the root cell and the rows at its friction points, the jobs ``(batch, bk)`` whose cells have
-    one shape stacked: ``[(job indices, (det (m, K), N0, N1 (m, K, R), s0, s1 (m, P, R), scale (m, P)))]``, ``m`` the
-    states of those jobs in job order; with a wrench box ``box`` at each of its vertices, wrench-major
-    (:class:`qsplan.mechanics.bands.cells.FrictionCells`' order).  Box friction stacks the jobs' rows before the
-    wrench vertices multiply them (elementwise: the same numbers, ``W`` times less to copy)."""
+    one shape stacked: ``[(job indices, (det (m, K), lo0, hi0, N1 (m, K, R), s0, s1 (m, P, R), scale (m, P)))]``,
+    ``m`` the states of those jobs in job order.  With a wrench box ``box`` the rows at the friction points are taken
+    at each of its vertices, wrench-major (:class:`qsplan.mechanics.bands.cells.FrictionCells`' order), and the control
+    values are each row's smallest and largest ``N0`` over them (``lo0``, ``hi0``; ``det`` and ``N1`` do not depend on
+    the wrench: :func:`~qsplan.mechanics.bands.preclusion.extreme_lower_bounds` takes them so, the bound of every
+    control point); without one, ``lo0`` is ``hi0`` is ``N0``.  Box friction stacks the jobs' rows before the wrench
+    vertices multiply them (elementwise: the same numbers, less to copy)."""
     loads = box is not None
     verts = None if box is None else box.vertices()
     if not shared:
         out = []
         for js, rows in _grouped(batch_rows_many([(b, bk, _vertices(bk, lo, hi)) for b, bk in jobs], loads=loads)):
-            s0, s1, det, scale = rows if box is None else wrench_vertex_rows(*rows, verts)
-            out.append((js, (det, s0 * det[..., None], s1 * det[..., None], s0, s1, scale)))
+            s0, s1, det, scale = rows[:4]
+            N1 = s1 * det[..., None]
+            if box is None:
+                N0 = s0 * det[..., None]
+                out.append((js, (det, N0, N0, N1, s0, s1, scale)))
+                continue
+            s0, s1, scale = wrench_vertex_parts(s0, s1, scale, rows[4], verts)  # (m, W, K, R), s1 (m, 1, K, R)
+            lo0, hi0 = wrench_extremes(s0[:, w] * det[..., None] for w in range(len(verts)))  # N0 = s0 det at each
+            out.append((js, (det, lo0, hi0, N1, s0, s1, scale)))
         return out
     nodes = [shared_nodes(bk.mode, lo, hi) for _, bk in jobs]
     at_nodes = batch_rows_many([(b, bk, np.repeat(nd[:, None], b.n_c, axis=1)) for (b, bk), nd in zip(jobs, nodes)], loads=loads)
@@ -150,46 +161,49 @@ def _root_cells(jobs, lo, hi, shared: bool, box=None) -> list:
         else:
             cN2 = np.linalg.solve(V, (node_rows[4] * det[..., None, None]).reshape(det.shape + (-1,)))
             N2 = np.concatenate([(Mb @ c).reshape(N0.shape[1:] + (3,))[None] for c in cN2])
-            N0, N1, det_c, _ = wrench_vertex_rows(N0, N1, det_c, None, N2, verts)
+            K = det_c.shape[1]
+            N0 = wrench_vertex_rows(N0, N1, det_c, None, N2, verts)[0]
+            lo0, hi0 = wrench_extremes(N0[:, w * K : (w + 1) * K] for w in range(len(verts)))
             p0, p1, _, scale = wrench_vertex_rows(*point_rows, verts)
-        out.append((det_c, N0, N1, p0, p1, scale))
+            out.append((det_c, lo0, hi0, N1, p0, p1, scale))
+            continue
+        out.append((det_c, N0, N0, N1, p0, p1, scale))
     return _grouped(out)
 
 
-def _root_search(cell, lo_, hi_, flip, atol, tol, wrenches=1):
-    """The first step of the per-state search at every state: ``(value, resolved)`` (S,) each (``wrenches``: the wrench
-    vertices of the cells' control points, :func:`~qsplan.mechanics.bands.preclusion.cell_lower_bounds`)."""
-    det, N0, N1, pl, pu, pok = cell
+def _root_search(cell, lo_, hi_, flip, atol, tol):
+    """The first step of the per-state search at every state: ``(value, resolved)`` (S,) each."""
+    det, lo0, hi0, N1, pl, pu, pok = cell
     sign = -1.0 if flip else 1.0
     if flip:
         pl, pu = -pu, -pl
     lo2, hi2, at2 = lo_[:, None], hi_[:, None], atol[:, None]
     feas = pok & (pl <= pu) & (np.maximum(pl, lo2) <= np.minimum(pu, hi2) + at2)
     incumbent = np.min(np.where(feas, np.clip(pl, lo2, hi2), np.inf), axis=1)
-    lb, _ = cell_lower_bounds(det, N0, sign * N1, lo_, hi_, tol, wrenches)
+    lb, _ = extreme_lower_bounds(det, lo0, hi0, sign * N1, lo_, hi_, tol)
     possible = lb < np.inf
     done = possible & (lb >= np.minimum(incumbent, hi_) - atol)
     floor = np.where(done, lb, np.inf)
     return sign * np.minimum(incumbent, floor), ~(possible & ~done)
 
 
-def _root_searches(groups, gl, gh, atol, tol, wrenches=1):
+def _root_searches(groups, gl, gh, atol, tol):
     """Both searches of the root cell (the smallest possible effort, then the largest above it) for every job, the
     jobs whose cells have one shape stacked (:func:`_root_cells`' groups): ``(low, upper, resolved)`` per job, (S,)
     each (``upper`` meaningful where ``low`` is finite or ``-inf``, and the search resolved)."""
     out = [None] * len(gl)
-    for js, (det, N0, N1, s0, s1, scale) in groups:
+    for js, (det, lo0, hi0, N1, s0, s1, scale) in groups:
         g_lo, g_hi, at = (np.concatenate([v[j] for j in js]) for v in (gl, gh, atol))
-        m, P, R = s0.shape
-        pl, pu, pok = point_bands(s0.reshape(-1, R), s1.reshape(-1, R), scale.reshape(-1), tol)
-        cell = (det, N0, N1, pl.reshape(m, P), pu.reshape(m, P), pok.reshape(m, P))
-        low, ok1 = _root_search(cell, g_lo, g_hi, False, at, tol, wrenches)
+        m = s0.shape[0]  # the points' rows (m, P, R), or (m, W, K, R) with s1 (m, 1, K, R): point_bands broadcasts
+        pl, pu, pok = (x.reshape(m, -1) for x in point_bands(s0, s1, scale, tol))
+        cell = (det, lo0, hi0, N1, pl, pu, pok)
+        low, ok1 = _root_search(cell, g_lo, g_hi, False, at, tol)
         # the largest possible effort, above the smallest: only where that exists (elsewhere the hull is empty or
         # the per-state search takes over, whatever this search says)
         more = ok1 & (low != np.inf)
         up, resolved = low.copy(), ok1.copy()
         if more.any():
-            neg_up, ok2 = _root_search(tuple(c[more] for c in cell), -g_hi[more], -low[more], True, at[more], tol, wrenches)
+            neg_up, ok2 = _root_search(tuple(c[more] for c in cell), -g_hi[more], -low[more], True, at[more], tol)
             up[more] = np.where(neg_up != -np.inf, neg_up, low[more])  # nothing above low within atol: the point low
             resolved[more] = ok2
         at_ = 0
@@ -252,8 +266,7 @@ def competitor_hulls(batch: StateBatch, kin: dict, comps, lo, hi, g_lo, g_hi, sh
     gl = [g_lo[live] for _, live in lives]
     gh = [g_hi[live] for _, live in lives]
     atol = [rtol * np.maximum(np.maximum(finite(a), finite(b)), 1.0) for a, b in zip(gl, gh)]
-    W = 1 if box is None else len(box.vertices())  # the cells' wrench vertices (cell_lower_bounds takes them so)
-    found = _root_searches(_root_cells(jobs, c_lo, c_hi, c_shared, box), gl, gh, atol, tol, W)
+    found = _root_searches(_root_cells(jobs, c_lo, c_hi, c_shared, box), gl, gh, atol, tol)
     for (c, live), (low, up, resolved), a, b in zip(lives, found, gl, gh):
         h = out[c]
         bounded = resolved & (low != np.inf)

@@ -56,7 +56,7 @@ import numpy as np
 from qsplan.mechanics.errors import QsplanError
 
 __all__ = ["MAX_DISTURBANCE", "WrenchBox", "check_wrench_box", "load_columns", "loaded_reason", "shift_rows",
-           "worst_over_wrenches", "wrench_vertex_rows"]  # fmt: skip
+           "worst_over_wrenches", "wrench_vertex_parts", "wrench_vertex_rows"]  # fmt: skip
 
 #: Largest magnitude of a disturbance component (N or N m).  A hand-held workpiece meets inertial and contact
 #: disturbances of grams to kilograms times g; a component above 1e6 is a unit mistake (mN or N mm given as N),
@@ -207,16 +207,27 @@ def wrench_vertex_rows(s0, s1, det, scale, s2, wrenches):
         ``scale``: the force scale of the rows or the wrench's largest component, whichever is larger (N),
         for the tolerances (``Tolerances.force`` is relative to the largest load).
     """
-    w = np.asarray(wrenches, dtype=float)
-    rows = shift_rows(s0, s2, w)
+    rows, s1w, scale = wrench_vertex_parts(s0, s1, scale, s2, wrenches)
     lead, (W, N, r) = rows.shape[:-3], rows.shape[-3:]
     flat = lambda a: a.reshape(lead + (W * N,) + a.shape[len(lead) + 2 :])  # noqa: E731
-    s1w = np.broadcast_to(s1[..., None, :, :], lead + (W, N, r))
+    s1w = np.broadcast_to(s1w, lead + (W, N, r))
     detw = np.broadcast_to(det[..., None, :], lead + (W, N))
     if scale is not None:
-        size = np.max(np.abs(w), axis=-1)[..., :, None]  # (..., W, 1)
-        scale = flat(np.broadcast_to(np.maximum(scale[..., None, :], size), lead + (W, N)))
+        scale = flat(np.broadcast_to(scale, lead + (W, N)))
     return flat(rows), flat(s1w), flat(detw), scale
+
+
+def wrench_vertex_parts(s0, s1, scale, s2, wrenches):
+    """:func:`wrench_vertex_rows`' ``s0``, ``s1`` and ``scale`` with the wrench axis apart and nothing repeated:
+    ``s0`` (..., W, N, r), ``s1`` (..., 1, N, r) (it does not depend on the wrench: a view) and ``scale`` (..., W, N)
+    (None if ``scale`` is), for the functions that take them broadcast
+    (:func:`qsplan.mechanics.bands.effort.intersect_rows`)."""
+    w = np.asarray(wrenches, dtype=float)
+    rows = shift_rows(s0, s2, w)
+    if scale is not None:
+        size = np.max(np.abs(w), axis=-1)[..., :, None]  # (..., W, 1)
+        scale = np.maximum(scale[..., None, :], size)
+    return rows, s1[..., None, :, :], scale
 
 
 def worst_over_wrenches(lower, upper, ok, W: int):

@@ -322,22 +322,24 @@ COLUMNS_FROM = 2048
 def intersect_rows(s0, s1, scale, tol: Tolerances):
     """Band edges of ``s0 + tau s1 >= 0`` over rows, per mu row: lower, upper, ok (N,).
 
-    ``s0, s1`` (N, r) and ``scale`` (N,) are :func:`band_rows`' output.  A row the effort does not move (its slope at
-    most ``tol.force`` of the largest) bounds nothing and must hold as it is (within ``tol.force * scale``).  Edges
-    are never a negative zero, and NaN is numpy's own (:func:`_canonical`).
+    ``s0, s1`` (N, r) and ``scale`` (N,) are :func:`band_rows`' output; any leading shape (...) instead of (N,) with
+    ``s1`` and ``scale`` broadcasting against ``s0`` (the rows under each wrench vertex share ``s1``,
+    :func:`qsplan.mechanics.bands.disturbance.wrench_vertex_parts`): the edges of the broadcast rows.  A row the effort
+    does not move (its slope at most ``tol.force`` of the largest) bounds nothing and must hold as it is (within
+    ``tol.force * scale``).  Edges are never a negative zero, and NaN is numpy's own (:func:`_canonical`).
     """
-    ftol = tol.force * scale[:, None]
+    ftol = tol.force * scale[..., None]
     if s0.size < COLUMNS_FROM:
-        big = np.max(np.abs(s1), axis=1, keepdims=True)
+        big = np.max(np.abs(s1), axis=-1, keepdims=True)
         flat = np.abs(s1) <= tol.force * big  # effort does not move this row (relative to the mode's largest slope)
         with np.errstate(divide="ignore", invalid="ignore"):
             edge = -s0 / s1
-        lower = np.max(np.where(~flat & (s1 > 0), edge, -np.inf), axis=1)
-        upper = np.min(np.where(~flat & (s1 < 0), edge, np.inf), axis=1)
-        flat_ok = np.all(~flat | (s0 >= -ftol), axis=1)
-        ok = flat_ok & (lower <= upper) & np.all(np.isfinite(s0), axis=1)
+        lower = np.max(np.where(~flat & (s1 > 0), edge, -np.inf), axis=-1)
+        upper = np.min(np.where(~flat & (s1 < 0), edge, np.inf), axis=-1)
+        flat_ok = np.all(~flat | (s0 >= -ftol), axis=-1)
+        ok = flat_ok & (lower <= upper) & np.all(np.isfinite(s0), axis=-1)
         return _canonical(lower), _canonical(upper), ok
-    return _intersect_columns(s0, s1, -ftol[:, 0], tol)
+    return _intersect_columns(s0, s1, -ftol[..., 0], tol)
 
 
 def _canonical(edge):
@@ -347,21 +349,22 @@ def _canonical(edge):
 
 
 def _intersect_columns(s0, s1, neg_ftol, tol: Tolerances):
-    """:func:`intersect_rows`' answer folded column by column (elementwise passes only; the same numbers)."""
+    """:func:`intersect_rows`' answer folded column by column (elementwise passes only; the same numbers), what depends
+    on ``s1`` alone at its own (broadcast) shape."""
     a1 = np.abs(s1)
-    big = a1[:, 0]
-    for j in range(1, s1.shape[1]):
-        big = np.maximum(big, a1[:, j])
+    big = a1[..., 0]
+    for j in range(1, s1.shape[-1]):
+        big = np.maximum(big, a1[..., j])
     big = tol.force * big
     lower, upper, ok = None, None, None
     with np.errstate(divide="ignore", invalid="ignore"):
-        for j in range(s1.shape[1]):
-            c0, c1 = s0[:, j], s1[:, j]
-            moves = ~(a1[:, j] <= big)  # not flat (NaN slopes count as moving, as in intersect_rows)
+        for j in range(s1.shape[-1]):
+            c0, c1 = s0[..., j], s1[..., j]
+            moves = ~(a1[..., j] <= big)  # not flat (NaN slopes count as moving, as in intersect_rows)
             lo_j = -c0 / c1  # the edge, kept where the row bounds from below (np.where's value, without its branches)
             up_j = lo_j.copy()
-            np.putmask(lo_j, ~(moves & (c1 > 0)), -np.inf)
-            np.putmask(up_j, ~(moves & (c1 < 0)), np.inf)
+            np.putmask(lo_j, np.broadcast_to(~(moves & (c1 > 0)), lo_j.shape), -np.inf)
+            np.putmask(up_j, np.broadcast_to(~(moves & (c1 < 0)), up_j.shape), np.inf)
             ok_j = (moves | (c0 >= neg_ftol)) & np.isfinite(c0)
             if j == 0:
                 lower, upper, ok = lo_j, up_j, ok_j

@@ -66,7 +66,7 @@ from qsplan.mechanics.modes.contact_mode import mode_from_letters
 from qsplan.mechanics.numerics import DEFAULT_TOLERANCES, Tolerances
 
 __all__ = ["CERTIFY_AFTER", "MAX_CELLS", "PRECLUSION_RTOL", "CompetitorTorques", "cell_lower_bounds", "competitor_torques",
-           "friction_set", "point_bands"]
+           "extreme_lower_bounds", "friction_set", "point_bands", "wrench_extremes"]
 
 #: Relative tolerance of the branch and bound (of the effort interval's largest finite
 #: edge, or 1 N m): the search stops when no cell can lower the bound by more.  The
@@ -132,25 +132,37 @@ def cell_lower_bounds(det, N0, N1, g_lo, g_hi, tol: Tolerances, wrenches: int = 
     smallest, bit for bit.  The bound is computed on each row's largest and smallest ``N0`` over the blocks (``e``,
     the magnitudes' largest, too): ``wrenches`` times fewer values, the same answer as ``wrenches=1``.
     """
-    m, K, R = N0.shape
+    if wrenches == 1:
+        return extreme_lower_bounds(det, N0, N0, N1, g_lo, g_hi, tol)
+    K = N0.shape[1] // wrenches  # each row's extremes over the wrench blocks (the docstring): the same bound
+    lo0, hi0 = wrench_extremes(N0[:, w * K : (w + 1) * K] for w in range(wrenches))
+    return extreme_lower_bounds(det[:, :K], lo0, hi0, N1[:, :K], g_lo, g_hi, tol)
+
+
+def wrench_extremes(blocks) -> tuple:
+    """Elementwise smallest and largest of ``blocks`` (arrays of one shape): ``(lo0, hi0)``, NaN and infinities kept
+    (``np.minimum`` and ``np.maximum`` propagate NaN)."""
+    blocks = iter(blocks)
+    lo0 = hi0 = next(blocks)
+    for x in blocks:
+        lo0, hi0 = np.minimum(lo0, x), np.maximum(hi0, x)
+    return lo0, hi0
+
+
+def extreme_lower_bounds(det, lo0, hi0, N1, g_lo, g_hi, tol: Tolerances):
+    """:func:`cell_lower_bounds` from each row's smallest and largest ``N0`` over the cell's wrench vertices (``lo0``,
+    ``hi0`` (m, K, R), the same array without a wrench box), ``det`` (m, K) and ``N1`` (m, K, R) at one of them."""
+    m, K, R = hi0.shape
     g_lo, g_hi = (np.broadcast_to(np.asarray(g, dtype=float), (m,))[:, None] for g in (g_lo, g_hi))
-    if wrenches > 1:  # each row's extremes over the wrench blocks (the docstring): the same bound
-        K //= wrenches
-        blocks = [N0[:, w * K : (w + 1) * K] for w in range(wrenches)]
-        hi0, lo0 = blocks[0], blocks[0]
-        for x in blocks[1:]:  # NaN and infinities kept (np.maximum and np.minimum propagate NaN)
-            hi0, lo0 = np.maximum(hi0, x), np.minimum(lo0, x)
-        N1 = N1[:, :K]
-    else:
-        hi0 = lo0 = N0
-    fin0 = (np.isfinite(hi0) & np.isfinite(lo0)).reshape(m, K * R)  # per cell, flat: faster reductions
+    fin0 = np.isfinite(hi0) if lo0 is hi0 else np.isfinite(hi0) & np.isfinite(lo0)
+    fin0 = fin0.reshape(m, K * R)  # per cell, flat: faster reductions
     fin1 = np.isfinite(N1).reshape(m, K * R)
     finite = np.all(np.isfinite(det), axis=1) & np.all(fin0, axis=1) & np.all(fin1, axis=1)
     pos, neg = np.all(det > 0, axis=1), np.all(det < 0, axis=1)
     steady = finite & (pos | neg)
     # the largest magnitudes (non-finite values counted as 0, so no NaN is left to skip: max, not nanmax)
     big = np.abs(np.where(fin0, hi0.reshape(m, K * R), 0.0))
-    if wrenches > 1:
+    if lo0 is not hi0:
         big = np.maximum(big, np.abs(np.where(fin0, lo0.reshape(m, K * R), 0.0)))
     e = tol.force * np.max(big, axis=1)[:, None, None]  # (m,1,1)
     e = np.maximum(e, 1e-300)
