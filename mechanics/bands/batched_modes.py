@@ -158,8 +158,13 @@ def _distinct_points(bk: BatchKinematics, mu):
     """The friction points (N, n_c) at which ``Q_AI`` differs: ``(points (U, n_c), inverse (N,))``.  ``Q_AI`` depends on
     friction only at the mode's sliding contacts (eqs. 18-20); points equal there, bit for bit, share one matrix."""
     cols = np.unique(bk.contact[bk.slide])
-    _, first, inverse = np.unique(np.ascontiguousarray(mu[:, cols]).view(np.int64), axis=0, return_index=True, return_inverse=True)
-    return mu[first], inverse.reshape(-1)
+    keys = np.ascontiguousarray(mu[:, cols]).view(np.int64)  # a point's bits there (a few dozen points: a dict)
+    first, inverse = {}, np.empty(len(mu), dtype=np.intp)
+    for n, key in enumerate(map(bytes, keys)):
+        inverse[n] = first.setdefault(key, len(first))
+    index = np.zeros(len(first), dtype=np.intp)
+    index[inverse[::-1]] = np.arange(len(mu))[::-1]  # each distinct point's first occurrence
+    return mu[index], inverse
 
 
 def batch_rows_many(jobs, force_margin=None, loads: bool = False) -> list:
@@ -211,7 +216,10 @@ def batch_rows_many(jobs, force_margin=None, loads: bool = False) -> list:
             s2[bad_j] = np.nan
         else:
             s0, s1 = coulomb_rows(bk.mode, bk.idx, bk.contact, mu, sol_j)
-        scale = np.maximum(np.max(np.abs(sol_j[..., 0]), axis=2), np.max(np.abs(b.r0), axis=1)[:, None])
+        largest = np.abs(sol_j[..., 0, 0])  # the largest |c_A| at zero effort, folded over the k rows (a short axis)
+        for i in range(1, k):
+            largest = np.maximum(largest, np.abs(sol_j[..., i, 0]))
+        scale = np.maximum(largest, np.max(np.abs(b.r0), axis=1)[:, None])
         if force_margin is not None:
             s0 = s0 - row_margins(bk.mode, force_margin)
         s0[bad_j] = np.nan
