@@ -209,7 +209,7 @@ class EquilibriumRelaxation:
             En, Et = self.A_eq[:, 0::2], self.A_eq[:, 1::2]
             G = np.ascontiguousarray((En[:, owner] * dirs[:, 0] + Et[:, owner] * dirs[:, 1]).T)
             self._columns = dict(
-                G=G, ub=np.array(ub, dtype=float), gnorm=np.maximum(np.linalg.norm(G, axis=1), 1e-300), owner=owner,
+                G=G, ub=np.array(ub, dtype=float), gnorm=np.linalg.norm(G, axis=1), owner=owner,
                 dir=np.ascontiguousarray(dirs), shift=np.ascontiguousarray((En * base[:, 0] + Et * base[:, 1]).T),
                 base=np.ascontiguousarray(base), b=np.ascontiguousarray(self.b_eq, dtype=float),
             )  # fmt: skip

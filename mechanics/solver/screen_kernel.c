@@ -749,8 +749,8 @@ static int relax_one(Relax *p, const unsigned char *mask, double *force)
         double best = 0.0;
         for (int q = 0; q < na; q++) {
             int j = p->cols[q];
-            if (p->state[j] == 2)
-                continue;
+            if (p->state[j] == 2 || p->gnorm[j] == 0.0)
+                continue; /* basic, or a column with no equilibrium row (it changes nothing) */
             double yg = dotm(y, p->G + (size_t)j * m, m);
             double gain = (p->state[j] == 0 ? yg : -yg) / p->gnorm[j]; /* objective decrease per unit step */
             if (gain > p->dtol && (bland ? enter < 0 : gain > best)) {
