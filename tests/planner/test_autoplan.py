@@ -82,16 +82,23 @@ def test_planner_is_deterministic(tmp_path):
     assert a.plan.sequence[:-1] == b.plan.sequence[:-1]
 
 
-@pytest.mark.parametrize("stem", [pytest.param(s, marks=pytest.mark.slow)  # ~14-25 s each
-                                  if s.startswith("two_link") or s == "reorient_edge_task" else s
-                                  for s in sorted(s for s, p in task_paths().items() if "[goal]" in p.read_text())])
-def test_bundled_goal_tasks(tmp_path, stem):
-    """Each bundled automatic task is planned, certified and re-simulated; the infeasible one says why."""
-    from qsplan.planner.pipeline.run import run_plan
-    from qsplan.planner.plan.results import PlanFailure
+@pytest.mark.parametrize("stem", sorted(s for s, p in task_paths().items() if "[goal]" in p.read_text()))
+def test_bundled_goal_tasks(tmp_path, bundled_plan, stem):
+    """Each bundled automatic task is planned, certified and re-simulated; the infeasible one says why.
 
-    task = load_task(task_paths()[stem])
+    The plan and its exported files are the run's shared ones (``qsplan plan``, :func:`tests.planner.bundled.planned`
+    and the ``bundled_plan`` fixture, which ``test_plan.py`` reads too): this test adds the re-simulation of the
+    exported file at three friction vectors (as ``qsplan plan --verify 3``), the goal reached and the commands'
+    continuity."""
+    import json
+
+    from qsplan.planner.pipeline.run import run_plan
+    from qsplan.planner.pipeline.worker import replay_exported
+    from qsplan.planner.plan.results import PlanFailure
+    from tests.planner.bundled import planned
+
     if stem == "friction_closes_task":
+        task = load_task(task_paths()[stem])
         with pytest.raises(PlanFailure) as err:
             run_plan(task, tmp_path / "out", verify=0, plots=False)
         msg = err.value.report.message
@@ -99,13 +106,16 @@ def test_bundled_goal_tasks(tmp_path, stem):
         assert "with mu in [0, 0.5" in msg  # the friction from which the band closes, by bisection
         assert (tmp_path / "out" / "failure.json").exists()
         return
-    run = run_plan(task, tmp_path / "out", verify=3, plots=False)
-    assert run.followed and run.certificate.ok
+    plan, out = planned(stem), bundled_plan(stem)
+    task = plan.task
+    assert json.loads((out / "certificate.json").read_text())["certified"] is True
+    replays = replay_exported(plan, out / "plan.csv", 3, seed=1)
+    assert len(replays) == 3 and all(r.followed for r in replays), [r.summary() for r in replays if not r.followed]
     if task.goal.x is not None:
-        assert np.ravel(run.plan.phases[-1].x)[-1] == task.goal.x  # a slide's last sample, or a regrasp's x
+        assert np.ravel(plan.phases[-1].x)[-1] == task.goal.x  # a slide's last sample, or a regrasp's x
     else:  # a turning goal: its angle, or its edge on the palm (the certificate checks both)
-        assert run.plan.phases[-1].kind == "pivot" and run.certificate.ok
-    for seg in run.plan.segments:  # commands continuous (a squeezing finger's band unbounded below leapt to -4.5 N m)
+        assert plan.phases[-1].kind == "pivot"
+    for seg in plan.segments:  # commands continuous (a squeezing finger's band unbounded below leapt to -4.5 N m)
         jump = float(np.max(np.abs(np.diff(seg.command)))) if seg.command.size > 1 else 0.0
         assert jump <= 0.1 * (float(np.max(np.abs(seg.command))) + task.torque_resolution), (stem, jump)
 

@@ -229,7 +229,7 @@ def _torque_zero(rows):
 
 @pytest.mark.ompl
 @pytest.mark.parametrize("edit, kw, kinds", [
-    (None, {"n_random": 3, "seed": 5}, set()),
+    pytest.param(None, {"n_random": 3, "seed": 5}, set(), marks=pytest.mark.slow),
     pytest.param(None, {"n_random": 0, "force_margin": 50.0}, {"force margin"}, marks=pytest.mark.slow),
     pytest.param(_flip_velocity, {"n_random": 2}, {"motion"}, marks=pytest.mark.slow),
     pytest.param(_torque_far_outside, {"n_random": 2}, {"torque", "mode"}, marks=pytest.mark.slow),
@@ -237,10 +237,10 @@ def _torque_zero(rows):
     pytest.param(_stop_velocity, {"n_random": 1}, {"mode"}, marks=pytest.mark.slow),
 ])  # fmt: skip
 def test_batched_certificate_is_the_per_vector_one(short_plan, tmp_path, edit, kw, kinds):
-    """All friction vectors of a row in one batch give the certificate of one solve per vector (4-8 s each: the
-    reference solves once per vector; the genuine plan by default, the failing ones slow, while
-    ``test_certify_batched.py`` checks the whole plan's mode checks against the row-by-row reference on every kind
-    of failure by default)."""
+    """All friction vectors of a row in one batch give the certificate of one solve per vector (4-15 s each: the
+    reference solves once per vector; all slow, while ``test_certify_batched.py`` checks the whole plan's mode checks,
+    the only part ``batched`` changes, against the row-by-row reference on genuine plans and every kind of failure by
+    default)."""
     task, out = short_plan
     src = out if edit is None else _corrupt(out, tmp_path / "bad", edit)
     fast = certify_plan(src, task, **kw)

@@ -1,7 +1,7 @@
 """Every failure path of every goal kind writes its report (issue 31, items 2 and 3).
 
 For each kind of failure (a goal by x, by waypoints, by theta, by palm; the paper hand, the two-link hand, the
-parallel jaw) ``qsplan plan`` with the plots on and off exits 2 with one line naming the report, and writes
+parallel jaw) ``qsplan plan`` with the plots on (and off: each report kind by default, every case in the slow run) exits 2 with one line naming the report, and writes
 ``failure.json`` (its ``kind`` and a ``planner_status`` that says what ran) and, with the plots, ``failure.png``;
 no plan file.  Before: a turning goal that could not be planned crashed while drawing its failure
 (``ax.axvline`` of a goal with no x), a goal the route refused wrote no report, a pentagon's turning goal leaked an
@@ -93,8 +93,21 @@ def _failed_run(tmp_path, capsys, task_file, plots: bool) -> dict:
     return report
 
 
-@pytest.mark.parametrize("plots", [True, False], ids=["plots", "no-plots"])
-@pytest.mark.parametrize("case", sorted(CASES))
+def _runs() -> list:
+    """Every case with the plots on (``failure.json`` and ``failure.png``), and with them off the first case of each
+    ``failure.json`` kind by default, the others slow: the plots off change only whether ``failure.png`` is drawn,
+    after the same planning, so one case of each kind shows that no drawing is made and the report is the same."""
+    runs, kinds = [], set()
+    for case in sorted(CASES):
+        runs.append(pytest.param(case, True, id=f"{case}-plots"))
+        kind = CASES[case][2]
+        marks = () if kind not in kinds else (pytest.mark.slow,)
+        kinds.add(kind)
+        runs.append(pytest.param(case, False, id=f"{case}-no-plots", marks=marks))
+    return runs
+
+
+@pytest.mark.parametrize("case, plots", _runs())
 def test_every_failure_writes_its_report(case, plots, tmp_path, capsys):
     source, edits, kind, status = CASES[case]
     report = _failed_run(tmp_path, capsys, _task_file(tmp_path, source, edits), plots)

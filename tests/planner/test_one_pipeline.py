@@ -139,7 +139,13 @@ def _outline(plan) -> list:
             for p in plan.phases]
 
 
-@pytest.mark.parametrize("name", PAPER_TASKS)
+#: The paper-hand tasks whose generic path is planned in the default run: a slide, a regrasp, a turn and a refusal (one
+#: of each kind of route); the others in the slow run (1-3 s each, the generic path planning them again).
+GENERIC_QUICK = ("demo_task", "scripted_regrasp_task", "reorient_task", "friction_closes_task")
+
+
+@pytest.mark.parametrize("name", [n if n in GENERIC_QUICK else pytest.param(n, marks=pytest.mark.slow)
+                                  for n in PAPER_TASKS])  # fmt: skip
 def test_generic_path_equals_the_accelerated_paper_hand(name):
     """Accelerator off: the described hand's generic closing, scenes and grasp candidates."""
     task = bundled_task(name)

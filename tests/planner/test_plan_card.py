@@ -5,6 +5,7 @@ layout checks of every figure (no overlapping text, no legend over data, units o
 
 import re
 from dataclasses import fields
+from functools import cache
 
 import numpy as np
 import pytest
@@ -33,11 +34,17 @@ def planned(name):
     return shared(name)
 
 
+@cache
+def card(name):
+    """The plan card of a bundled task's plan, drawn once per process: the tests below only read it (1-3 s each)."""
+    return plan_card(planned(name))
+
+
 def every_finger_touches(plan, pose, q) -> bool:
     """The contact search finds the grasp's contact set (palm, palm, a left-finger link, a right-finger link); a
     paper-form hand's in any formation: the palm and both fingers touch (qsplan.hands.contacts.found)."""
-    from qsplan.hands.contacts.sets import finger_link
     from qsplan.hands.contacts.found import ordered_contacts
+    from qsplan.hands.contacts.sets import finger_link
 
     hand = plan.task.hand
     if getattr(hand, "paper", None) is not None:
@@ -167,13 +174,13 @@ def check_card(plan, fig):
 
 @pytest.mark.parametrize("name", QUICK_CARDS)
 def test_card(name):
-    check_card(planned(name), plan_card(planned(name)))
+    check_card(planned(name), card(name))
 
 
 @pytest.mark.slow
 @pytest.mark.parametrize("name", [n for n in TASKS if n not in QUICK_CARDS])
 def test_card_of_every_bundled_task(name):
-    check_card(planned(name), plan_card(planned(name)))
+    check_card(planned(name), card(name))
 
 
 def test_demo_card_tells_a_finite_upper_edge_from_an_unbounded_one():
@@ -181,7 +188,7 @@ def test_demo_card_tells_a_finite_upper_edge_from_an_unbounded_one():
     plan = planned("demo_task")
     (seg,) = plan.segments
     assert np.all(np.isfinite(seg.upper)) and np.max(seg.upper) > 1.0
-    fig = plan_card(plan)
+    fig = card("demo_task")
     legend = {t.get_text() for t in legend_of(fig).get_texts()}
     assert "upper edge above the plot (finite)" in legend and "upper edge unbounded" not in legend
     assert "slack 0.04 N m" in all_text(fig) and "0.04 N m" in phase_rows(plan)[0][5]
@@ -198,7 +205,7 @@ def test_torque_direction_is_shown():
         r = p - axis
         assert np.sign(r[0] * d[1] - r[1] * d[0]) == sign and np.hypot(*d) == pytest.approx(1.0)
     assert np.all(seg.command > 0) and "counter-clockwise" in phase_rows(plan)[0][4]
-    fig = plan_card(plan)
+    fig = card("demo_task")
     for ax in snapshot_axes(fig):
         assert any(getattr(a, "arrowprops", None) and a.arrowprops.get("arrowstyle") == "-|>" for a in ax.texts)
 
@@ -234,7 +241,6 @@ def as_slide(phase) -> SlidePhase:
 @pytest.mark.parametrize("name", TURNING)
 def test_a_turning_plan_names_and_colours_each_step_kind(name):
     from matplotlib.colors import to_rgb
-
     from qsplan.planner.plotting.plan_panels import phase_colour, timeline_handles
 
     plan = planned(name)
@@ -244,7 +250,7 @@ def test_a_turning_plan_names_and_colours_each_step_kind(name):
     y = vertex_heights(plan, pivot)  # the workpiece turns on vertex 1, the one on the palm: what the title says
     assert np.abs(y[:, 1]).max() < 1e-6 and np.ptp(pivot.pose[:, 2]) > 0.3
     assert np.all(np.delete(y[1:-1], 1, axis=1) > 1e-4)  # every other vertex lifted (the last row may land an edge)
-    fig = plan_card(plan)
+    fig = card(name)
     for ax, s in zip(snapshot_axes(fig), card_snapshots(plan)):
         title = ax.get_title()
         expected = {"slide": "sliding", "hold": "holding", "pivot": "pivoting on vertex 1"}[kinds[s.phase]]
@@ -289,7 +295,7 @@ def test_every_phase_is_drawn_on_a_readable_scale(name):
     """Issue 31: the reorientation card drew phase 0's 0.1-0.35 N m band on the pivot's 8 N m axis.  Each phase's
     command and band span a quarter of its panel at least, and each slack bracket 3 % of it."""
     plan = planned(name)
-    fig = plan_card(plan)
+    fig = card(name)
     for ph in plan.segments:
         ax = command_panel(fig, ph)
         to_axes = ax.transData + ax.transAxes.inverted()
@@ -351,9 +357,9 @@ def test_band_labels_cover_no_data(name):
     from qsplan.planner.plotting.plan import plot_plan_bands
 
     plan = planned(name)
-    card = plan_card(plan)
-    assert labels_over_data(card) == []
-    assert any(t.get_text().startswith("narrowest ") for ax in card.axes for t in ax.texts) == np.isfinite(
+    drawn = card(name)
+    assert labels_over_data(drawn) == []
+    assert any(t.get_text().startswith("narrowest ") for ax in drawn.axes for t in ax.texts) == np.isfinite(
         min(np.min(s.width) for s in plan.segments))  # fmt: skip
     bands = plot_plan_bands(plan)[0].get_figure(root=True)
     assert labels_over_data(bands) == [] and overlapping_texts(bands) == []
@@ -364,12 +370,12 @@ def test_mode_timeline_labels_fit_their_bars(name):
     """Issue 31: the mode timeline's pivot label ran past its bar."""
     from matplotlib.patches import Rectangle
     from matplotlib.text import Text
-
     from qsplan.planner.plotting.plan import plot_mode_timeline
+
     from tests.planner.figure_checks import render
 
     plan = planned(name)
-    for ax in (plot_mode_timeline(plan), next(a for a in plan_card(plan).axes
+    for ax in (plot_mode_timeline(plan), next(a for a in card(name).axes
                                               if a.get_title(loc="left").startswith("phases as numbered"))):  # fmt: skip
         fig = ax.get_figure(root=True)
         renderer = render(fig)
@@ -394,7 +400,7 @@ def test_velocity_panels_draw_what_the_controller_is_sent(tmp_path):
 
     plan = planned("two_link_regrasp_task")
     export_plan(plan, tmp_path)
-    fig = plan_card(plan)
+    fig = card("two_link_regrasp_task")
     names = joint_names(plan.task.hand)
     regrasp = next(i for i, ph in enumerate(plan.phases) if isinstance(ph, RegraspPlan))
     ph = plan.phases[regrasp]
