@@ -147,3 +147,21 @@ def test_kernel_refuses_arrays_of_the_wrong_size():
         bs.compiled_relax(*args, 6, *rest[1:])
     status, forces = bs.compiled_relax(*args[:-1], masks[:0], *rest)
     assert status == b"" and forces == b""
+
+
+@needs_relax
+def test_pruned_modes_command_never_imports_highspy_or_scipy(tmp_path):
+    """Issue 33: with the kernel built, ``qsplan modes`` prunes without HiGHS (~14 ms of import) or scipy."""
+    import json
+    import subprocess
+    import sys
+
+    from qsplan.mechanics.model.scene_io_write import scene_to_dict
+
+    path = tmp_path / "planted.json"
+    path.write_text(json.dumps(scene_to_dict(_planted(7, 12, 9))))
+    code = (f"from qsplan.planner.cli.main import main\nassert main(['modes', {str(path)!r}, '--json', '--search', "
+            "'prune', '--workers', '1']) == 0\nimport sys\n"
+            "print('loaded:', *sorted(m for m in ('highspy', 'scipy') if m in sys.modules))")  # fmt: skip
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
+    assert out.splitlines()[-1] == "loaded:"
