@@ -295,6 +295,7 @@ static int coulomb_prunes(Ctx *c, const double *u)
         k++;
     }
     /* one LU with partial pivoting: the determinant for the guard, then the solve */
+    double *dinv = c->y; /* 1 / pivot (c->y: free during the screen) */
     for (int j = 0; j < nS; j++) {
         int p = j;
         double best = fabs(K[j * nS + j]);
@@ -305,8 +306,8 @@ static int coulomb_prunes(Ctx *c, const double *u)
             }
         if (best == 0.0)
             return 0;
-        if (p != j) {
-            for (int q = 0; q < nS; q++) {
+        if (p != j) { /* columns before j hold nothing needed any more (no L is kept: h is eliminated alongside) */
+            for (int q = j; q < nS; q++) {
                 double t = K[j * nS + q];
                 K[j * nS + q] = K[p * nS + q];
                 K[p * nS + q] = t;
@@ -316,6 +317,7 @@ static int coulomb_prunes(Ctx *c, const double *u)
             h[p] = t;
         }
         double inv = 1.0 / K[j * nS + j];
+        dinv[j] = inv;
         ratio *= best;
         for (int i = j + 1; i < nS; i++) {
             double f = K[i * nS + j] * inv;
@@ -327,11 +329,11 @@ static int coulomb_prunes(Ctx *c, const double *u)
     if (!(ratio >= c->red_sing))
         return 0;
     double *w = c->u + r; /* after u */
-    for (int i = nS - 1; i >= 0; i--) {
+    for (int i = nS - 1; i >= 0; i--) { /* the pivots' inverses: no division on the chain of dependent steps */
         double s = h[i];
         for (int q = i + 1; q < nS; q++)
             s -= K[i * nS + q] * w[q];
-        w[i] = s / K[i * nS + i];
+        w[i] = s * dinv[i];
     }
     /* ||c||_2^2 = ||c0||^2 + ||w||^2 (c0, the least-norm force, is orthogonal to N's columns) bounds F:
      * a slack below -force_rel * Fup prunes at once (2: room for rounding; the exact test would too) */
@@ -341,17 +343,18 @@ static int coulomb_prunes(Ctx *c, const double *u)
     double Fup = 2.0 * fmax(c->rhs_max, sqrt(ww)), early = -c->force_rel * Fup;
     double F = c->rhs_max, worst = INFINITY;
     for (int s = 0; s < nA; s++) {
-        double cn = c->y0[s], ct = c->y0[nA + s];
+        double cn = c->y0[s];
         const double *Nn = c->NB + (size_t)s * nS, *Nt = c->NB + (size_t)(nA + s) * nS;
-        for (int q = 0; q < nS; q++) {
+        for (int q = 0; q < nS; q++)
             cn += Nn[q] * w[q];
-            ct += Nt[q] * w[q];
-        }
         if (fabs(cn) > F)
             F = fabs(cn);
         if (cn < worst)
             worst = cn;
-        if (c->rolling[s]) { /* eq. (28) */
+        if (c->rolling[s]) { /* eq. (28); a sliding contact's c_t is -mu xi c_n by construction, unused */
+            double ct = c->y0[nA + s];
+            for (int q = 0; q < nS; q++)
+                ct += Nt[q] * w[q];
             double m = c->mu[c->A[s]] * cn;
             if (fabs(ct) > F)
                 F = fabs(ct);
