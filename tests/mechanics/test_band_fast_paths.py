@@ -127,3 +127,20 @@ def test_cell_bounds_over_wrench_extremes_are_those_over_every_control_point():
             met["inf"] += int(np.sum(lb == np.inf))
             met["-inf"] += int(np.sum(lb == -np.inf))
     assert all(v > 0 for v in met.values()), met
+
+
+@pytest.mark.parametrize("n", [7, 300])  # the reductions, then the column fold
+def test_intersect_rows_broadcast_is_the_materialised_rows(n):
+    """The rows under each wrench vertex share ``s1``: broadcast (wrench_vertex_parts) or repeated, the same bits."""
+    rng = np.random.default_rng([SEED, n])
+    tol = DEFAULT_TOLERANCES
+    W, F, r = 4, 8, 5
+    s0, s1, scale = _rows(rng, n * W * F, r)
+    s0, scale = s0.reshape(n, W, F, r), scale.reshape(n, W, F)
+    s1 = s1[: n * F].reshape(n, 1, F, r)
+    with np.errstate(all="ignore"):
+        got = intersect_rows(s0, s1, scale, tol)
+        flat = intersect_rows(s0.reshape(-1, r), np.broadcast_to(s1, s0.shape).reshape(-1, r), scale.reshape(-1), tol)
+    assert (s0.size >= effort.COLUMNS_FROM) == (n > 10)
+    for x, y in zip(got, flat):
+        assert x.shape == (n, W, F) and x.tobytes() == y.reshape(n, W, F).tobytes()
