@@ -2,7 +2,8 @@
 
 * :func:`qsplan.mechanics.bands.effort.intersect_rows` folds large row sets column by column
   (:data:`~qsplan.mechanics.bands.effort.COLUMNS_FROM`): the same bits as its reductions, and the same bands as a
-  plain loop over the rows (an independent reference), on rows with flat, NaN, infinite and zero entries;
+  plain loop over the rows (an independent reference), on rows with flat, NaN, infinite and zero entries; rows that
+  share ``s1`` broadcast (the wrench vertices') give the bits of the same rows repeated;
 * :func:`qsplan.mechanics.bands.preclusion.cell_lower_bounds` with ``wrenches`` (each row's extremes over the wrench
   vertices) gives the bounds of every control point (``wrenches=1``) on the cells of real competitor searches under a
   wrench box, box and shared friction, the root cell and its bisections: cells where ``det`` keeps its sign and
