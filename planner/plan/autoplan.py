@@ -41,8 +41,8 @@ from qsplan.planner.search.ompl_search import search_route
 from qsplan.planner.search.tables import band_tables, table_grid
 from qsplan.planner.task.goal import feature_text
 
-__all__ = ["FREE_GRID", "FREE_SEARCH_MARGIN", "MAX_GOAL_GRASPS", "MAX_ROUNDS", "grasp_rows", "goal_nodes",
-           "plan_automatic", "route_phases", "start_nodes"]
+__all__ = ["FREE_GRID", "FREE_SEARCH_MARGIN", "GOAL_FREE_TOL", "MAX_GOAL_GRASPS", "MAX_ROUNDS", "grasp_rows",
+           "goal_nodes", "plan_automatic", "route_phases", "start_nodes"]
 
 #: Rounds of search and realisation: each failed round closes a table cell or forbids a regrasp, so a
 #: handful suffices; the bound keeps a pathological task from looping.
@@ -52,6 +52,12 @@ MAX_ROUNDS = 12
 #: ``[start]`` (and its goal grasps always): 13 values of a 3 rad range are 0.22 rad apart, about 2 cm at the tip of
 #: a 7 cm link; two-link fingers then close from 13 x 13 = 169 rows (each closing batched over the whole palm).
 FREE_GRID = 13
+
+#: How close (rad or m) a goal row's free joints must come to the values a route must end with
+#: (:func:`goal_nodes`' ``goal_free``: a slide that a turn continues from its flush instant, whose free joints the
+#: pivot holds): the tables copy those values into a held row, so they agree to round-off; any other row of the grid
+#: is at least a grid step (0.2 rad) away.
+GOAL_FREE_TOL = 1e-9
 
 #: Most goal grasps a described hand's tables keep (a spread of the valid ones): each adds two rows (held at the goal,
 #: sloped from each start grasp) to tables whose every state is judged.
@@ -103,10 +109,17 @@ def start_nodes(tables, task) -> list:
     return [(g, i) for g in _start_grasps(tables, task, i)]
 
 
-def goal_nodes(tables, task) -> list:
-    """The search's goal nodes ``(grasp, i)``: the valid rows meeting the goal's features at the goal x."""
+def goal_nodes(tables, task, goal_free=None) -> list:
+    """The search's goal nodes ``(grasp, i)``: the valid rows meeting the goal's features at the goal x; with
+    ``goal_free`` (the free joints' values, rad or m, in the order of ``task.hand.free_joints``) only the rows holding
+    those values there (to :data:`GOAL_FREE_TOL`)."""
     i = tables.index(task.goal.x)
-    return [(g, i) for g in _goal_grasps(tables, task, i) if tables.graph.valid[g, i]]
+    nodes = [(g, i) for g in _goal_grasps(tables, task, i) if tables.graph.valid[g, i]]
+    if goal_free is None:
+        return nodes
+    free = list(task.hand.free_joints)
+    want = np.asarray(goal_free, dtype=float)
+    return [(g, j) for g, j in nodes if np.all(np.abs(tables.q[g, j, free] - want) <= GOAL_FREE_TOL)]
 
 
 def route_phases(route) -> list:
@@ -243,7 +256,8 @@ class _Rejected(Exception):
         self.what, self.failure = what, failure
 
 
-def plan_automatic(task, options=None, progress=None, planner: str = "widest", tables=None, timed: bool = True) -> Plan:
+def plan_automatic(task, options=None, progress=None, planner: str = "widest", tables=None, timed: bool = True,
+                   goal_free=None) -> Plan:  # fmt: skip
     """Plan an automatic task (one with a ``goal``): see the module docstring.
 
     Parameters
@@ -260,6 +274,10 @@ def plan_automatic(task, options=None, progress=None, planner: str = "widest", t
     timed : bool
         Time-scale the plan (:func:`qsplan.planner.plan.timing.time_scale`); False: the quasistatic phases, for a
         route that continues them (:mod:`qsplan.planner.plan.turning`).
+    goal_free : array-like, optional
+        The free joints' values (rad or m, ``task.hand.free_joints``' order) the route must end with
+        (:func:`goal_nodes`), sliding (no regrasp into its last grasp): a turn's slide ends at its formation's flush
+        instant, whose free joints the pivot holds, and the turn continues from its last row.
 
     Returns
     -------
@@ -292,7 +310,7 @@ def plan_automatic(task, options=None, progress=None, planner: str = "widest", t
     progress(f"  {tables.states} configurations and {tables.band_states} guaranteed bands in {tables.seconds:.2f} s")
     i_start, i_goal = tables.index(task.start_x), tables.index(task.goal.x)
     starts = [g for g, _ in start_nodes(tables, task)]
-    goals = goal_nodes(tables, task)
+    goals = goal_nodes(tables, task, goal_free)
     if not starts:
         raise PlanFailure(unreachable_goal_report(task, tables, i_start, "start", _start_grasps))
     if not goals:
@@ -300,6 +318,8 @@ def plan_automatic(task, options=None, progress=None, planner: str = "widest", t
     if any(s == g for s in ((st, i_start) for st in starts) for g in goals):
         raise QsplanError(f"goal: the start already meets the goal ({task.goal.describe()}): nothing to plan")
     forbidden, counters, rounds, search_s, evaluations = set(), [0, 0.0], 0, 0.0, 0
+    if goal_free is not None:  # the route ends with a slide in its goal grasp, not a regrasp into it: what follows
+        forbidden = {(h, g, i) for g, i in goals for h in range(len(tables.grasps)) if h != g}  # continues the slide
     width = tables.graph.width.copy()
     while True:
         rounds += 1

@@ -221,14 +221,19 @@ def _route(task, pivot, start, theta_goal, pieces, options, progress, planner, s
 
     hand = task.hand
     sub, step = slide_task(task, pivot, start)
+    # a hand with free joints: the slide must end holding the flush instant's (the pivot holds them), not in another
+    # grasp of the goal's features whose last row would then jump to the flush instant
+    free = list(hand.free_joints)
+    goal_free = np.asarray(start, dtype=float)[3:][free] if free else None
     try:
-        slide = plan_automatic(sub, options, progress, planner, timed=False)
+        slide = plan_automatic(sub, options, progress, planner, timed=False, goal_free=goal_free)
     except PlanFailure as exc:  # said as the route's step, drawn with the task it was planned as
         raise PlanFailure(StepReport(step, sub, exc.report)) from None
     phases = list(slide.phases)
     last = phases[-1]
     if not last.in_contact:
-        raise PlanFailure(configuration_report(task, last.name, "the flush instant", float(last.x[-1]), last.q[-1],
+        x_last = float(np.ravel(last.x)[-1])  # a regrasp's x is one number
+        raise PlanFailure(configuration_report(task, last.name, "the flush instant", x_last, last.q[-1],
                                                "the route to the flush instant ends with a regrasp, not in contact",
                                                "ran: the sequence search to the flush instant"))  # fmt: skip
     # the last row moves onto the flush instant itself (5 um on): a row at rest, its band judged again for the

@@ -36,7 +36,7 @@ from qsplan.mechanics.errors import QsplanError
 from qsplan.planner.replay.phases import replay_segments, rows_pose
 
 __all__ = ["ReplaySystem", "SegmentReplay", "Replay", "replay_plan", "replay_segments",
-           "friction_samples", "REPLAY_STEP"]
+           "friction_samples", "REPLAY_STEP", "REVERSAL_NOTE"]
 
 #: Step of the replay (s).  Mode changes are located by root finding, not by the step; 0.05 s is
 #: 0.5 mm of workpiece travel at the default 1 cm/s, the spacing of the plan's rows (its band sweep),
@@ -62,6 +62,25 @@ def _travel_step(t, x, travel) -> float:
     dt, dx = np.diff(t), np.abs(np.diff(x))
     speed = float(np.max(dx[dt > 0] / dt[dt > 0], initial=0.0))
     return min(REPLAY_STEP, travel / speed) if speed > 0 else REPLAY_STEP
+
+
+#: How a pivot's piece that ends at its contact's slip reversal was replayed (:func:`_ends_at_its_reversal`).
+REVERSAL_NOTE = ("a pivot's piece ending at a contact's slip reversal (the planner's cut): simulated until that "
+                 "contact's sliding speed reached zero, within the cut's bracket of the piece's last row")
+
+
+def _ends_at_its_reversal(motion, columns, rows) -> bool:
+    """Whether a pivot's simulated piece stopped where the plan ends it: a contact's sliding speed reached zero (the
+    simulator's ``sliding`` event, the last of its motion) within :data:`qsplan.planner.plan.pivot.REVERSAL_TOL` of the
+    piece's last row in the workpiece's angle.  The formation search cuts a pivot on the far side of each slip reversal,
+    bisected to that bracket (:func:`qsplan.planner.plan.pivot.pivot_geometry`), and holds there: the instants left
+    after the reversal belong to the hold, where the certificate proves that nothing moves."""
+    from qsplan.planner.plan.pivot import REVERSAL_TOL
+
+    if not motion.events or motion.events[-1].kind != "sliding" or motion.segments[-1].ended_by != "sliding":
+        return False
+    theta_end = float(np.asarray(columns["theta_workpiece"], float)[rows[-1]])
+    return abs(float(motion.events[-1].state[2]) - theta_end) <= REVERSAL_TOL
 
 
 def _stop_message(motion, planned) -> str | None:
@@ -360,6 +379,8 @@ def replay_plan(columns, hand, mu, options=None, scenes=None, formation=None) ->
         else:  # stopped at the segment's start
             err, end = np.nan, np.concatenate([pose, q, [t[0]]])
         stop = _stop_message(motion, seg["mode"])
+        if turning and stop is not None and _ends_at_its_reversal(motion, columns, rows):
+            stop, note = None, REVERSAL_NOTE
         out.append(SegmentReplay(seg["phase"], seg["mode"], tuple(motion.labels), stop, err, float(end[0]), motion,
                                  note))  # fmt: skip
         if not out[-1].followed:

@@ -42,8 +42,8 @@ def _same_manipulator(a, b):
 # --- the bundled hands -------------------------------------------------------------------------------------------
 
 
-def test_the_three_bundled_hands_load():
-    assert set(bundled_hands()) == {"paper_hand", "two_link_hand", "parallel_jaw"}
+def test_the_bundled_hands_load():
+    assert set(bundled_hands()) == {"paper_hand", "two_link_hand", "parallel_jaw", "turning_hand"}
     for name in bundled_hands():
         desc = load_hand(name)
         assert isinstance(desc, HandDescription)
@@ -347,7 +347,8 @@ def test_toml_syntax_error_and_missing_files_are_one_line(tmp_path):
         load_hand(path)
     assert "\n" not in str(info.value)
     with pytest.raises(SceneError, match=re.escape(f"{tmp_path / 'nope.toml'}: no such hand file; expected a path to a "
-                                                   ".toml file or a bundled hand (paper_hand, parallel_jaw, two_link_hand)")):  # fmt: skip
+                                                   ".toml file or a bundled hand (paper_hand, parallel_jaw, "
+                                                   "turning_hand, two_link_hand)")):  # fmt: skip
         load_hand("nope.toml", base_dir=tmp_path)
     with pytest.raises(SceneError, match=r"^no_such_hand: no such hand file"):
         load_hand("no_such_hand")

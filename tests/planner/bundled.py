@@ -22,11 +22,23 @@ try:
 except ImportError:  # not POSIX: each process plans for itself
     fcntl = None
 
-__all__ = ["SHARED", "bundled_task", "held", "planned", "shared_root"]
+__all__ = ["SHARED", "SLOW_TASKS", "bundled_task", "held", "planned", "shared_root", "task_params"]
 
 #: The directory where the processes of one test run share their plans (set by ``tests/conftest.py`` in a
 #: pytest-xdist worker); None: this process alone.
 SHARED: Path | None = None
+
+
+#: Bundled tasks whose plan takes more than a few seconds (planning, certifying and re-simulating full_turn_task: ~9 s
+#: on 2 cores): the tests that plan them run in the slow suite (:func:`task_params`).
+SLOW_TASKS = ("full_turn_task",)
+
+
+def task_params(names) -> list:
+    """Bundled task ``names`` as pytest parameters, those of :data:`SLOW_TASKS` marked slow."""
+    import pytest
+
+    return [pytest.param(n, marks=pytest.mark.slow) if n in SLOW_TASKS else n for n in names]
 
 
 def shared_root(tmp_path_factory) -> Path:
