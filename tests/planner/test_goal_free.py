@@ -11,16 +11,11 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from qsplan.planner.plan.autoplan import (
-    GOAL_FREE_TOL,
-    goal_nodes,
-    grasp_rows,
-    plan_automatic,
-)
+
+from qsplan.planner.plan.autoplan import GOAL_FREE_TOL, goal_nodes, grasp_rows, plan_automatic
 from qsplan.planner.search.tables import band_tables, table_grid
 from qsplan.planner.task.goal import palm_x_range
-
-from .bundled import bundled_task
+from tests.planner.bundled import bundled_task
 
 
 @pytest.fixture(scope="module")
