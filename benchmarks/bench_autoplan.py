@@ -12,9 +12,11 @@ sweeps, OMPL regrasps; wall time), the described hands' (issue 15: the two-link 
 gripper) on their contact manifolds: time, states evaluated (the planner's validity checks and dense
 samples), phases and the narrowest guaranteed band.  The goals that turn the workpiece (issue 23: the slide to the
 flush instant, a certified hold, the pivot) in a table of their own: time, states, phases, the narrowest band, the
-holds and their proof margin, the motion's duration.  ``qsplan demo``'s whole-command time is in ``bench_plan.py``.
+holds and their proof margin, the motion's duration.  Last, how far each bundled turning task's hand and workpiece
+turn (:data:`REACH`): every formation at each friction set, where its geometry ends and where its bands hold to
+(``docs/reorientation.md``'s table).  ``qsplan demo``'s whole-command time is in ``bench_plan.py``.
 
-Run: ``python3 benchmarks/bench_autoplan.py [--iterations N]``.
+Run: ``python3 benchmarks/bench_autoplan.py [--iterations N] [--turning]`` (``--turning``: only the turning tables).
 """
 
 import argparse
@@ -183,9 +185,16 @@ def turning_rows(tasks):
     fidelity(tasks["reorient_task"])
 
 
+#: How far each bundled turning hand and workpiece turns (issue 34's table): the task, and the friction sets its
+#: formations are judged at.
+REACH = {"reorient_task": ((0.0, 0.0), (0.0, 0.2)), "reorient_edge_task": ((0.0, 0.0), (0.0, 0.2)),
+         "full_turn_task": ((0.0, 0.0), (0.0, 0.03), (0.0, 0.05), (0.0, 0.1), (0.0, 0.2), (0.1, 0.2))}  # fmt: skip
+
+
 def fidelity(demo):
-    """Issue 32 item 4: from the demo's start, at friction [0, 0] and [0, 0.2], the furthest turn the search reaches:
-    every formation, where its geometry ends, and where its bands first fall below the resolution before that."""
+    """Issue 32 item 4 and issue 34: from each :data:`REACH` task's start (``reorient_task``: the demo's), at each of its
+    friction sets, the furthest turn the search reaches: every formation, where its geometry ends, and where its bands
+    first fall below the resolution before that."""
     from dataclasses import replace
 
     import numpy as np
@@ -197,23 +206,30 @@ def fidelity(demo):
     from qsplan.planner.task.goal import Goal
 
     print()
-    print(f"{'friction':<11} {'formation':<70} {'geometry ends (deg)':>20} {'bands hold to (deg)':>20}  what blocks")
-    for mu in ((0.0, 0.0), (0.0, 0.2)):
-        for pivot, start in pivot_formations(demo.hand):
-            far = pivot.direction * 1.6  # beyond any event: where the geometry ends
-            task = replace(demo, mu_range=mu, goal=Goal(None, None, None, theta=far))
-            geo = pivot_geometry(task, pivot, start, far)
-            end = geo.end.theta if geo.end is not None else far
-            last = float(geo.path.theta[max((geo.end.row if geo.end else geo.path.theta.size) - 1, 1)])
-            try:
-                pieces = pivot_pieces(task, pivot, start, last, pivot_geometry(task, pivot, start, last), None)
-                reach, why = last, geo.end.words if geo.end else "-"
-                n = len(pieces)
-            except PlanFailure as exc:
-                reach, why, n = float(exc.report.pose[2]), exc.report.reason, 0
-            label = f"{pivot.words(demo.hand)}"[:70]
-            print(f"{str(list(mu)):<11} {label:<70} {np.degrees(end):20.2f} {np.degrees(reach):20.2f}  "
-                  f"{why[:90]}{'' if not n else f' ({n} pieces)'}")  # fmt: skip
+    print(f"{'task':<15} {'friction':<11} {'formation':<32} {'geometry ends (deg)':>20} {'bands hold to (deg)':>20}  "
+          "what blocks")  # fmt: skip
+    for stem, frictions in REACH.items():
+        base = demo if stem == "reorient_task" else load_task(task_paths()[stem])
+        hand = base.hand
+        free = None
+        if hand.free_joints and base.start_joints is not None:  # held as the task starts them (the search's rule)
+            free = np.asarray(base.start_joints, dtype=float)[list(hand.free_joints)]
+        formations = pivot_formations(hand, free)
+        for mu in frictions:
+            for pivot, start in formations:
+                far = pivot.direction * 1.6  # beyond any event: where the geometry ends
+                task = replace(base, mu_range=mu, goal=Goal(None, None, None, theta=far))
+                geo = pivot_geometry(task, pivot, start, far)
+                end = geo.end.theta if geo.end is not None else far
+                last = float(geo.path.theta[max((geo.end.row if geo.end else geo.path.theta.size) - 1, 1)])
+                try:
+                    pieces = pivot_pieces(task, pivot, start, last, pivot_geometry(task, pivot, start, last), None)
+                    reach, why = last, geo.end.words if geo.end else "-"
+                    n = len(pieces)
+                except PlanFailure as exc:
+                    reach, why, n = float(exc.report.pose[2]), exc.report.reason, 0
+                print(f"{stem.removesuffix('_task'):<15} {str(list(mu)):<11} {pivot.name:<32} {np.degrees(end):20.2f} "
+                      f"{np.degrees(reach):20.2f}  {why[:90]}{'' if not n else f' ({n} pieces)'}")  # fmt: skip
 
 
 if __name__ == "__main__":
