@@ -51,6 +51,7 @@ typedef struct {
     size_t out_len, out_cap;
     long long n_kin, n_coul, n_total;
     int oom;
+    int hot; /* the contact (position in A) whose slack rejected the last mode: checked first */
 } Ctx;
 
 /* Householder QR of X (m x n, row-major, m >= n): R in the upper triangle of X; reflector k in column k
@@ -176,6 +177,7 @@ static void setup_set(Ctx *c)
     c->nS = nA - c->r;
     int r = c->r;
     c->eq_ok = 0;
+    c->hot = 0;
     /* kinematics: QR of N_A^T (dof x nA) */
     double *X = c->qr, *Q = c->q;
     for (int l = 0; l < dof; l++)
@@ -286,7 +288,7 @@ static int coulomb_prunes(Ctx *c, const double *u)
             vt += c->TZ[s * r + q] * u[q];
         if (!(fabs(vt) > c->slip))
             return 0; /* xi (eq. 16) not certain: the reference decides */
-        int at = (vt > 0 ? 0 : nA) + s;
+        int at = (vt <= 0) * nA + s; /* xi = +1 rows first */
         if (c->KSnorm[at] == 0.0)
             return 0;
         memcpy(K + (size_t)k * nS, c->KS + (size_t)at * nS, sizeof(double) * nS);
@@ -294,55 +296,66 @@ static int coulomb_prunes(Ctx *c, const double *u)
         ratio *= c->KSnorm[at];
         k++;
     }
-    /* one LU with partial pivoting: the determinant for the guard, then the solve */
+    /* one LU with partial pivoting: the determinant for the guard, then the solve.  Rows are swapped by
+     * pointer; each elimination updates one row from another (distinct rows: restrict, vectorised). */
     double *dinv = c->y; /* 1 / pivot (c->y: free during the screen) */
+    double *rowp[nS > 0 ? nS : 1], hh[nS > 0 ? nS : 1];
+    for (int i = 0; i < nS; i++) {
+        rowp[i] = K + (size_t)i * nS;
+        hh[i] = h[i];
+    }
     for (int j = 0; j < nS; j++) {
         int p = j;
-        double best = fabs(K[j * nS + j]);
-        for (int i = j + 1; i < nS; i++)
-            if (fabs(K[i * nS + j]) > best) {
-                best = fabs(K[i * nS + j]);
-                p = i;
-            }
+        double best = fabs(rowp[j][j]);
+        for (int i = j + 1; i < nS; i++) { /* the first largest, as before; selects, not branches (the
+                                             * pivot's row is unpredictable) */
+            double a = fabs(rowp[i][j]);
+            int gt = a > best;
+            best = gt ? a : best;
+            p = gt ? i : p;
+        }
         if (best == 0.0)
             return 0;
-        if (p != j) { /* columns before j hold nothing needed any more (no L is kept: h is eliminated alongside) */
-            for (int q = j; q < nS; q++) {
-                double t = K[j * nS + q];
-                K[j * nS + q] = K[p * nS + q];
-                K[p * nS + q] = t;
-            }
-            double t = h[j];
-            h[j] = h[p];
-            h[p] = t;
-        }
-        double inv = 1.0 / K[j * nS + j];
+        double *t = rowp[j], th = hh[j]; /* swapped unconditionally (p == j: a no-op) */
+        rowp[j] = rowp[p];
+        rowp[p] = t;
+        hh[j] = hh[p];
+        hh[p] = th;
+        const double *restrict pj = rowp[j];
+        double inv = 1.0 / pj[j], hj = hh[j];
         dinv[j] = inv;
         ratio *= best;
         for (int i = j + 1; i < nS; i++) {
-            double f = K[i * nS + j] * inv;
+            double *restrict pi = rowp[i];
+            double f = pi[j] * inv;
             for (int q = j + 1; q < nS; q++)
-                K[i * nS + q] -= f * K[j * nS + q];
-            h[i] -= f * h[j];
+                pi[q] -= f * pj[q];
+            hh[i] -= f * hj;
         }
     }
     if (!(ratio >= c->red_sing))
         return 0;
     double *w = c->u + r; /* after u */
     for (int i = nS - 1; i >= 0; i--) { /* the pivots' inverses: no division on the chain of dependent steps */
-        double s = h[i];
+        const double *pi = rowp[i];
+        double s = hh[i];
         for (int q = i + 1; q < nS; q++)
-            s -= K[i * nS + q] * w[q];
+            s -= pi[q] * w[q];
         w[i] = s * dinv[i];
     }
     /* ||c||_2^2 = ||c0||^2 + ||w||^2 (c0, the least-norm force, is orthogonal to N's columns) bounds F:
-     * a slack below -force_rel * Fup prunes at once (2: room for rounding; the exact test would too) */
+     * a slack below -force_rel * Fup prunes at once (2: room for rounding; the exact test would too).
+     * Whether some slack falls below it does not depend on the order the contacts are checked in: the
+     * contact that rejected the last mode goes first (neighbouring modes mostly fail at the same one). */
     double ww = c->c0norm2;
     for (int q = 0; q < nS; q++)
         ww += w[q] * w[q];
     double Fup = 2.0 * fmax(c->rhs_max, sqrt(ww)), early = -c->force_rel * Fup;
     double F = c->rhs_max, worst = INFINITY;
-    for (int s = 0; s < nA; s++) {
+    for (int k = -1; k < nA; k++) {
+        int s = k < 0 ? c->hot : k;
+        if (k == c->hot)
+            continue;
         double cn = c->y0[s];
         const double *Nn = c->NB + (size_t)s * nS, *Nt = c->NB + (size_t)(nA + s) * nS;
         for (int q = 0; q < nS; q++)
@@ -363,8 +376,10 @@ static int coulomb_prunes(Ctx *c, const double *u)
             if (m - ct < worst)
                 worst = m - ct;
         }
-        if (worst < early)
+        if (worst < early) {
+            c->hot = s;
             return 1;
+        }
     }
     return F > 0 && worst < -c->force_rel * F;
 }
