@@ -122,6 +122,23 @@ def goal_nodes(tables, task, goal_free=None) -> list:
     return [(g, j) for g, j in nodes if np.all(np.abs(tables.q[g, j, free] - want) <= GOAL_FREE_TOL)]
 
 
+def _free_joints_report(task, tables, i, goal_free):
+    """The goal's features are met at grid index ``i``, but by no row holding the free joints at ``goal_free`` (a turn's
+    flush instant): a configuration report naming the joints, the values asked and those the valid rows hold."""
+    from qsplan.planner.plan.failure import ConfigurationReport
+
+    hand = task.hand
+    free = list(hand.free_joints)
+    names = [hand.joint_names[j] for j in free]
+    units = [JOINT_UNITS[hand.joint_kinds[j]]["q"] for j in free]
+    asked = ", ".join(f"{n} = {v:.6g} {u}" for n, v, u in zip(names, goal_free, units))
+    held = sorted({tuple(round(float(v), 6) for v in tables.q[g, j, free]) for g, j in goal_nodes(tables, task)})
+    rows = "; ".join(", ".join(f"{n} = {v:.6g} {u}" for n, v, u in zip(names, h, units)) for h in held[:4])
+    reason = (f"the goal's features are met at x = {float(tables.x[i]):.4g} m only by grasps holding the free joints "
+              f"elsewhere ({rows}), none at the values the route must end with ({asked})")  # fmt: skip
+    return ConfigurationReport("the goal", "the goal", float(tables.x[i]), None, reason)
+
+
 def route_phases(route) -> list:
     """The route's steps grouped into phases: ``("slide", grasp, i0, i1, effort)`` (a run of steps in one grasp,
     effort joint and direction) and ``("regrasp", from grasp, to grasp, i)``."""
@@ -313,6 +330,8 @@ def plan_automatic(task, options=None, progress=None, planner: str = "widest", t
     goals = goal_nodes(tables, task, goal_free)
     if not starts:
         raise PlanFailure(unreachable_goal_report(task, tables, i_start, "start", _start_grasps))
+    if not goals and goal_free is not None and goal_nodes(tables, task):  # the features are met, the joints not
+        raise PlanFailure(_free_joints_report(task, tables, i_goal, goal_free))
     if not goals:
         raise PlanFailure(unreachable_goal_report(task, tables, i_goal, "goal", _goal_grasps))
     if any(s == g for s in ((st, i_start) for st in starts) for g in goals):

@@ -57,3 +57,19 @@ def test_the_route_ends_sliding_in_that_grasp_or_is_refused(tables_of_task):
     assert np.max(np.abs(ends - start)) > 1e-3
     with pytest.raises(PlanFailure, match="no guaranteed band"):
         plan_automatic(task, tables=tables, timed=False, goal_free=start)
+
+
+def test_a_goal_met_only_with_other_free_joints_says_so(tables_of_task):
+    """The goal's features are met, but by no row holding the asked free joints: the refusal says so, naming each
+    free joint with the value asked and the values the goal's rows hold, not "unreachable on this palm"."""
+    from qsplan.planner.plan.results import PlanFailure
+
+    task, tables = tables_of_task
+    free = list(task.hand.free_joints)
+    asked = np.asarray(task.start_joints, float)[free] + 0.123  # off the grid of held values
+    with pytest.raises(PlanFailure) as err:
+        plan_automatic(task, tables=tables, timed=False, goal_free=asked)
+    msg = err.value.report.message
+    assert "only by grasps holding the free joints elsewhere" in msg and "unreachable" not in msg
+    for j, v in zip(free, asked):
+        assert f"{task.hand.joint_names[j]} = {v:.6g} rad" in msg
