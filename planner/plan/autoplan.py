@@ -41,8 +41,8 @@ from qsplan.planner.search.ompl_search import search_route
 from qsplan.planner.search.tables import band_tables, table_grid
 from qsplan.planner.task.goal import feature_text
 
-__all__ = ["FREE_GRID", "FREE_SEARCH_MARGIN", "GOAL_FREE_TOL", "MAX_GOAL_GRASPS", "MAX_ROUNDS", "grasp_rows",
-           "goal_nodes", "plan_automatic", "route_phases", "start_nodes"]
+__all__ = ["FREE_GRID", "FREE_SEARCH_MARGIN", "GOAL_FREE_TOL", "MAX_GOAL_GRASPS", "MAX_ROUNDS", "ending_in_place",
+           "grasp_rows", "goal_nodes", "plan_automatic", "route_phases", "start_nodes"]
 
 #: Rounds of search and realisation: each failed round closes a table cell or forbids a regrasp, so a
 #: handful suffices; the bound keeps a pathological task from looping.
@@ -120,6 +120,16 @@ def goal_nodes(tables, task, goal_free=None) -> list:
     free = list(task.hand.free_joints)
     want = np.asarray(goal_free, dtype=float)
     return [(g, j) for g, j in nodes if np.all(np.abs(tables.q[g, j, free] - want) <= GOAL_FREE_TOL)]
+
+
+def ending_in_place(tables, goals, goal_free) -> set:
+    """The regrasps a route ending at ``goals`` must not use: with ``goal_free`` (a turn's slide, continued from its
+    flush instant) every regrasp into a goal node's grasp, so the route ends with a slide in that grasp and its last
+    row is the flush instant itself; without, none.  ``(from grasp, to grasp, grid index)``, as
+    :func:`qsplan.planner.search.widest.widest_route` takes them."""
+    if goal_free is None:
+        return set()
+    return {(h, g, i) for g, i in goals for h in range(len(tables.grasps)) if h != g}
 
 
 def _free_joints_report(task, tables, i, goal_free):
@@ -336,9 +346,8 @@ def plan_automatic(task, options=None, progress=None, planner: str = "widest", t
         raise PlanFailure(unreachable_goal_report(task, tables, i_goal, "goal", _goal_grasps))
     if any(s == g for s in ((st, i_start) for st in starts) for g in goals):
         raise QsplanError(f"goal: the start already meets the goal ({task.goal.describe()}): nothing to plan")
-    forbidden, counters, rounds, search_s, evaluations = set(), [0, 0.0], 0, 0.0, 0
-    if goal_free is not None:  # the route ends with a slide in its goal grasp, not a regrasp into it: what follows
-        forbidden = {(h, g, i) for g, i in goals for h in range(len(tables.grasps)) if h != g}  # continues the slide
+    counters, rounds, search_s, evaluations = [0, 0.0], 0, 0.0, 0
+    forbidden = ending_in_place(tables, goals, goal_free)  # a turn's slide ends sliding in its goal grasp
     width = tables.graph.width.copy()
     while True:
         rounds += 1

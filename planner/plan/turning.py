@@ -27,8 +27,8 @@ import numpy as np
 from qsplan.planner.plan.results import Plan, PlanFailure
 from qsplan.planner.task.goal import Goal, GoalNotServedError
 
-__all__ = ["FLUSH_APPROACH", "FormationOutcome", "SEARCHED_FORMATIONS", "Surveyed", "TurnReport", "goal_angle",
-           "pivot_pieces", "plan_turn", "slide_task", "survey"]
+__all__ = ["FLUSH_APPROACH", "FormationOutcome", "SEARCHED_FORMATIONS", "Surveyed", "TurnReport", "flush_free_joints",
+           "goal_angle", "pivot_pieces", "plan_turn", "slide_task", "survey"]
 
 #: How far (m) short of the flush instant the slide's band tables end: five times the contact tolerance (1 um), so
 #: the polygons show the four contacts of the palm edge there; the slide then reaches the flush instant itself in
@@ -84,6 +84,14 @@ def slide_task(task, pivot, start):
     words = (f"the slide to the flush instant (x = {x:.6g} m, the {pivot.flush} finger along edge "
              f"{int(hand.user_edges[pivot.edge])})")  # fmt: skip
     return replace(task, goal=goal), words
+
+
+def flush_free_joints(hand, start):
+    """The free joints' values (rad or m, ``hand.free_joints``' order) at a pivot's flush instant ``start`` (``(x, y,
+    0, q)``), or None for a hand without free joints: the slide to it must end holding them (the pivot holds them), not
+    in another grasp of the goal's features whose last row would then jump to the flush instant."""
+    free = list(hand.free_joints)
+    return np.asarray(start, dtype=float)[3:][free] if free else None
 
 
 @dataclass(frozen=True, slots=True)
@@ -221,12 +229,8 @@ def _route(task, pivot, start, theta_goal, pieces, options, progress, planner, s
 
     hand = task.hand
     sub, step = slide_task(task, pivot, start)
-    # a hand with free joints: the slide must end holding the flush instant's (the pivot holds them), not in another
-    # grasp of the goal's features whose last row would then jump to the flush instant
-    free = list(hand.free_joints)
-    goal_free = np.asarray(start, dtype=float)[3:][free] if free else None
     try:
-        slide = plan_automatic(sub, options, progress, planner, timed=False, goal_free=goal_free)
+        slide = plan_automatic(sub, options, progress, planner, timed=False, goal_free=flush_free_joints(hand, start))
     except PlanFailure as exc:  # said as the route's step, drawn with the task it was planned as
         raise PlanFailure(StepReport(step, sub, exc.report)) from None
     phases = list(slide.phases)

@@ -222,7 +222,7 @@ def preview_task(task, progress=None) -> Preview:
     t0 = time.perf_counter()
     if not reorients(task):
         return _preview(task, progress, t0)
-    from qsplan.planner.plan.turning import slide_task, survey
+    from qsplan.planner.plan.turning import flush_free_joints, slide_task, survey
 
     what = f"a turn ({task.goal.describe()})"
     try:
@@ -237,7 +237,7 @@ def preview_task(task, progress=None) -> Preview:
         return replace(out, formations=formations, seconds=time.perf_counter() - t0)
     best = max(reaching, key=lambda s: s.outcome.band)  # the first of equals, as the planner keeps
     sub, step = slide_task(task, best.pivot, best.start)
-    inner = _preview(sub, progress, t0, goal_name="slide's end")
+    inner = _preview(sub, progress, t0, goal_name="slide's end", goal_free=flush_free_joints(task.hand, best.start))
     goal = ConfigurationCheck("goal", inner.goal.x, None, None, None, 0, 0,
                               note=f"{what}: the formations searched: {lines}")  # fmt: skip
     verdict = (f"goal: {what}: {best.outcome.words} reaches it, narrowest pivot band "
@@ -256,11 +256,12 @@ def torque_words(width: float) -> str:
     return f"{width:.4g} N m" if np.isfinite(width) else "unbounded above"
 
 
-def _preview(task, progress, t0, goal_name="goal", turn=None, refused=False) -> Preview:
+def _preview(task, progress, t0, goal_name="goal", turn=None, refused=False, goal_free=None) -> Preview:
     """:func:`preview_task` of a task whose goal keeps the orientation (its goal named ``goal_name``), or of a turning
     goal not previewed (``turn``: what the goal's check says; ``refused``: the route refuses it), the start previewed
-    alone."""
-    from qsplan.planner.plan.autoplan import FREE_SEARCH_MARGIN, goal_nodes, grasp_rows, start_nodes
+    alone.  ``goal_free``: a turn's slide, its route judged as the planner plans it (``plan_automatic``'s): ending at
+    rows holding those free joints, by a slide in the goal grasp."""
+    from qsplan.planner.plan.autoplan import FREE_SEARCH_MARGIN, ending_in_place, goal_nodes, grasp_rows, start_nodes
     from qsplan.planner.plan.failure import palm_report
     from qsplan.planner.search.tables import SEARCH_MARGIN, band_tables, table_grid
     from qsplan.planner.states.contact import mode_name
@@ -299,7 +300,7 @@ def _preview(task, progress, t0, goal_name="goal", turn=None, refused=False) -> 
     if refusal is not None:
         goals = []
     elif task.goal is not None:
-        goals = goal_nodes(tables, task)
+        goals = goal_nodes(tables, task, goal_free)
     else:  # a scripted task ends in its start's grasp
         goals = [(g, i_goal) for g in starts if tables.graph.valid[g, i_goal]]
 
@@ -321,7 +322,8 @@ def _preview(task, progress, t0, goal_name="goal", turn=None, refused=False) -> 
         goal = ConfigurationCheck("goal", goal_x, None, None, None, 0, goal.candidates, f"{refusal}{where}")
         ok, route, verdict, ends = False, (), str(refusal), None
     else:
-        ok, route, verdict, ends = route_verdict(task, tables, bars, window, start, goal, starts, goals, beyond)
+        ok, route, verdict, ends = route_verdict(task, tables, bars, window, start, goal, starts, goals, beyond,
+                                                 ending_in_place(tables, goals, goal_free))  # fmt: skip
     if ends is not None:  # draw the route's own first and last grasps
         start, goal = checks([ends[0]] + [g for g in starts if g != ends[0]],
                              [ends[1]] + [g for g, _ in goals if g != ends[1]])  # fmt: skip

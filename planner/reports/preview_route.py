@@ -68,7 +68,7 @@ def _narrowest(task, tables, route) -> str:
     return f"; narrowest band {_width(s.width, _unit(task, tables.efforts[s.effort]))}"
 
 
-def _automatic(task, tables, bars, window, starts, goals, goal_name="goal"):
+def _automatic(task, tables, bars, window, starts, goals, goal_name="goal", forbidden=frozenset()):
     from qsplan.planner.plan.obstacles import no_route_report
     from qsplan.planner.search.widest import widest_route
 
@@ -76,9 +76,9 @@ def _automatic(task, tables, bars, window, starts, goals, goal_name="goal"):
     if any((g, i_start) in set(goals) for g in starts):
         return False, (), f"the start already meets the {goal_name} ({task.goal.describe()}): nothing to plan", None
     graph = window_graph(tables, window)
-    route = widest_route(graph, [(g, i_start) for g in starts], goals)
+    route = widest_route(graph, [(g, i_start) for g in starts], goals, forbidden)
     if route is None:
-        report = no_route_report(task, tables, graph, starts, i_start, goals, set())
+        report = no_route_report(task, tables, graph, starts, i_start, goals, set(forbidden))
         return False, (), f"no banded route from the start to the {goal_name}: {report.summary}", None
     words = _route_words(task, tables, bars, route)
     text = (f"a banded route exists from the start to the {goal_name}: " + ", then ".join(words)
@@ -148,10 +148,12 @@ def _nearest(x, bars, x0, most: int = 3) -> str:
     return "banded nearest: " + ", ".join(w for _, w in sorted(found)[:most])
 
 
-def route_verdict(task, tables, bars, window, start, goal, starts, goals, beyond) -> tuple:
+def route_verdict(task, tables, bars, window, start, goal, starts, goals, beyond, forbidden=frozenset()) -> tuple:
     """``(ok, route words, verdict, ends)`` of the preview (see the module docstring); ``beyond`` a
     :class:`qsplan.planner.plan.failure.PalmReport` or None; ``ends`` the route's first and last rows, or None.  The
-    goal is named as its check names itself (``goal.where``: a turn's slide previews its end, "slide's end")."""
+    goal is named as its check names itself (``goal.where``: a turn's slide previews its end, "slide's end").
+    ``forbidden``: regrasps ``(from grasp, to grasp, i)`` the route may not use (the planner's:
+    :func:`qsplan.planner.plan.autoplan.ending_in_place`)."""
     head = f"start {'ok' if start.ok else 'not ok'} / {goal.where} {'ok' if goal.ok else 'not ok'}"
     if beyond is not None:
         return False, (), f"{head} / {beyond.message.removeprefix('no plan: ')}", None
@@ -159,6 +161,6 @@ def route_verdict(task, tables, bars, window, start, goal, starts, goals, beyond
         bad = [c for c in (start, goal) if not c.ok]
         text = "; ".join(f"the {c.where}: {'; '.join(c.problems)} ({_nearest(tables.x, bars, c.x)})" for c in bad)
         return False, (), f"{head}: {text}", None
-    ok, words, text, ends = _automatic(task, tables, bars, window, starts, goals, goal.where) \
+    ok, words, text, ends = _automatic(task, tables, bars, window, starts, goals, goal.where, forbidden) \
         if task.goal is not None else _scripted(task, tables, bars, start)  # fmt: skip
     return ok, words, f"{head} / {text} (a preview on the planner's grid: the planner judges its route again)", ends

@@ -223,3 +223,19 @@ def test_check_names_every_formation_of_a_turn_none_reaches(tmp_path, capsys, ed
     assert doc["goal"]["refused"] and not doc["goal"]["previewed"] and why in doc["goal"]["message"]
     assert doc["goal"]["message"].startswith("goal: a turn (") and doc["start"]["ok"] and why in doc["verdict"]
     assert (tmp_path / "check" / "check.png").is_file()
+
+
+def test_check_previews_a_chain_hands_turn_as_the_planner_plans_its_slide(capsys):
+    """A hand with free joints (``full_turn_task``'s turning hand): the preview judges the slide to the flush instant
+    as ``plan_automatic`` plans it, ending at rows that hold the flush instant's free joints, by a slide in that grasp
+    (:func:`qsplan.planner.plan.autoplan.ending_in_place`).  Before, it previewed a regrasp into another grasp at the
+    end, a route the planner does not take; now its route is the plan's: one slide, the same torque-controlled joint."""
+    from tests.planner.bundled import planned
+
+    code = main(["check", "full_turn_task", "--json"])
+    doc = json.loads(capsys.readouterr()[0])
+    assert code == 0 and doc["ok"]
+    assert len(doc["route"]) == 1 and doc["route"][0].startswith("slide left from x = ")
+    slide = planned("full_turn_task").phases[0]
+    assert slide.kind == "slide" and f"(joint {slide.effort_joint} torque-controlled)" in doc["route"][0]
+    assert all("regrasp" not in step for step in doc["route"])
