@@ -8,6 +8,23 @@ import pytest
 _BLAS_LIMIT = []
 
 
+def _sigint_as_at_a_terminal():
+    """SIGINT at its default action here, so that the processes the Ctrl-C tests start see it as at a terminal.
+
+    A command started in the background of a non-interactive shell (``cmd &`` in a script, as some CI runners start
+    jobs) begins with SIGINT ignored (POSIX), and every process it starts inherits that: Python then installs no
+    handler, and a ``qsplan`` the tests interrupt runs to its end (exit 0) instead of exiting 130.  An ignored SIGINT
+    is given Python's own handler back (``signal.default_int_handler``, which a child's ``exec`` resets to the
+    default); a handler set otherwise is left alone."""
+    import signal
+
+    if signal.getsignal(signal.SIGINT) == signal.SIG_IGN:
+        try:
+            signal.signal(signal.SIGINT, signal.default_int_handler)
+        except ValueError:  # not the main thread of its process: nothing this process can set
+            pass
+
+
 def pytest_configure(config):
     """Under pytest-xdist (the README's ``-n auto``), each worker's BLAS gets its share of the cores.
 
@@ -15,6 +32,7 @@ def pytest_configure(config):
     workers for the cores (the mechanics and hands tests took ~15 % more CPU time with them on two workers).  The
     limit also reaches the processes a test starts (``OPENBLAS_NUM_THREADS``, unless already set).  Results do not
     change: the tests compare to stated tolerances, and the plans' byte-identity is between runs of one process."""
+    _sigint_as_at_a_terminal()  # every process of the run: the controller and each worker
     workers = int(os.environ.get("PYTEST_XDIST_WORKER_COUNT") or 1)
     if workers <= 1:
         return
