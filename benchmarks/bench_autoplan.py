@@ -211,10 +211,7 @@ def fidelity(demo):
     for stem, frictions in REACH.items():
         base = demo if stem == "reorient_task" else load_task(task_paths()[stem])
         hand = base.hand
-        free = None
-        if hand.free_joints and base.start_joints is not None:  # held as the task starts them (the search's rule)
-            free = np.asarray(base.start_joints, dtype=float)[list(hand.free_joints)]
-        formations = pivot_formations(hand, free)
+        formations = pivot_formations(hand, base.start_free)  # held as the task starts them (the search's rule)
         for mu in frictions:
             for pivot, start in formations:
                 far = pivot.direction * 1.6  # beyond any event: where the geometry ends

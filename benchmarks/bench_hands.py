@@ -44,7 +44,7 @@ from qsplan.mechanics.bands.batched import LazyScenes, batch_from_arrays
 from qsplan.mechanics.bands.batched_robust import robust_band_arrays
 
 from bench_plan import table_rate  # the demo tables' rate, measured as bench_plan.py measures it
-from revisions import export_revision
+from revisions import revision_env
 
 HERE = Path(__file__).resolve().parent
 
@@ -134,10 +134,7 @@ def compare_tables(rev: str, repeat: int, rounds: int) -> dict:
     """The demo tables' rate (checks/s, best) and checks of git revision ``rev`` (``before``) and of this tree
     (``after``): a process per side and round, the sides interleaved; each process takes the best of ``repeat``."""
     with tempfile.TemporaryDirectory(prefix="qsplan-bench-") as tmp:
-        before = dict(os.environ)
-        before["PYTHONPATH"] = os.pathsep.join(filter(None, [str(export_revision(rev, Path(tmp) / "rev")),
-                                                             before.get("PYTHONPATH")]))  # fmt: skip
-        sides = {"before": before, "after": dict(os.environ)}
+        sides = {"before": revision_env(rev, Path(tmp) / "rev"), "after": dict(os.environ)}
         best = {side: (0.0, 0) for side in sides}
         code = _TABLE_RATE.format(here=str(HERE), repeat=repeat)
         for i in range(rounds):

@@ -26,7 +26,7 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-from revisions import export_revision  # noqa: E402 (benchmarks/ on the path first)
+from revisions import revision_env  # noqa: E402 (benchmarks/ on the path first)
 
 #: Issue 33's goals (s, whole command, on this 2-core machine) and its figures before (the issue's table).
 GOALS = {"demo": 2.0, "verify": 1.0, "plan reorient_task": 5.0, "modes n_c=20": 0.25}
@@ -64,10 +64,7 @@ def main(argv=None) -> int:
         planted_scene(scene)
         sides = {"after": dict(os.environ)}
         if args.compare:
-            env = dict(os.environ)
-            env["PYTHONPATH"] = os.pathsep.join(filter(None, [str(export_revision(args.compare, tmp / "rev")),
-                                                              env.get("PYTHONPATH")]))  # fmt: skip
-            sides = {"before": env, **sides}
+            sides = {"before": revision_env(args.compare, tmp / "rev"), **sides}
         best = {(cmd, side): float("inf") for cmd in GOALS for side in sides}
         for i in range(args.repeat):
             for side, env in sides.items():

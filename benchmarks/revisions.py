@@ -1,5 +1,5 @@
 """A git revision of qsplan laid out as installed, to run beside the working tree (``--compare REV`` of
-``bench_whole.py`` and ``bench_certify.py``): :func:`export_revision`."""
+``bench_whole.py``, ``bench_hands.py`` and ``bench_certify.py``): :func:`export_revision`, :func:`revision_env`."""
 
 import os
 import shutil
@@ -37,3 +37,11 @@ def export_revision(rev: str, into: Path) -> Path:
     return lib
 
 
+
+
+def revision_env(rev: str, into: Path) -> dict:
+    """This process's environment with git revision ``rev`` (:func:`export_revision` into ``into``) first on
+    ``PYTHONPATH``: a Python started with it imports that revision's qsplan."""
+    env = dict(os.environ)
+    env["PYTHONPATH"] = os.pathsep.join(filter(None, [str(export_revision(rev, into)), env.get("PYTHONPATH")]))
+    return env

@@ -44,7 +44,7 @@ from qsplan.planner.certify.inputs import (plan_columns_required, plan_sources, 
                                            read_plan_file, task_from_metadata)  # fmt: skip
 from qsplan.planner.certify.modes import (ModeJob, disturbance_checks, mode_checks, mode_misfit, plan_mode_checks,
                                           row_scene, slip_reversals, slip_velocities)  # fmt: skip
-from qsplan.planner.certify.timing import hold_checks, interval_rates, row_velocity, timing_checks
+from qsplan.planner.certify.timing import hold_checks, row_x_velocity, timing_checks
 from qsplan.planner.certify.route import (ENDPOINT_TOL, FREE_PATH_STEP, endpoint_checks, free_path_checks,
                                           rest_checks, structure_checks)  # fmt: skip
 from qsplan.planner.certify.rows import (
@@ -236,26 +236,12 @@ def _num(v):
 
 
 def _xdot_rows(cols, k, names) -> float:
-    """The workpiece's x velocity (m/s) the rows give at in-contact row ``k`` (the time scaling's rule,
-    :func:`qsplan.planner.certify.timing.row_velocity`); where rows of its phase come both before and after it, the
-    mean of the rule's velocity on the chord to the next row and on the chord from the row before (a central
-    difference).  A straight slide's two chords give the same velocity; a pivot's rows lie on a curve, where one chord
-    is off the instantaneous velocity by half a step of its curvature (1 to 3 %, and any fraction where the velocity
-    passes through zero, along ``full_turn_task``'s pivot at 0.25 deg a row) and the mean only by the step squared
-    (within 0.9 % there, 0.02 % in the median).  nan for a phase of one row, or at rest."""
+    """The workpiece's x velocity (m/s) the rows give at in-contact row ``k``
+    (:func:`qsplan.planner.certify.timing.row_x_velocity`); nan for a phase of one row, or at rest."""
     if "phase" not in cols or ("speed_scale" in cols and cols["speed_scale"][k] == 0.0):
         return math.nan  # no phase; or at rest: no speed to compare (its direction is the band's and the modes')
-    moving = row_velocity(cols, k, names)
-    if moving is None:
-        return math.nan
-    t, ph, x = cols["t"], cols["phase"], cols["x_workpiece"]
-    n = t.size
-    both = (0 < k < n - 1 and ph[k - 1] == ph[k] == ph[k + 1] and t[k - 1] < t[k] < t[k + 1]
-            and "speed_scale" in cols)  # fmt: skip
-    if not both:
-        return float(moving[1])
-    before = float(x[k] - x[k - 1]) * interval_rates(cols, k - 1, k)[1]
-    return 0.5 * (float(moving[1]) + before)
+    moving = row_x_velocity(cols, k, names)
+    return math.nan if moving is None else moving
 
 
 def certify_plan(plan, task, *, n_random: int = 8, seed: int = 0, force_margin: float = 0.0,

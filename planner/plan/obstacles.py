@@ -106,9 +106,9 @@ def _matching(task, tables, which) -> list:
     rows = range(len(tables.grasps))
     hand = task.hand
     if which == "start" and hand.free_joints:
-        if task.start_joints is None:
+        start = task.start_free
+        if start is None:
             return list(rows)
-        start = np.asarray(task.start_joints, float)[list(hand.free_joints)]
         return [g for g in rows if np.array_equal(np.asarray(tables.grasps[g].grasp.free, float), start)]
     feats = task.start_features if which == "start" else (task.goal.left, task.goal.right)
     texts = [feature_text(f) for f in feats]

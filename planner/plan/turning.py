@@ -309,10 +309,7 @@ def survey(task, progress=None) -> tuple:
     progress = progress or (lambda line: None)
     _check_goal(task)
     hand = task.hand
-    free = None
-    if hand.free_joints and task.start_joints is not None:  # a chain hand's free joints as the task starts them
-        free = np.asarray(task.start_joints, dtype=float)[list(hand.free_joints)]
-    formations = pivot_formations(hand, free)
+    formations = pivot_formations(hand, task.start_free)  # a chain hand's free joints held as the task starts them
     progress(f"formation search: {len(formations)} pivot formations of this hand and workpiece")
     out = []
     for pivot, start in formations:

@@ -37,11 +37,8 @@ def _row_q(task, segment: str, x: float):
             row = max(rows, key=lambda r: len(r.label))
             q = hand.grasp_states(task.formation, row.grasp, np.array([x]), row.free_at([x])).q[0]
             return q if np.all(np.isfinite(q)) else None
-    free = None
-    if hand.free_joints and task.start_joints is not None:
-        free = np.asarray(task.start_joints)[list(hand.free_joints)]
     try:
-        return hand.closed_configuration(task.formation, None, x, free)
+        return hand.closed_configuration(task.formation, None, x, task.start_free)
     except QsplanError:
         return None
 

@@ -163,6 +163,15 @@ class Task:
         return self.speeds if self.speeds is not None else np.full(len(self.joint_limits), self.joint_speed)
 
     @property
+    def start_free(self) -> np.ndarray | None:
+        """The hand's free joints as the task starts them (rad or m, in ``hand.free_joints``' order; a chain hand's
+        ``[start]``), or None: a hand without free joints, or a task that does not start them."""
+        free = list(self.hand.free_joints)
+        if not free or self.start_joints is None:
+            return None
+        return np.asarray(self.start_joints, dtype=float)[free]
+
+    @property
     def automatic(self) -> bool:
         """Whether the planner finds the sequence (a ``[goal]``, no scripted waypoints)."""
         return self.goal is not None

@@ -22,24 +22,11 @@ try:
 except ImportError:  # not POSIX: each process plans for itself
     fcntl = None
 
-__all__ = ["SHARED", "SLOW_TASKS", "bundled_task", "held", "planned", "shared_root", "task_params"]
+__all__ = ["SHARED", "bundled_task", "held", "planned", "shared_root"]
 
 #: The directory where the processes of one test run share their plans (set by ``tests/conftest.py`` in a
 #: pytest-xdist worker); None: this process alone.
 SHARED: Path | None = None
-
-
-#: Bundled tasks whose plan takes too long for the default run: the tests that plan them run in the slow suite
-#: (:func:`task_params`).  None today: full_turn_task (planned, certified and re-simulated in ~13 s of one core, shared
-#: by the tests that read it) is in the default run, so CI plans and certifies the full turn.
-SLOW_TASKS: tuple = ()
-
-
-def task_params(names) -> list:
-    """Bundled task ``names`` as pytest parameters, those of :data:`SLOW_TASKS` marked slow."""
-    import pytest
-
-    return [pytest.param(n, marks=pytest.mark.slow) if n in SLOW_TASKS else n for n in names]
 
 
 def shared_root(tmp_path_factory) -> Path:

@@ -7,7 +7,6 @@ import pytest
 
 from qsplan.mechanics.errors import QsplanError
 from qsplan.planner.task.task import demo_task_path, load_task, make_task, task_paths
-from tests.planner.bundled import task_params
 
 pytestmark = pytest.mark.ompl
 
@@ -83,7 +82,7 @@ def test_planner_is_deterministic(tmp_path):
     assert a.plan.sequence[:-1] == b.plan.sequence[:-1]
 
 
-@pytest.mark.parametrize("stem", task_params(sorted(s for s, p in task_paths().items() if "[goal]" in p.read_text())))
+@pytest.mark.parametrize("stem", sorted(s for s, p in task_paths().items() if "[goal]" in p.read_text()))
 def test_bundled_goal_tasks(tmp_path, bundled_plan, stem):
     """Each bundled automatic task is planned, certified and re-simulated; the infeasible one says why.
 

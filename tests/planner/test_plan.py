@@ -15,7 +15,6 @@ from qsplan.planner.export.plan_files import export_plan, read_plan_csv
 from qsplan.planner.plan.scripted import check_free_state
 from qsplan.planner.replay.replay import friction_samples, replay_plan
 from qsplan.planner.task.task import load_task, make_task, task_paths
-from tests.planner.bundled import task_params
 from tests.planner.rest_rows import moving_velocity
 
 
@@ -181,7 +180,7 @@ def test_degenerate_closure_is_named_without_meaningless_edge_corners():
 
 
 @pytest.mark.ompl
-@pytest.mark.parametrize("stem", task_params(sorted(task_paths())))
+@pytest.mark.parametrize("stem", sorted(task_paths()))
 def test_bundled_tasks_are_planned_without_overlaps_or_refused_with_a_reason(stem, demo_files, bundled_plan, tmp_path):
     """Checked independently of the planner, from the exported rows (tests/planner/overlaps.py)."""
     from qsplan.planner.plan.results import PlanFailure

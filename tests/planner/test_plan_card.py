@@ -17,7 +17,6 @@ from qsplan.planner.plotting.card import card_snapshots, phase_rows, plan_card
 from qsplan.planner.plotting.hands import STATES, effort_direction, plan_snapshots
 from qsplan.planner.plotting.style import torque_text
 from qsplan.planner.task.task import task_paths
-from tests.planner.bundled import task_params
 from tests.planner.figure_checks import all_text, labels_without_units, legends_over_axes, overlapping_texts
 
 pytestmark = pytest.mark.ompl
@@ -69,7 +68,7 @@ def row_config(plan, i, k):
     return ph.poses(plan.task.hand.rest_height)[min(k, ph.t.size - 1)], ph.q[k]
 
 
-@pytest.mark.parametrize("name", task_params(TASKS))
+@pytest.mark.parametrize("name", TASKS)
 def test_snapshot_labels_match_the_rows(name):
     plan = planned(name)
     last = (len(plan.phases) - 1, plan.phases[-1].t.size - 1)
