@@ -188,7 +188,8 @@ def turning_rows(tasks):
 #: How far each bundled turning hand and workpiece turns (issue 34's table): the task, and the friction sets its
 #: formations are judged at.
 REACH = {"reorient_task": ((0.0, 0.0), (0.0, 0.2)), "reorient_edge_task": ((0.0, 0.0), (0.0, 0.2)),
-         "full_turn_task": ((0.0, 0.0), (0.0, 0.03), (0.0, 0.05), (0.0, 0.1), (0.0, 0.2), (0.1, 0.2))}  # fmt: skip
+         "full_turn_task": ((0.0, 0.0), (0.0, 0.03), (0.0, 0.05), (0.0, 0.1), (0.0, 0.2), (0.1, 0.2)),
+         "finger_replaced_task": ((0.05, 0.1),)}  # fmt: skip
 
 
 def fidelity(demo):

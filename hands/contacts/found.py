@@ -165,6 +165,24 @@ def hold_scene(hand, pose, q, effort_controlled, effort=None):
     return row_contact_scene(hand, pose, q, e, held, effort=effort)
 
 
+def lifted_scene(hand, pose, q, finger: str):
+    """The scene a hold with ``finger`` (``"left"`` or ``"right"``) lifted is proved in
+    (:func:`qsplan.mechanics.bands.friction_hold.prove_friction_hold`): the one rule of the planner's finger replaced
+    mid-turn and the certifier's.  Every contact the polygons show at ``pose``, ``q`` except ``finger``'s (while it
+    leaves, moves and closes again it pushes nothing: a contact it keeps at zero force while receding is a motion of
+    the others), every joint held (velocity 0, none torque-controlled).
+
+    Raises
+    ------
+    SceneError
+        As :func:`ordered_contacts`; QsplanError when only ``finger`` touches the workpiece.
+    """
+    found = ordered_contacts(hand, pose, q)
+    drop = np.array([n.split(":")[0] == finger for n in contact_names(hand, pose, found)], dtype=bool)
+    n_j = len(hand.joint_names)
+    return row_contact_scene(hand, pose, q, np.zeros(n_j, dtype=bool), np.zeros(n_j), drop=drop, found=found)
+
+
 def drawable_contacts(hand, pose, q) -> list:
     """The contacts to draw at ``pose``, ``q``: as the polygons show them (:func:`ordered_contacts`)."""
     return ordered_contacts(hand, pose, q)

@@ -44,7 +44,7 @@ from qsplan.planner.certify.inputs import (plan_columns_required, plan_sources, 
                                            read_plan_file, task_from_metadata)  # fmt: skip
 from qsplan.planner.certify.modes import (ModeJob, disturbance_checks, mode_checks, mode_misfit, plan_mode_checks,
                                           row_scene, slip_reversals, slip_velocities)  # fmt: skip
-from qsplan.planner.certify.timing import hold_checks, row_x_velocity, timing_checks
+from qsplan.planner.certify.timing import hold_checks, row_com_velocity, timing_checks
 from qsplan.planner.certify.route import (ENDPOINT_TOL, FREE_PATH_STEP, endpoint_checks, free_path_checks,
                                           rest_checks, structure_checks)  # fmt: skip
 from qsplan.planner.certify.rows import (
@@ -235,13 +235,13 @@ def _num(v):
     return float(v) if v is not None and math.isfinite(v) else None
 
 
-def _xdot_rows(cols, k, names) -> float:
-    """The workpiece's x velocity (m/s) the rows give at in-contact row ``k``
-    (:func:`qsplan.planner.certify.timing.row_x_velocity`); nan for a phase of one row, or at rest."""
+def _v_rows(cols, k, names) -> np.ndarray:
+    """The workpiece's centre-of-mass velocity ``(vx, vy)`` (m/s) the rows give at in-contact row ``k``
+    (:func:`qsplan.planner.certify.timing.row_com_velocity`); nan for a phase of one row, or at rest."""
     if "phase" not in cols or ("speed_scale" in cols and cols["speed_scale"][k] == 0.0):
-        return math.nan  # no phase; or at rest: no speed to compare (its direction is the band's and the modes')
-    moving = row_x_velocity(cols, k, names)
-    return math.nan if moving is None else moving
+        return np.full(2, math.nan)  # no phase; or at rest: no speed to compare (its direction is the band's and modes')
+    moving = row_com_velocity(cols, k, names)
+    return np.full(2, math.nan) if moving is None else moving
 
 
 def certify_plan(plan, task, *, n_random: int = 8, seed: int = 0, force_margin: float = 0.0,
@@ -311,6 +311,7 @@ def certify_plan(plan, task, *, n_random: int = 8, seed: int = 0, force_margin: 
     scenes = {}  # in-contact rows' scenes: their bands recomputed in one batch per mode
     named = {}  # in-contact rows' contacts, as their mode letters follow them (the metadata's contact sets)
     jobs, mode_at = [], {}  # batched: the rows' mode checks, solved together after the loop; where their answers go
+    lifted = {}  # the holds proved with a finger lifted (a finger replaced mid-turn), one per run of free rows
     for k in range(n):
         mode = str(cols["mode"][k])
         found = limit_checks(task, cols, k)
@@ -326,7 +327,7 @@ def certify_plan(plan, task, *, n_random: int = 8, seed: int = 0, force_margin: 
         if mode == "free":
             found += free_row_cells(cols, k, names)
             if bodies is not None:
-                found += rest_checks(task, cols, k, bodies)
+                found += rest_checks(task, cols, k, bodies, lifted)
                 if k + 1 < n and str(cols["mode"][k + 1]) == "free" and phase[k + 1] == phase[k]:
                     found += free_path_checks(task, cols, k, roots)
         elif not any(kind == "input" for kind, _ in found):
@@ -353,10 +354,10 @@ def certify_plan(plan, task, *, n_random: int = 8, seed: int = 0, force_margin: 
                     mus = friction_points(task, int(n_random), rng, len(scene.contact_names))
                     pts = len(mus)
                     if not hold_row(cols, k) and batched:  # a hold: nothing moves, the hold proof decides
-                        jobs.append(ModeJob(k, scene, mus, _xdot_rows(cols, k, names)))
+                        jobs.append(ModeJob(k, scene, mus, _v_rows(cols, k, names)))
                         mode_at[k] = len(found)
                     elif not hold_row(cols, k):  # the reference, row by row
-                        more, excluded = mode_checks(task, cols, k, mus, force_margin, _xdot_rows(cols, k, names),
+                        more, excluded = mode_checks(task, cols, k, mus, force_margin, _v_rows(cols, k, names),
                                                      False, scene)  # fmt: skip
                         found += more
                         if task.disturbance is not None:

@@ -24,9 +24,13 @@ message)`` triples, the row the phase's first.  What each key promises, and how 
     ``pieces`` its rest-to-rest pieces (runs of rows in motion), ``path_acceleration_1_s2`` the largest change of the
     speed scale per second between two rows, ``peak_speed_scale`` the largest speed scale at a row,
     ``quasistatic_duration_s`` the path covered (a phase at rest throughout: its duration).  A regrasp's
-    ``x_workpiece_m``: its first row's.
+    ``x_workpiece_m``: its first row's.  A finger replaced mid-turn (free rows where one finger's joints move and the
+    other's do not): ``phase_kind`` ``replace``, that ``finger``, ``y_workpiece_m`` and ``theta_workpiece_rad`` of its
+    first row, and ``contacts_kept``: the contacts the polygons show there without that finger's.
 ``metadata.sequence[i]``
-    A step of the kind of phase ``i`` (``slide``, ``regrasp``, ``hold``, ``pivot``); the search's figures last.
+    A step of the kind of phase ``i`` (``slide``, ``regrasp``, ``replace``, ``hold``, ``pivot``); the search's figures
+    last.  A replacement's ``theta_rad``, ``finger`` and ``contacts_kept`` as its phase's (``formation`` and
+    ``hold_margin_N`` informational: the next phases name the formation, the row checks prove the hold).
     ``x_from_m``, ``x_to_m`` (``x_from``, ``x_to``, ``x``), ``theta_from_rad``, ``theta_to_rad``, ``theta_rad``,
     ``effort_joint``, ``effort_unit``, ``narrowest_band``: the phase's rows'.  A hold's ``torque_from``,
     ``torque_to``: its first and last command; its ``proved_interval``: every hold row's band, and within the band
@@ -151,6 +155,29 @@ def _command(cols, rows) -> dict:
             "lower_edge_max_N_m": finite_or_none(float(np.max(lower)))}  # fmt: skip
 
 
+def _replacement(task, cols, rows) -> dict:
+    """A run of free rows where one finger's joints move and the other's do not (a finger replaced mid-turn): its
+    ``phase_kind``, ``finger``, the workpiece's ``y_workpiece_m`` and ``theta_workpiece_rad`` and the ``contacts_kept``
+    the polygons show at its first row without the moving finger's; ``{}`` for a regrasp (both fingers move)."""
+    from qsplan.hands.contacts.found import contact_names, ordered_contacts
+    from qsplan.mechanics.errors import SceneError
+
+    from qsplan.planner.certify.rows import row_pose, row_q
+
+    hand = task.hand
+    q = np.array([row_q(cols, k, hand.joint_names) for k in rows])
+    moving = [f for f, joints in zip(("left", "right"), hand.finger_joints) if np.any(np.ptp(q[:, list(joints)], axis=0) > 0)]
+    if len(moving) != 1:
+        return {}
+    pose = row_pose(cols, int(rows[0]))
+    try:
+        kept = [n for n in contact_names(hand, pose, ordered_contacts(hand, pose, q[0])) if n.split(":")[0] != moving[0]]
+    except SceneError:
+        kept = None  # the row checks name the overlap
+    return {"phase_kind": "replace", "finger": moving[0], "y_workpiece_m": float(pose[1]),
+            "theta_workpiece_rad": float(pose[2]), "contacts_kept": kept}
+
+
 def _phase_kind(cols, rows, names) -> str:
     moved, turned = _moves(cols, rows, names)
     return "pivot" if turned else ("slide" if moved else "hold")
@@ -221,6 +248,7 @@ def _more(d, task, cols, rows, path, evidence, names) -> list:
         unknown.add("time_scaling")
     if not contact:
         truth["x_workpiece_m"] = float(cols["x_workpiece"][rows[0]])
+        truth.update(_replacement(task, cols, rows))
     elif _effort_ok(task, cols, rows):
         truth["effort_unit"] = task.hand.joint_unit(str(cols["effort_joint"][rows[0]]), "tau")
         truth["phase_kind"] = _phase_kind(cols, rows, names)
@@ -341,7 +369,8 @@ def sequence_claims(sequence, phases, task, cols, evidence) -> list:
             continue
         path = f"metadata.sequence[{j}]"
         contact = str(cols["mode"][rows[0]]) != "free"
-        kind = _phase_kind(cols, rows, names) if contact else "regrasp"
+        replaced = {} if contact else _replacement(task, cols, rows)
+        kind = _phase_kind(cols, rows, names) if contact else ("replace" if replaced else "regrasp")
         if s.get("kind") != kind:
             out.append((int(rows[0]), "metadata", f"{path}.kind states {show(s.get('kind'))}; phase {i}'s rows are a "
                                                   f"{kind}"))  # fmt: skip
@@ -352,6 +381,9 @@ def sequence_claims(sequence, phases, task, cols, evidence) -> list:
         unknown = INFORMATIONAL_STEP_KEYS | {"proved_interval", "vertex"}  # informational, or checked below
         if kind == "regrasp":
             truth["x"] = float(x[0])
+        if kind == "replace":
+            truth.update(theta_rad=float(th[0]), finger=replaced["finger"], contacts_kept=replaced["contacts_kept"])
+            unknown = unknown | {"formation", "hold_margin_N"}  # informational: the next phases and the row checks
         if contact and not _effort_ok(task, cols, rows):  # the input check names the rows
             unknown |= {"effort_joint", "effort_unit", "narrowest_band", "torque_from", "torque_to", "proved_interval"}
         elif contact:

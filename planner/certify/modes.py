@@ -29,9 +29,10 @@ from qsplan.mechanics import DEFAULT_TOLERANCES, Tolerances, solve_many, solve_m
 __all__ = ["MOTION_RTOL", "EXACT_TOLERANCES", "FORCES_PER_CALL", "PARALLEL_TOL", "SLIP_SIGN_TOL", "ModeJob", "disturbance_checks", "mode_checks", "rigid_pairs", "structural_degeneracy",
            "mode_misfit", "plan_mode_checks", "row_scene", "slip_velocities", "slip_reversals"]
 
-#: Relative difference tolerated between the workpiece speed the solver computes from
-#: the exported velocity command and the one the rows' poses show (finite differences of
-#: a straight slide are exact; the command is the closed-form derivative): 1 %.
+#: Relative difference tolerated between the workpiece's centre-of-mass velocity the solver computes from the exported
+#: velocity command and the one the rows' poses show, as a vector relative to the rows' speed (finite differences of a
+#: straight slide are exact, a pivot's central differences within 0.9 %; the command is the closed-form derivative):
+#: 1 %.
 MOTION_RTOL = 1e-2
 
 #: Tolerances at which a mode that was degenerate at the default ones is tested again.  A
@@ -108,9 +109,22 @@ def _force_msg(c_n, i_c, force_margin, mu) -> str:
     return f"normal force {c_n:.4g} N at contact {i_c} below the margin {force_margin:g} N at mu = {_fmt_mu(mu)}"
 
 
-def _motion_msg(xdot, xdot_rows, mu) -> str:
-    return (f"the commands move the workpiece at {xdot * 1e3:.4g} mm/s at mu = {_fmt_mu(mu)}; "
-            f"the rows show {xdot_rows * 1e3:.4g} mm/s")  # fmt: skip
+def _com_velocity(qdot, x: float, y: float) -> np.ndarray:
+    """The workpiece's centre-of-mass velocity ``(vx, vy)`` (m/s, shape (..., 2)) from the solver's ``qdot`` (the
+    velocity of the workpiece point at the world origin, and its rate of turn), its centre of mass at ``(x, y)``."""
+    return np.stack([qdot[..., 0] - qdot[..., 2] * y, qdot[..., 1] + qdot[..., 2] * x], axis=-1)
+
+
+def _motion_off(v, v_rows) -> np.ndarray:
+    """Whether the commanded centre-of-mass velocity ``v`` (shape (..., 2)) is off the rows' ``v_rows`` (2,) by more
+    than :data:`MOTION_RTOL` of the rows' speed (a relative error of the vector: a coordinate passing through zero,
+    as the x velocity of a pivot's centre of mass at its leftmost, is judged against the whole motion)."""
+    return np.linalg.norm(v - v_rows, axis=-1) > MOTION_RTOL * np.linalg.norm(v_rows)
+
+
+def _motion_msg(v, v_rows, mu) -> str:
+    return (f"the commands move the workpiece's centre of mass at ({v[0] * 1e3:.4g}, {v[1] * 1e3:.4g}) mm/s at mu = "
+            f"{_fmt_mu(mu)}; the rows show ({v_rows[0] * 1e3:.4g}, {v_rows[1] * 1e3:.4g}) mm/s")  # fmt: skip
 
 
 def _under_msg(msg, w) -> str:
@@ -202,7 +216,7 @@ def slip_reversals(mode: str, contacts, before, after) -> list:
     return []
 
 
-def mode_checks(task, cols, k, mus, force_margin=0.0, xdot_rows=np.nan, batched=True, scene=None) -> tuple:
+def mode_checks(task, cols, k, mus, force_margin=0.0, v_rows=np.nan, batched=True, scene=None) -> tuple:
     """Check 4: with the row's commands the planned mode is the only feasible one at every friction vector.
 
     Parameters
@@ -212,8 +226,9 @@ def mode_checks(task, cols, k, mus, force_margin=0.0, xdot_rows=np.nan, batched=
     force_margin : float
         N: the planned mode's normal forces must be at least this at every contact it keeps (a breaking contact,
         ``B``, carries none).
-    xdot_rows : float
-        The workpiece's ``x`` velocity (m/s) the rows show (finite difference); nan: not checked.
+    v_rows : ndarray, shape (2,), or float
+        The workpiece's centre-of-mass velocity ``(vx, vy)`` (m/s) the rows show (finite differences); nan: not
+        checked.
     batched : bool
         Every friction vector in one batch (:func:`qsplan.mechanics.solve_many`); False: the
         reference, one solve per vector (:func:`qsplan.mechanics.solve_many_reference`).  Same verdicts.
@@ -277,10 +292,10 @@ def mode_checks(task, cols, k, mus, force_margin=0.0, xdot_rows=np.nan, batched=
         if force_margin > 0 and loaded.size and loaded.min() < force_margin and "force margin" not in found:
             i_c = int(held[np.argmin(loaded)])
             found["force margin"] = _force_msg(c_n[i_c], i_c, force_margin, mu)
-        xdot = qdot[0] - qdot[2] * float(cols["y_workpiece"][k])  # qdot is the world origin's velocity
-        if np.isfinite(xdot_rows) and "motion" not in found:
-            if np.sign(xdot) != np.sign(xdot_rows) or abs(xdot - xdot_rows) > MOTION_RTOL * abs(xdot_rows):
-                found["motion"] = _motion_msg(xdot, xdot_rows, mu)
+        if np.all(np.isfinite(v_rows)) and "motion" not in found:
+            v = _com_velocity(qdot, float(cols["x_workpiece"][k]), float(cols["y_workpiece"][k]))
+            if _motion_off(v, v_rows):
+                found["motion"] = _motion_msg(v, v_rows, mu)
     kinds = {"planned": "mode", "mode": "mode"}
     set_aside = tuple(sorted(letters[j] for j in np.flatnonzero(excluded)))
     return [(kinds.get(kind, kind), msg) for kind, msg in found.items()], set_aside
@@ -314,14 +329,21 @@ class ModeJob:
         The row's scene (:func:`row_scene`).
     mus : ndarray, shape (m, n_c)
         Its friction vectors.
-    xdot_rows : float
-        The workpiece's ``x`` velocity (m/s) the rows show; nan: not checked.
+    v_rows : ndarray, shape (2,), or float
+        The workpiece's centre-of-mass velocity ``(vx, vy)`` (m/s) the rows show; nan: not checked.
     """
 
     row: int
     scene: object
     mus: np.ndarray
-    xdot_rows: float
+    v_rows: object
+
+
+def _position(cols, job):
+    """The workpiece's centre of mass ``(x, y)`` (m) at the job's row, where its motion is checked (else None)."""
+    if not np.all(np.isfinite(job.v_rows)):
+        return None
+    return float(cols["x_workpiece"][job.row]), float(cols["y_workpiece"][job.row])
 
 
 def _first(flags) -> np.ndarray:
@@ -358,9 +380,10 @@ class _RowJudge:
         self.looks = [(b, int(i)) for b in range(n_blocks) for i in sorted(
             set(np.flatnonzero(self.by_mu[b])) | ({int(self.kin_first[b])} if self.kin_first[b] < m else set()))]
 
-    def verdicts(self, tight, force_margin, y_workpiece, wrenches):
+    def verdicts(self, tight, force_margin, position, wrenches):
         """``(found, excluded)`` as :func:`mode_checks` then :func:`disturbance_checks` give them; ``tight``: the
-        codes of :attr:`looks`, shape (len(looks), n_modes)."""
+        codes of :attr:`looks`, shape (len(looks), n_modes); ``position``: the centre of mass ``(x, y)`` (m) where
+        the row's motion is checked, else None."""
         from qsplan.mechanics import Status
 
         names, letters, mode, mus = Status.ORDER, self.sv.letters, self.mode, self.job.mus
@@ -383,10 +406,9 @@ class _RowJudge:
             qdot = self.sv.qdot.reshape(B, m, len(letters), 3)[:, :, self.j_mode]
             if force_margin > 0 and held.size:
                 first["force margin"] = _first(self.planned & (c_n[..., held].min(axis=-1) < force_margin))
-            xdot = qdot[..., 0] - qdot[..., 2] * y_workpiece  # qdot is the world origin's velocity
-            x_rows = self.job.xdot_rows
-            if np.isfinite(x_rows):
-                off = (np.sign(xdot[0]) != np.sign(x_rows)) | (np.abs(xdot[0] - x_rows) > MOTION_RTOL * abs(x_rows))
+            if position is not None:
+                v = _com_velocity(qdot, *position)
+                off = _motion_off(v[0], np.asarray(self.job.v_rows, dtype=float))
                 first["motion"] = np.concatenate([_first(self.planned[0] & off)[None], np.full(B - 1, m)])
         order = ("mode", "planned", "undecided", "force margin", "motion")  # mode_checks' order at one vector
         kinds = {"planned": "mode"}
@@ -410,7 +432,7 @@ class _RowJudge:
                     i_c = int(held[np.argmin(loaded)])
                     msg = _force_msg(c_n[b, i, i_c], i_c, force_margin, mu)
                 else:
-                    msg = _motion_msg(xdot[b, i], self.job.xdot_rows, mu)
+                    msg = _motion_msg(v[b, i], self.job.v_rows, mu)
                 found.append((kinds.get(kind, kind), msg))
             blocks.append(found)
         out, disturbed = list(blocks[0]), {}
@@ -422,7 +444,7 @@ class _RowJudge:
 
 
 def plan_mode_checks(task, cols, jobs, force_margin=0.0) -> dict:
-    """:func:`mode_checks` (with the job's ``xdot_rows``) then, with a task's disturbance, :func:`disturbance_checks`
+    """:func:`mode_checks` (with the job's ``v_rows``) then, with a task's disturbance, :func:`disturbance_checks`
     at every row of ``jobs`` at once: the same verdicts and messages.
 
     Every row x block (the undisturbed scene, then each vertex of ``task.disturbance``) x friction vector is solved in
@@ -477,5 +499,5 @@ def _mode_checks_call(cols, jobs, force_margin, wrenches) -> dict:
                                        for job, judge in zip(jobs, judges)], EXACT_TOLERANCES,
                               loads=[g[[b for b, _ in judge.looks]].reshape(-1, 3) for g, judge in zip(loads, judges)],
                               forces=False)  # fmt: skip
-    return {job.row: judge.verdicts(t.codes, force_margin, float(cols["y_workpiece"][job.row]), wrenches)
+    return {job.row: judge.verdicts(t.codes, force_margin, _position(cols, job), wrenches)
             for job, judge, t in zip(jobs, judges, tight)}

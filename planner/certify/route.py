@@ -183,11 +183,15 @@ def orientation_checks(task, cols, last_bodies) -> list:
     return out
 
 
-def rest_checks(task, cols, k, bodies) -> list:
-    """A regrasp row: the workpiece where the previous row left it, resting on the palm on its bottom edge."""
+def rest_checks(task, cols, k, bodies, proved=None) -> list:
+    """A regrasp row: the workpiece where the previous row left it, resting on the palm on its bottom edge; or, where
+    it does not (a finger replaced mid-turn, :mod:`qsplan.planner.plan.replace`), held by what one finger that does
+    not move in the phase and the palm touch while the other finger's joints move, that hold proved over the task's
+    friction box and disturbance box (:func:`qsplan.planner.plan.replace.lifted_hold`, the planner's rule).
+    ``proved``: a dict the proofs are kept in, one per run of free rows (its first row's index)."""
     from shapely.geometry import Point
 
-    from qsplan.planner.certify.rows import CONTACT_GAP_TOL, JUMP_TOL, row_pose
+    from qsplan.planner.certify.rows import CONTACT_GAP_TOL, JUMP_TOL, row_pose, row_q
 
     out = []
     if k > 0:
@@ -197,10 +201,42 @@ def rest_checks(task, cols, k, bodies) -> list:
                                 f"{moved[2]:.4g} rad) from the previous row while no finger holds it (a free row)"))  # fmt: skip
     W = np.asarray(bodies["polys"]["workpiece"].exterior.coords)[:-1]
     gaps = [Point(W[i]).distance(bodies["polys"]["palm"]) for i in (0, 1)]
-    if max(gaps) > CONTACT_GAP_TOL:
-        out.append(("rest", f"the workpiece does not rest on the palm on a free row: its bottom edge's ends are "
-                            f"{gaps[0] * 1e3:.4g} mm and {gaps[1] * 1e3:.4g} mm above it"))  # fmt: skip
+    if max(gaps) <= CONTACT_GAP_TOL:
+        return out
+    rows = _free_run(cols, k)
+    q = np.array([row_q(cols, i, task.hand.joint_names) for i in rows])
+    hand = task.hand
+    moving = [f for f, joints in zip(("left", "right"), hand.finger_joints) if np.any(np.ptp(q[:, list(joints)], axis=0) > 0)]
+    if len(moving) != 1:
+        out.append(("rest", f"the workpiece does not rest on the palm on its bottom edge on a free row (its ends "
+                            f"{gaps[0] * 1e3:.4g} mm and {gaps[1] * 1e3:.4g} mm above it), and "
+                            f"{'both fingers move' if moving else 'no finger moves'} in this run of free rows: only "
+                            f"a finger replaced while the other holds it is certified"))  # fmt: skip
+        return out
+    proved = {} if proved is None else proved
+    if int(rows[0]) not in proved:
+        from qsplan.planner.plan.replace import lifted_hold
+
+        proved[int(rows[0])] = lifted_hold(task, row_pose(cols, int(rows[0])), q[0], moving[0])
+    proof = proved[int(rows[0])]
+    if not proof.proved:
+        out.append(("rest", f"the workpiece rests on the palm and the {'right' if moving[0] == 'left' else 'left'} "
+                            f"finger while the {moving[0]} finger moves, and that hold is not proved over the "
+                            f"friction box: {proof.reason}"))  # fmt: skip
     return out
+
+
+def _free_run(cols, k) -> np.ndarray:
+    """The rows of row ``k``'s run of free rows (consecutive, one phase where the file numbers them)."""
+    n = cols["t"].size
+    phase = cols.get("phase", np.full(n, np.nan))
+    same = lambda i: str(cols["mode"][i]) == "free" and (phase[i] == phase[k] or np.isnan(phase[k]))  # noqa: E731
+    lo, hi = k, k
+    while lo > 0 and same(lo - 1):
+        lo -= 1
+    while hi + 1 < n and same(hi + 1):
+        hi += 1
+    return np.arange(lo, hi + 1)
 
 
 def _reach(man) -> np.ndarray:

@@ -32,7 +32,7 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["ACCEL_RTOL", "HOLD_PROOF", "RATE_TOL", "hold_checks", "interval_rates", "row_velocity", "row_x_velocity",
+__all__ = ["ACCEL_RTOL", "HOLD_PROOF", "RATE_TOL", "hold_checks", "interval_rates", "row_com_velocity", "row_velocity", "row_x_velocity",
            "timing_checks"]
 
 #: Relative excess tolerated on an acceleration limit and on the disturbance box: the planner times the rows to
@@ -81,25 +81,38 @@ def row_velocity(cols, k, names):
     qd = np.array([cols[f"qd_{m}"][k] for m in names], dtype=float)
     if "speed_scale" not in cols:
         return qd, dx / float(t[b] - t[a])
-    return qd, _rule_x_velocity(cols, k, a, b)
+    return qd, _rule_velocity(cols, k, a, b)
+
+
+def row_com_velocity(cols, k, names):
+    """The workpiece's centre-of-mass velocity ``(vx, vy)`` (m/s) the rows give at moving in-contact row ``k``: per
+    coordinate the rule's rate on the chord to the next row of its phase (at rest, or without the time scaling, the
+    chord per second: :func:`row_velocity`'s), and where rows of its phase come both before and after it, the mean with
+    the rule's rate on the chord from the row before (a central difference).  A straight slide's two chords give the
+    same velocity; a pivot's rows lie on a curve, where one chord is off the instantaneous velocity by half a step of
+    its curvature (1 to 3 % along ``full_turn_task``'s pivot at 0.25 deg a row) and the mean only by the step squared
+    (within 0.9 % there, 0.02 % in the median).  ``None`` where :func:`row_velocity` gives none."""
+    if row_velocity(cols, k, names) is None:
+        return None
+    same = _chords(cols, k)
+    t = cols["t"]
+    (a, b), out = same[0], []
+    for column in ("x_workpiece", "y_workpiece"):
+        if "speed_scale" not in cols or cols["speed_scale"][k] == 0.0:
+            out.append(float(cols[column][b] - cols[column][a]) / float(t[b] - t[a]))
+            continue
+        v = _rule_velocity(cols, k, a, b, column)
+        if len(same) >= 2:
+            v = 0.5 * (v + _rule_velocity(cols, k, *same[1], column))
+        out.append(v)
+    return np.array(out)
 
 
 def row_x_velocity(cols, k, names):
-    """The workpiece's x velocity (m/s) the rows give at moving in-contact row ``k``: :func:`row_velocity`'s, and
-    where rows of its phase come both before and after it (the rule's rates known), the mean of the rule's velocity
-    on the chord to the next row and on the chord from the row before (a central difference).  A straight slide's two
-    chords give the same velocity; a pivot's rows lie on a curve, where one chord is off the instantaneous velocity by
-    half a step of its curvature (1 to 3 %, and any fraction where the velocity passes through zero, along
-    ``full_turn_task``'s pivot at 0.25 deg a row) and the mean only by the step squared (within 0.9 % there, 0.02 %
-    in the median).  ``None`` where :func:`row_velocity` gives none."""
-    moving = row_velocity(cols, k, names)
-    if moving is None:
-        return None
-    same = _chords(cols, k)
-    if len(same) < 2 or "speed_scale" not in cols or cols["speed_scale"][k] == 0.0:
-        return float(moving[1])
-    a, b = same[1]  # the chord from the row before (same[0], the chord to the next row, is row_velocity's)
-    return 0.5 * (float(moving[1]) + _rule_x_velocity(cols, k, a, b))
+    """The workpiece's x velocity (m/s) the rows give at moving in-contact row ``k`` (:func:`row_com_velocity`'s x);
+    ``None`` where :func:`row_velocity` gives none."""
+    v = row_com_velocity(cols, k, names)
+    return None if v is None else float(v[0])
 
 
 def _chords(cols, k) -> list:
@@ -111,10 +124,11 @@ def _chords(cols, k) -> list:
             if 0 <= a and b < n and ph[a] == ph[k] and ph[b] == ph[k] and t[b] > t[a]]  # fmt: skip
 
 
-def _rule_x_velocity(cols, k, a, b) -> float:
-    """The workpiece's x velocity (m/s) at row ``k``, an end of the chord ``(a, b)``, by the time scaling's rule."""
+def _rule_velocity(cols, k, a, b, column: str = "x_workpiece") -> float:
+    """The rate (m/s) of the workpiece's ``column`` at row ``k``, an end of the chord ``(a, b)``, by the time scaling's
+    rule."""
     r0, r1, _ = interval_rates(cols, a, b)
-    return float(cols["x_workpiece"][b] - cols["x_workpiece"][a]) * (r0 if k == a else r1)
+    return float(cols[column][b] - cols[column][a]) * (r0 if k == a else r1)
 
 
 def timing_checks(task, cols) -> list:

@@ -71,8 +71,10 @@ def run_task(task, args, out, inputs=()) -> int:
                       progress=progress, sequence_planner=args.sequence_planner, inputs=inputs)  # fmt: skip
     plan = result.plan
     name, t, w = plan.narrowest()
+    replaced = [ph.finger for ph in plan.phases if ph.kind == "replace"]
+    mid_turn = f" ({len(replaced)} of them a finger replaced mid-turn: {', '.join(replaced)})" if replaced else ""
     out.write(f"{task.name}: planned {len(plan.segments)} in-contact segments and {len(plan.phases) - len(plan.segments)} "
-              f"regrasps, {plan.duration:.4g} s of motion\n")  # fmt: skip
+              f"regrasps{mid_turn}, {plan.duration:.4g} s of motion\n")  # fmt: skip
     out.write(f"planning: {plan.seconds:.3g} s, {plan.validity_checks} states judged "
               f"({plan.checks_per_second:.4g} per second: band tables, dense sweeps and the regrasps' OMPL checks)\n")  # fmt: skip
     search = plan.search

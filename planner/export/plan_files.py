@@ -130,7 +130,7 @@ def plan_metadata(plan) -> dict:
             d["effort_unit"] = _joint_units(task.hand)[ph.effort_joint]["tau"]
             d.update(phase_kind=ph.kind, formation=ph.formation, **phase_contacts(ph))
         else:
-            d.update(kind="regrasp", x_workpiece_m=float(np.ravel(ph.x)[0]))
+            d.update(kind="regrasp", x_workpiece_m=float(np.ravel(ph.x)[0]), **ph.free_metadata())
         if plan.timing:
             d["time_scaling"] = plan.timing[i].as_dict()
         phases.append(d)

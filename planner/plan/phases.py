@@ -22,11 +22,10 @@ from qsplan.mechanics.errors import QsplanError
 from qsplan.planner.plan.failure import configuration_report, failure_report
 from qsplan.planner.plan.results import PlanFailure, RegraspPhase, SlidePhase
 from qsplan.planner.search.ompl_bridge import PlannerOptions, plan_path
-from qsplan.planner.states.contact import (check_contact_state, check_free_state, configuration_problem, contact_samples,
-                                           free_state_problem, mode_name)  # fmt: skip
+from qsplan.planner.states.contact import check_contact_state, configuration_problem, contact_samples, mode_name
 
 __all__ = ["DEFAULT_OPTIONS", "FreePath", "OPENING", "REGRASP_OPENING", "SLIP_RTOL", "SWEEP_STEP", "densify",
-           "densify_rows", "regrasp_phase", "slide_phase", "slip_reversal", "straight_path", "sweep_contact_segment"]
+           "densify_rows", "free_motion", "regrasp_phase", "slide_phase", "slip_reversal", "straight_path", "sweep_contact_segment"]
 
 #: Angle (rad) each finger opens by to release the workpiece between segments: about 1.5 cm
 #: at the tip of a 0.16 m finger, clear of the workpiece's corners.
@@ -282,7 +281,7 @@ def regrasp_phase(task, name, x, q_from, q_to, t0, options, progress, counters, 
     direction ``opening_from`` (per joint -1, 0 or +1, :meth:`qsplan.hands.protocol.Hand.opening`; default the paper
     hand's inner edges': the left finger counter-clockwise), every joint moves to the opened ``q_to`` and the
     fingers close; the workpiece rests on the palm meanwhile.  Every leg is collision-free
-    (:func:`check_free_state`), and the straight lines between OMPL's states are checked again every
+    (:func:`free_motion`), and the straight lines between OMPL's states are checked again every
     :data:`SWEEP_STEP` of a link's travel (:attr:`qsplan.hands.protocol.Hand.finger_reach` sets the joint step).
 
     Raises
@@ -295,36 +294,67 @@ def regrasp_phase(task, name, x, q_from, q_to, t0, options, progress, counters, 
     default = task.hand.opening(None, x, q) if opening_from is None or opening_to is None else None
     q_open = _opened(task, q, default if opening_from is None else opening_from)
     q_to_open = _opened(task, q_to, default if opening_to is None else opening_to)
+    t, path, qd, results = free_motion(task, name, task.pose(x), q, q_open, q_to_open, q_to, t0, options, progress,
+                                       counters)  # fmt: skip
+    return RegraspPhase(name, float(x), t, path, qd, results)
+
+
+def free_motion(task, name, pose, q, q_open, q_to_open, q_to, t0, options, progress, counters, moving=None,
+                who: str = "the fingers") -> tuple:  # fmt: skip
+    """The legs of a free finger motion with the workpiece at ``pose``: from ``q`` to the opened ``q_open``, through
+    OMPL to ``q_to_open``, and closing at ``q_to`` (rad or m, shape (n_j,)); ``moving`` (bool, shape (n_j,); default
+    every joint): the joints OMPL plans, the others held where ``q`` has them.  Every leg is collision-free
+    (:func:`configuration_problem`), and the straight lines between OMPL's states are checked again every
+    :data:`SWEEP_STEP` of a link's travel.  Returns ``(t, q rows, qd rows, OMPL results)``.
+
+    Raises
+    ------
+    PlanFailure
+        With a :class:`qsplan.planner.plan.failure.ConfigurationReport` naming the leg and what blocks it.
+    """
+    pose = np.asarray(pose, dtype=float)
+    n_j = q.size
+    moving = np.ones(n_j, dtype=bool) if moving is None else np.asarray(moving, dtype=bool)
     lim = task.joint_limits
+    x = float(pose[0])
+    at = None if np.array_equal(pose, task.pose(x)) else pose  # a report names the pose where it is not the rest's
+
+    def full(s):
+        out = q.copy()
+        out[moving] = s
+        return out
+
+    def valid(s):
+        return configuration_problem(task, pose, full(s)) is None
+
     results, path = [], [q[None, :]]
     legs = [(q, q_open, "the opening"), (q_open, q_to_open, "the move to the new grasp"), (q_to_open, q_to, "the closing")]
     if np.array_equal(q_open, q_to_open):  # the same grasp again: open and close
         legs = [legs[0], (q_open, q_to, "the closing")]
     for a, b, what in legs:
-        res = plan_path(lim[:, 0], lim[:, 1], a, b, lambda s: check_free_state(task, x, s), options)
+        res = plan_path(lim[moving, 0], lim[moving, 1], a[moving], b[moving], valid, options)
         counters[0] += res.validity_checks
         counters[1] += res.seconds
-        progress(f"  OMPL: {what} of the fingers: {res.status}, {len(res.path)} states, "
+        progress(f"  OMPL: {what} of {who}: {res.status}, {len(res.path)} states, "
                  f"{res.validity_checks} validity checks in {res.seconds:.2f} s")  # fmt: skip
         if not res.exact:
-            raise PlanFailure(configuration_report(task, name, f"{what} of the fingers", x, b,
+            raise PlanFailure(configuration_report(task, name, f"{what} of {who}", x, b,
                                                    f"OMPL found no collision-free finger motion ({res.status})",
-                                                   res.status))  # fmt: skip
+                                                   res.status, at))  # fmt: skip
         results.append(res)
-        path.append(res.path[1:])
+        path.append(np.array([full(s) for s in np.asarray(res.path)[1:]]).reshape(-1, n_j))
     path = np.vstack(path)
     # OMPL checked its edges at validity_resolution; the fingers move on straight lines between the rows
     # exported, so check those lines again every SWEEP_STEP of travel at the fingertips (m for a prismatic joint)
     reach = task.hand.finger_reach
     steps = np.array([SWEEP_STEP / reach if k == "revolute" else SWEEP_STEP for k in task.hand.joint_kinds])
-    dense = densify_rows(path, steps)
-    for qk in dense:
-        why = free_state_problem(task, x, qk)
+    for qk in densify_rows(path, steps):
+        why = configuration_problem(task, pose, qk)
         if why:
             raise PlanFailure(configuration_report(task, name, "a state between OMPL's states", x, qk, why,
-                                                   results[-1].status))  # fmt: skip
+                                                   results[-1].status, at))  # fmt: skip
     moves = np.max(np.abs(np.diff(path, axis=0)) / np.asarray(task.joint_speeds, float)[None, :], axis=1)
     t = t0 + np.concatenate([[0.0], np.cumsum(moves)])
     seg_qd = np.diff(path, axis=0) / np.maximum(np.diff(t), 1e-12)[:, None]
     qd = np.vstack([seg_qd, np.zeros((1, path.shape[1]))])
-    return RegraspPhase(name, float(x), t, path, qd, tuple(results))
+    return t, path, qd, tuple(results)

@@ -90,14 +90,16 @@ def pivot_thetas(theta0: float, theta1: float) -> np.ndarray:
     return np.linspace(theta0, theta1, max(n, 2))
 
 
-def _expected_contacts(i: int, n: int) -> int:
-    """Contacts a pivot's row touches: the flush instant's five at its first row, then four."""
-    return 5 if i == 0 else 4
+def _expected_contacts(i: int, flush: bool) -> int:
+    """Contacts a pivot's row touches: the flush instant's five at its first row (``flush``: the pivot starts there),
+    then four."""
+    return 5 if i == 0 and flush else 4
 
 
 def pivot_geometry(task, pivot, start, theta_goal: float) -> PivotGeometry:
-    """``pivot`` swept from configuration ``start`` (its flush instant) to ``theta_goal`` (rad), its first event and
-    the slip reversals before it (module docstring)."""
+    """``pivot`` swept from configuration ``start`` (its flush instant, or a configuration on it mid-turn: a finger
+    replaced there, :mod:`qsplan.planner.plan.replace`) to ``theta_goal`` (rad), its first event and the slip
+    reversals before it (module docstring)."""
     from qsplan.hands.contacts.found import made_contacts, ordered_contacts
     from qsplan.hands.formations.manifold import along_edges
     from qsplan.hands.formations.pivots import pivot_path
@@ -105,7 +107,8 @@ def pivot_geometry(task, pivot, start, theta_goal: float) -> PivotGeometry:
     from qsplan.planner.states.contact import configuration_problem
 
     hand = task.hand
-    path = pivot_path(hand, pivot, start, pivot_thetas(0.0, theta_goal))
+    flush = float(start[2]) == 0.0  # the flush instant (theta 0 exactly); mid-turn otherwise
+    path = pivot_path(hand, pivot, start, pivot_thetas(float(start[2]), theta_goal))
     cons = pivot.constraints(hand)
     n, end, contacts = path.theta.size, None, []
     for i in range(n):
@@ -133,12 +136,12 @@ def pivot_geometry(task, pivot, start, theta_goal: float) -> PivotGeometry:
         if i == n - 1 and i > 0:  # the goal's row may make a contact (an edge landing): not in the motion
             prev = (path.pose[i - 1], path.q[i - 1])
             found = [f for f, m in zip(found, made_contacts(hand, prev, (pose, q), found)) if not m]
-        if len(found) != _expected_contacts(i, n):
+        if len(found) != _expected_contacts(i, flush):
             end = PivotEnd(i, float(path.theta[i]), "contacts", f"the polygons show {len(found)} contacts; the "
-                                                                f"formation has {_expected_contacts(i, n)}")  # fmt: skip
+                                                                f"formation has {_expected_contacts(i, flush)}")  # fmt: skip
             break
     valid = n if end is None else end.row
-    cuts = _reversals(task, pivot, path, valid, contacts)
+    cuts = _reversals(task, pivot, path, valid, contacts, 1 if flush else 0)
     return PivotGeometry(path, end, cuts)
 
 
@@ -153,14 +156,14 @@ def _slips(hand, pose, q, dpose, dq, found=None) -> np.ndarray:
     return scene.Wt.T @ nu - scene.Jt @ dq
 
 
-def _reversals(task, pivot, path, valid: int, contacts) -> tuple:
+def _reversals(task, pivot, path, valid: int, contacts, first: int = 1) -> tuple:
     """The angles (rad, bisected to :data:`REVERSAL_TOL`) where a contact's sliding direction reverses along the
-    four-contact rows ``1 .. valid - 1`` of ``path`` (``contacts``: each row's, searched); each later cut from the
-    previous one's side."""
+    four-contact rows ``first .. valid - 1`` of ``path`` (``contacts``: each row's, searched; ``first`` 1 after a flush
+    instant, whose row has five); each later cut from the previous one's side."""
     from qsplan.hands.formations.pivots import pivot_path
 
     hand = task.hand
-    rows = range(1, valid)
+    rows = range(first, valid)
     if len(rows) < 2:
         return ()
     slips = [_slips(hand, path.pose[i], path.q[i], path.dpose[i], path.dq[i], contacts[i]) for i in rows]

@@ -16,7 +16,7 @@ from qsplan.planner.search.ompl_bridge import PlannerOptions
 from qsplan.planner.task.task import Task
 
 __all__ = ["ContactSegmentPlan", "HoldPhase", "PivotPhase", "Plan", "PlanFailure", "RegraspPhase", "RegraspPlan",
-           "SlidePhase"]
+           "ReplacePhase", "SlidePhase"]
 
 
 class PlanFailure(NoAnswerError):
@@ -237,8 +237,75 @@ class RegraspPhase:
         """The workpiece's pose at every row (m, m, rad), shape (n, 3): resting on its palm edge at ``x``."""
         return np.tile([float(self.x), float(rest_height), 0.0], (self.t.size, 1))
 
+    def free_metadata(self) -> dict:
+        """What ``plan.json`` adds to the phase's ``kind`` and ``x_workpiece_m``: nothing for a regrasp on the palm."""
+        return {}
+
+    def label(self) -> tuple:
+        """``(what, control)`` in words, for plots: ``("regrasp", "fingers velocity")``."""
+        return "regrasp", "fingers velocity"
+
+    def title(self) -> str:
+        """What the hand does, in a plot's title."""
+        return "regrasp, every joint velocity-controlled"
+
+    def does(self, who: str) -> str:
+        """The card's cell: ``who`` (the fingers that leave the workpiece, in words) and what they do."""
+        return f"regrasp: {who}\nopen and close again"
+
 
 RegraspPlan = RegraspPhase  # its name before the phases were typed (users' scripts import it)
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class ReplacePhase(RegraspPhase):
+    """One finger lifted and replaced during a turn (:func:`qsplan.planner.plan.replace.replace_phase`): the workpiece
+    rests at ``pose`` on the palm and the other finger, every joint of which is held, while ``finger`` opens, moves
+    through OMPL and closes on a new feature (its free joints possibly held elsewhere afterwards).  Nothing moves: the
+    hold with ``finger`` lifted is proved over the task's whole friction box and disturbance box
+    (:func:`qsplan.mechanics.bands.friction_hold.prove_friction_hold`), every row.
+
+    Attributes
+    ----------
+    pose : ndarray, shape (3,)
+        The workpiece's pose meanwhile (m, m, rad).
+    finger : str
+        The finger that moves (``"left"`` or ``"right"``).
+    kept : tuple of str
+        The contacts that hold the workpiece meanwhile (canonical names, :func:`qsplan.hands.contacts.found.
+        contact_names`).
+    hold_margin : float
+        The proof's certified margin at rest (N, :attr:`qsplan.mechanics.bands.friction_hold.FrictionHold.
+        rest_margin`).
+    """
+
+    pose: np.ndarray | None = None
+    finger: str = "right"
+    kept: tuple = ()
+    hold_margin: float = float("nan")
+    kind = "replace"
+
+    def poses(self, rest_height: float) -> np.ndarray:
+        """The workpiece's pose at every row (m, m, rad), shape (n, 3): held at :attr:`pose`."""
+        return np.tile(np.asarray(self.pose, dtype=float), (self.t.size, 1))
+
+    def label(self) -> tuple:
+        """``(what, control)`` in words, for plots: ``("right finger replaced", "right finger velocity")``."""
+        return f"{self.finger} finger replaced", f"{self.finger} finger velocity"
+
+    def title(self) -> str:
+        other = "left" if self.finger == "right" else "right"
+        return f"the {self.finger} finger replaced, every joint velocity-controlled (the {other} finger held)"
+
+    def does(self, who: str) -> str:
+        other = "left" if self.finger == "right" else "right"
+        return f"the {self.finger} finger replaced:\nthe {other} finger and palm hold"
+
+    def free_metadata(self) -> dict:
+        """``phase_kind`` ``replace``, the ``finger`` that moves, the workpiece's ``y_workpiece_m`` and
+        ``theta_workpiece_rad``, and the ``contacts_kept`` that hold it (the certifier checks each against the rows)."""
+        return {"phase_kind": self.kind, "finger": self.finger, "y_workpiece_m": float(self.pose[1]),
+                "theta_workpiece_rad": float(self.pose[2]), "contacts_kept": list(self.kept)}
 
 
 @dataclass(frozen=True, slots=True, eq=False)

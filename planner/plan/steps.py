@@ -17,7 +17,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-__all__ = ["HoldStep", "PivotStep", "RegraspStep", "SearchSummary", "SlideStep", "realised_steps", "route_steps",
+__all__ = ["HoldStep", "PivotStep", "RegraspStep", "ReplaceStep", "SearchSummary", "SlideStep", "realised_steps", "route_steps",
            "search_summary", "step_dicts"]
 
 
@@ -111,6 +111,31 @@ class HoldStep:
 
     def realised(self, phase) -> HoldStep:
         """This step: a hold's figures are its rows' already (the torques ramped, the proved interval)."""
+        return self
+
+
+@dataclass(frozen=True, slots=True)
+class ReplaceStep:
+    """A finger replaced mid-turn (:mod:`qsplan.planner.plan.replace`): at workpiece ``x`` (m) and angle ``theta``
+    (rad) the workpiece rests on the contacts ``kept`` (canonical names), every joint held, while ``finger`` lifts, moves
+    and closes on ``feature`` (the new formation's name, :attr:`qsplan.hands.formations.pivots.Pivot.name`); the hold is
+    proved over the friction box (``hold_margin``, N: the proof's certified margin at rest)."""
+
+    x: float
+    theta: float
+    finger: str
+    kept: tuple
+    formation: str
+    hold_margin: float
+    kind = "replace"
+
+    def as_dict(self) -> dict:
+        return {"kind": self.kind, "x_from_m": self.x, "x_to_m": self.x, "theta_rad": self.theta,
+                "finger": self.finger, "contacts_kept": list(self.kept), "formation": self.formation,
+                "hold_margin_N": _finite(self.hold_margin)}  # fmt: skip
+
+    def realised(self, phase) -> ReplaceStep:
+        """This step: the rows of a replacement change none of its figures."""
         return self
 
 

@@ -27,13 +27,20 @@ import numpy as np
 from qsplan.planner.plan.results import Plan, PlanFailure
 from qsplan.planner.task.goal import Goal, GoalNotServedError
 
-__all__ = ["FLUSH_APPROACH", "FormationOutcome", "SEARCHED_FORMATIONS", "Surveyed", "TurnReport", "flush_free_joints",
+__all__ = ["FLUSH_APPROACH", "FormationOutcome", "Leg", "REPLACE_ANGLES", "REPLACE_EVERY", "SEARCHED_FORMATIONS", "Surveyed", "TurnReport", "flush_free_joints",
            "goal_angle", "pivot_pieces", "plan_turn", "slide_task", "survey"]
 
 #: How far (m) short of the flush instant the slide's band tables end: five times the contact tolerance (1 um), so
 #: the polygons show the four contacts of the palm edge there; the slide then reaches the flush instant itself in
 #: its last row.
 FLUSH_APPROACH = 5e-6
+
+#: Rows of a pivot (0.25 deg apart) between the angles where its other finger may be replaced (one degree): the hold
+#: with the finger lifted is proved only in windows of a few degrees (docs/reorientation.md), finer gains nothing.
+REPLACE_EVERY = 4
+
+#: Angles with a proved lifted hold tried for a replacement, widest margin first: each costs the new grasps' geometry.
+REPLACE_ANGLES = 6
 
 #: ``planner_status`` of a turning goal no formation reaches.
 SEARCHED_FORMATIONS = "ran: the formation search; no route of formations reaches the goal"
@@ -195,32 +202,51 @@ def _outcome(pivot, hand, status, theta, why, pose=None, q=None, band=None) -> F
 
 
 def pivot_pieces(task, pivot, start, theta_goal, geometry, progress):
-    """The pivot's pieces (planned phases, times from 0), from its flush instant ``start`` to ``theta_goal`` (rad),
-    cut at ``geometry.cuts`` (:func:`qsplan.planner.plan.pivot.pivot_geometry`); raises PlanFailure naming the first
-    row without a band."""
+    """The pivot's pieces (planned phases, times from 0), from its flush instant ``start`` (or a configuration on it
+    mid-turn) to ``theta_goal`` (rad), cut at those of ``geometry.cuts`` before it (:func:`qsplan.planner.plan.pivot.
+    pivot_geometry`); raises PlanFailure naming the first row without a band."""
     from qsplan.hands.formations.pivots import pivot_path
     from qsplan.planner.plan.pivot import pivot_thetas, widest_piece
 
     hand = task.hand
-    ends = [0.0, *geometry.cuts, theta_goal]
-    pieces, c = [], np.asarray(start, dtype=float)
+    c = np.asarray(start, dtype=float)
+    flush = float(c[2]) == 0.0  # from the flush instant (the transition its first row), or mid-turn
+    ends = [float(c[2]), *(cut for cut in geometry.cuts if abs(cut - c[2]) < abs(theta_goal - c[2])), theta_goal]
+    pieces = []
     for j, (a, b) in enumerate(zip(ends[:-1], ends[1:])):
         path = pivot_path(hand, pivot, c, pivot_thetas(a, b))
         name = (f"pivot on vertex {int(hand.user_vertices[pivot.vertex])} from theta = {a:.4g} to {b:.4g} rad"
-                if len(ends) > 2 else f"pivot on vertex {int(hand.user_vertices[pivot.vertex])} to theta = {b:.4g} rad")
-        pieces.append(widest_piece(task, name, pivot, path, np.arange(path.theta.size), j == 0, progress))
+                if len(ends) > 2 or not flush else f"pivot on vertex {int(hand.user_vertices[pivot.vertex])} to theta = {b:.4g} rad")
+        pieces.append(widest_piece(task, name, pivot, path, np.arange(path.theta.size), flush and j == 0, progress))
         c = np.concatenate([path.pose[-1], path.q[-1]])
     return pieces
 
 
-def _route(task, pivot, start, theta_goal, pieces, options, progress, planner, started):
-    """The whole route: the slide to the flush instant, a hold, each piece with a hold before the next; timed."""
+@dataclass(frozen=True, slots=True, eq=False)
+class Leg:
+    """One formation's part of a route: ``pivot`` from configuration ``start`` (its flush instant for the first leg;
+    for a later one where ``finger`` was replaced, :mod:`qsplan.planner.plan.replace`) through ``pieces`` (planned
+    phases, times from 0)."""
+
+    pivot: object
+    start: np.ndarray
+    pieces: tuple
+    finger: str | None = None
+
+
+def _route(task, legs, options, progress, planner, started):
+    """The whole route: the slide to the first leg's flush instant, a hold, each piece with a hold before the next; a
+    later leg's finger replaced before its first hold; timed."""
     from qsplan.planner.plan.autoplan import plan_automatic
     from qsplan.planner.plan.failure import StepReport, configuration_report
-    from qsplan.planner.plan.pivot import hold_phase, shifted
+    from qsplan.planner.plan.phases import DEFAULT_OPTIONS
+    from qsplan.planner.plan.pivot import held_interval, hold_phase, shifted
+    from qsplan.planner.plan.release import release_torque
+    from qsplan.planner.plan.replace import replace_phase
     from qsplan.planner.plan.steps import (
         HoldStep,
         PivotStep,
+        ReplaceStep,
         SearchSummary,
         realised_steps,
         route_steps,
@@ -228,6 +254,7 @@ def _route(task, pivot, start, theta_goal, pieces, options, progress, planner, s
     from qsplan.planner.plan.timing import time_scale
 
     hand = task.hand
+    pivot, start = legs[0].pivot, legs[0].start
     sub, step = slide_task(task, pivot, start)
     try:
         slide = plan_automatic(sub, options, progress, planner, timed=False, goal_free=flush_free_joints(hand, start))
@@ -250,26 +277,52 @@ def _route(task, pivot, start, theta_goal, pieces, options, progress, planner, s
     end = timed.phases[-1]
     turned, steps, t0 = [], [], 0.0
     prev_effort, prev_tau = end.effort_joint, float(end.command[-1])
-    vertex = int(hand.user_vertices[pivot.vertex])
-    for j, piece in enumerate(pieces):
-        e = piece.effort_joint
-        pose, q0 = piece.pose[0], piece.q[0]
-        where = "the flush instant" if j == 0 else f"theta = {pose[2]:.4g} rad (a contact's sliding reverses)"
-        hold = hold_phase(task, f"hold at {where}", pose, q0, e, prev_tau if prev_effort == e else None,
-                          float(piece.command[0]), t0, pivot.name)  # fmt: skip
-        moved = shifted(piece, float(hold.t[-1]))
-        turned += [hold, moved]
-        steps += [HoldStep(float(pose[0]), float(pose[2]), e, float(hold.command[0]), float(piece.command[0]),
-                           float(hold.lower[0]), float(hold.upper[0])),
-                  PivotStep(vertex, float(piece.pose[0, 2]), float(piece.pose[-1, 2]), e, float(np.min(piece.width)))]
-        t0, prev_effort, prev_tau = float(moved.t[-1]), e, float(piece.command[-1])
+    counters = [slide.validity_checks, slide.ompl_seconds]
+    for leg in legs:
+        vertex = int(hand.user_vertices[leg.pivot.vertex])
+        if leg.finger is not None:  # the finger replaced: from the last row at rest to the leg's start
+            before = turned[-1]
+            pose = before.pose[-1]
+            # unloaded first, as before a regrasp (qsplan.planner.plan.release): the effort joint ramps at rest to the
+            # least torque at which the hold is still proved, so that a compliant grasp stores little when it lets go
+            e = before.effort_joint
+            lo, hi = held_interval(task, pose, before.q[-1], np.array(hand.joint_names) == e)[1]
+            tau = release_torque(lo, hi, task.torque_resolution)
+            if np.isfinite(tau) and tau != prev_tau:
+                hold = hold_phase(task, f"release hold at theta = {pose[2]:.4g} rad", pose, before.q[-1], e, prev_tau,
+                                  tau, t0, before.formation)  # fmt: skip
+                turned.append(hold)
+                steps.append(HoldStep(float(pose[0]), float(pose[2]), e, float(hold.command[0]), float(tau),
+                                      float(hold.lower[0]), float(hold.upper[0])))  # fmt: skip
+                t0 = float(hold.t[-1])
+            moved = replace_phase(task, f"the {leg.finger} finger replaced at theta = {pose[2]:.4g} rad", pose,
+                                  before.q[-1], leg.start[3:], leg.finger, t0, options or DEFAULT_OPTIONS, progress,
+                                  counters)  # fmt: skip
+            turned.append(moved)
+            steps.append(ReplaceStep(float(pose[0]), float(pose[2]), leg.finger, moved.kept, leg.pivot.name,
+                                     moved.hold_margin))  # fmt: skip
+            t0, prev_effort = float(moved.t[-1]), None  # the new grasp's torque is taken over at rest
+        for j, piece in enumerate(leg.pieces):
+            e = piece.effort_joint
+            pose, q0 = piece.pose[0], piece.q[0]
+            where = ("the flush instant" if not turned else
+                     f"theta = {pose[2]:.4g} rad" + (" (a contact's sliding reverses)" if j else " (the new grasp)"))
+            hold = hold_phase(task, f"hold at {where}", pose, q0, e, prev_tau if prev_effort == e else None,
+                              float(piece.command[0]), t0, leg.pivot.name)  # fmt: skip
+            moved = shifted(piece, float(hold.t[-1]))
+            turned += [hold, moved]
+            steps += [HoldStep(float(pose[0]), float(pose[2]), e, float(hold.command[0]), float(piece.command[0]),
+                               float(hold.lower[0]), float(hold.upper[0])),
+                      PivotStep(vertex, float(piece.pose[0, 2]), float(piece.pose[-1, 2]), e,
+                                float(np.min(piece.width)))]  # fmt: skip
+            t0, prev_effort, prev_tau = float(moved.t[-1]), e, float(piece.command[-1])
     rest = time_scale(Plan(task, tuple(turned), 0.0, 0, 0.0, slide.options))
     later = tuple(shifted(ph, float(end.t[-1])) for ph in rest.phases)
     sequence = route_steps(slide.sequence) + tuple(steps) + \
         tuple(st for st in slide.sequence if isinstance(st, SearchSummary))  # fmt: skip
-    plan = Plan(task, timed.phases + later, time.perf_counter() - started,
-                slide.validity_checks + sum(p.t.size for p in pieces), slide.ompl_seconds, slide.options,
-                realised_steps(sequence, timed.phases + later), timed.timing + rest.timing)  # fmt: skip
+    n_rows = sum(p.t.size for leg in legs for p in leg.pieces)
+    plan = Plan(task, timed.phases + later, time.perf_counter() - started, counters[0] + n_rows, counters[1],
+                slide.options, realised_steps(sequence, timed.phases + later), timed.timing + rest.timing)  # fmt: skip
     plan.check()
     return plan
 
@@ -289,7 +342,8 @@ def _check_goal(task) -> None:
 class Surveyed:
     """One pivot formation as the search saw it (:func:`survey`): the formation, its flush instant ``start``
     (``(x, y, 0, q)``), the goal's angle for it (rad, or None), what became of it, and its pieces (planned phases,
-    times from 0) where it reaches the goal with a band in every piece, else None."""
+    times from 0) where it reaches the goal with a band in every piece (or where its other finger is replaced, the
+    route going on in :attr:`later`), else None."""
 
     pivot: object
     start: np.ndarray
@@ -297,6 +351,13 @@ class Surveyed:
     outcome: FormationOutcome
     pieces: tuple | None
     failure: object = None
+    later: tuple = ()
+
+    @property
+    def legs(self) -> tuple:
+        """The route's formations (:class:`Leg`): this one to the goal, or to where its other finger is replaced
+        (:attr:`later`: the legs after each replacement)."""
+        return (Leg(self.pivot, self.start, tuple(self.pieces)), *self.later)
 
 
 def survey(task, progress=None) -> tuple:
@@ -322,7 +383,8 @@ def survey(task, progress=None) -> tuple:
             e = geometry.end
             i = max(e.row - 1, 0)
             o = _outcome(pivot, hand, "ended", e.theta, e.words, geometry.path.pose[i], geometry.path.q[i])
-            out.append(Surveyed(pivot, start, theta_goal, o, None))
+            found = _with_replacement(task, pivot, start, theta_goal, geometry, e.row, o, progress)
+            out.append(found or Surveyed(pivot, start, theta_goal, o, None))
             progress(f"  {o.line()}")
             continue
         try:
@@ -330,7 +392,9 @@ def survey(task, progress=None) -> tuple:
         except PlanFailure as exc:
             r = exc.report
             o = _outcome(pivot, hand, "no band", r.pose[2], r.reason, r.pose, r.q)
-            out.append(Surveyed(pivot, start, theta_goal, o, None, exc))
+            row = int(np.argmin(np.abs(geometry.path.theta - r.pose[2])))
+            found = _with_replacement(task, pivot, start, theta_goal, geometry, row, o, progress)
+            out.append(found or Surveyed(pivot, start, theta_goal, o, None, exc))
             progress(f"  {o.line()}")
             continue
         band = min(float(np.min(p.width)) for p in pieces)
@@ -339,6 +403,52 @@ def survey(task, progress=None) -> tuple:
         out.append(Surveyed(pivot, start, theta_goal, o, pieces))
         progress(f"  {o.line()}; narrowest band {_band_words(band)}")
     return tuple(out)
+
+
+def _with_replacement(task, pivot, start, theta_goal, geometry, stop: int, ended, progress) -> Surveyed | None:
+    """``pivot``'s route with its other finger replaced (:mod:`qsplan.planner.plan.replace`) at one of its rows before
+    ``stop`` (where it ends or loses its band), or None.  Of the rows every :data:`REPLACE_EVERY` where the hold with
+    the finger lifted is proved, the one with the widest margin (the proof's certified rest margin: the least normal
+    force and cone slack) first, at most :data:`REPLACE_ANGLES` of them: the first where a new grasp's formation
+    reaches the goal with a band in every piece, and this formation's pieces reach that row with bands.  ``ended``: this formation's own outcome, said in the new one's."""
+    from qsplan.planner.plan.pivot import PivotGeometry, pivot_geometry
+    from qsplan.planner.plan.replace import lifted_hold, reclosed, reclosings
+
+    hand, path, finger = task.hand, geometry.path, pivot.other_finger
+    proved = []
+    for i in range(stop - 1, 0, -REPLACE_EVERY):
+        proof = lifted_hold(task, path.pose[i], path.q[i], finger)
+        if proof.proved:
+            proved.append((-proof.rest_margin, -i, i))
+    for _, _, i in sorted(proved)[:REPLACE_ANGLES]:  # the widest margin first (a compliant hand rocks least there)
+        pose, q = path.pose[i], path.q[i]
+        theta_k = float(path.theta[i])
+        progress(f"  the {finger} finger lifted at theta = {np.degrees(theta_k):.2f} deg: the hold is proved")
+        pieces1 = None
+        for other, c in reclosings(task, pivot, pose, q):
+            if pivot_geometry(task, other, c, theta_goal).end is not None:
+                continue
+            try:
+                if pieces1 is None:  # this formation's pieces to theta_k: their last row is where the finger lifts
+                    cuts = tuple(x for x in geometry.cuts if abs(x) < abs(theta_k))
+                    pieces1 = pivot_pieces(task, pivot, start, theta_k, PivotGeometry(path, None, cuts), progress)
+                c = reclosed(task, other, pieces1[-1].pose[-1], pieces1[-1].q[-1], c)
+                later = None if c is None else pivot_geometry(task, other, c, theta_goal)
+                if later is None or later.end is not None:
+                    continue
+                pieces2 = pivot_pieces(task, other, c, theta_goal, later, progress)
+            except PlanFailure:
+                if pieces1 is None:
+                    break  # no band to theta_k: another angle
+                continue
+            band = min(float(np.min(p.width)) for p in (*pieces1, *pieces2))
+            o = _outcome(pivot, hand, "reaches the goal", theta_goal,
+                         f"{len(pieces1)} piece(s) to {np.degrees(theta_k):.2f} deg ({ended.why}), the {finger} "
+                         f"finger replaced there, then {other.words(hand)}: {len(pieces2)} piece(s)",
+                         band=band)  # fmt: skip
+            return Surveyed(pivot, start, theta_goal, o, tuple(pieces1), None,
+                            (Leg(other, c, tuple(pieces2), finger),))  # fmt: skip
+    return None
 
 
 def _band_words(width: float) -> str:
@@ -366,7 +476,7 @@ def plan_turn(task, options=None, progress=None, planner: str = "widest") -> Pla
             outcomes.append(s.outcome)
             continue
         try:
-            plan = _route(task, s.pivot, s.start, s.theta_goal, s.pieces, options, progress, planner, started)
+            plan = _route(task, s.legs, options, progress, planner, started)
         except PlanFailure as exc:
             r = exc.report
             status = "hold" if str(getattr(r, "where", "")).startswith("the hold") else "no slide"

@@ -204,7 +204,7 @@ class _Scene:
         ph = self.plan.phases[i]
         self.doing.set_text(f"the hand is {state_words(self.plan, i, state)}")
         mode, control = phase_label(ph, self.hand)
-        what = f"{mode}, {control}-controlled" if is_contact(ph) else "regrasp, every joint velocity-controlled"
+        what = f"{mode}, {control}-controlled" if is_contact(ph) else ph.title()
         n = len(self.plan.phases)
         self.title.set_text(f"phase {i}" + (f" (phases 0 to {n - 1})" if n > 1 else "") + f": {what}")
         for g in self.gauges:

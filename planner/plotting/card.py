@@ -83,6 +83,9 @@ _TIMELINE_HEIGHT = 0.45
 _TORQUE_HEIGHT, _VELOCITY_HEIGHT, _TORQUE_MIN, _VELOCITY_MIN = 2.3, 1.05, 1.6, 0.75
 _SNAPSHOT_TITLE, _SNAPSHOT_ROW_WIDTH, _SNAPSHOT_MAX_WIDTH = 0.4, 7.9, 2.0
 _LEGEND_LINE, _BODY_MARGIN = 0.16, 0.6
+#: Height (in) of a row of small snapshots, counted when deciding whether more than two velocity panels fit (a chain
+#: hand whose four joints each move at some time, as when a finger is replaced mid-turn: one panel, a line each).
+_SNAPSHOT_LEAST = 0.6
 
 _OK, _BAD = "#1a7f37", "#b42318"
 #: Characters per line of the verdict in the header (bold, 9 pt: the page's width).
@@ -126,7 +129,7 @@ def phase_rows(plan) -> list:
             pose = ph.poses(plan.task.hand.rest_height)[0]
             off = {s for k in range(ph.t.size) for s, on in fingers_touching(hand, pose, ph.q[k]).items() if not on}
             who = "both fingers" if len(off) == 2 else f"the {next(iter(off))} finger" if off else "the fingers"
-            rows.append((str(i), times, f"regrasp: {who}\nopen and close again", "velocity only", "-", "-", "-"))
+            rows.append((str(i), times, ph.does(who), "velocity only", "-", "-", "-"))
             continue
         word, unit = effort_words(hand, ph.effort_joint)
         mode, _ = phase_label(ph, hand)
@@ -481,6 +484,10 @@ def _card(plan, stated, snapshots) -> tuple:
               for segs in groups]  # fmt: skip
     entries = len(_legend_handles(plan, _ALL_MARKS, torque_joints))  # at most: what is drawn is known later
     grid_in = A4_PORTRAIT[1] - head_in - _BODY_MARGIN - _LEGEND_LINE * -(-entries // 2)
+    room = grid_in - _TIMELINE_HEIGHT - _SNAPSHOT_LEAST - len(panels) * _TORQUE_MIN
+    if len(velocity_panels) > 2 and len(velocity_panels) * _VELOCITY_MIN > room:  # no room: one panel per unit
+        velocity_panels = [[j for j in velocity_joints if units[j] == u]
+                           for u in dict.fromkeys(units[j] for j in velocity_joints)]  # fmt: skip
     rows, snap_h, torque_h, velocity_h = _layout(plan, shots, len(panels), len(velocity_panels), grid_in)
     heights = [snap_h, _TIMELINE_HEIGHT] + [torque_h] * len(panels) + [velocity_h] * len(velocity_panels)
     grid = body.add_gridspec(len(heights), 1, height_ratios=heights)

@@ -298,8 +298,8 @@ class Snapshot:
 
     @property
     def touching(self) -> bool:
-        """Every finger on the workpiece (its contacts can be drawn)."""
-        return not self.off
+        """A finger on the workpiece (its contacts can be drawn): every finger, or one while the other is replaced."""
+        return len(self.off) < 2
 
 
 def phase_pose(plan, phase, k) -> np.ndarray:

@@ -293,6 +293,11 @@ def animation_frames(plan, max_frames: int) -> list:
             nxt = not [s for s, on in fingers_touching(hand, pose, ph.q[k + 1]).items() if not on]
             state = ("closing" if nxt else "open") if off else "holding"
         contacts = []
+        if state in ("open", "closing") and any(fingers_touching(hand, pose, q).values()):  # one finger replaced
+            try:
+                contacts = sliding_directions(hand, pose, q, pose, q)
+            except SceneError:
+                contacts = []
         if state in ("sliding", "holding", "pivoting"):
             j = min(k + 1, ph.t.size - 1)
             moving = is_contact(ph) and j != k

@@ -91,7 +91,7 @@ def phase_label(phase, hand=None) -> tuple:
     from qsplan.mechanics.modes.contact_mode import ContactMode
 
     if not is_contact(phase):
-        return "regrasp", "fingers velocity"
+        return phase.label()
     try:
         kind = ContactMode(phase.mode).kind
     except (ValueError, TypeError):

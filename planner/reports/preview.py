@@ -240,7 +240,8 @@ def preview_task(task, progress=None) -> Preview:
     inner = _preview(sub, progress, t0, goal_name="slide's end", goal_free=flush_free_joints(task.hand, best.start))
     goal = ConfigurationCheck("goal", inner.goal.x, None, None, None, 0, 0,
                               note=f"{what}: the formations searched: {lines}")  # fmt: skip
-    verdict = (f"goal: {what}: {best.outcome.words} reaches it, narrowest pivot band "
+    how = f" ({best.outcome.why})" if best.later else ""  # a finger replaced mid-turn: said where
+    verdict = (f"goal: {what}: {best.outcome.words} reaches it{how}, narrowest pivot band "
                f"{torque_words(best.outcome.band)}; its first step, {step}: {inner.verdict} (the holds are proved "
                "when planned)")  # fmt: skip
     return replace(inner, task=task.name, goal=goal, ok=inner.ok, verdict=verdict, slide_end=inner.goal,

@@ -51,21 +51,21 @@ def _reverse(cols):  # the velocity-controlled finger driven backwards on rows 3
 
 def _jobs(task, cols, rows, n_random, seed=0):
     """Each row's ModeJob as certify_plan builds it (moving rows; the rows' own x speed, as the motion check uses)."""
-    from qsplan.planner.certify.certify import _xdot_rows
+    from qsplan.planner.certify.certify import _v_rows
 
     rng = np.random.default_rng(seed)
     jobs = []
     for k in rows:
         scene = row_scene(task, cols, k, judged_contacts(task, cols, k))
         mus = friction_points(task, n_random, rng, scene.n_contacts)
-        jobs.append(ModeJob(k, scene, mus, _xdot_rows(cols, k, ["left", "right"])))
+        jobs.append(ModeJob(k, scene, mus, _v_rows(cols, k, ["left", "right"])))
     return jobs
 
 
 def _reference(task, cols, jobs, margin):
     out = {}
     for job in jobs:
-        found, excluded = mode_checks(task, cols, job.row, job.mus, margin, job.xdot_rows, True, job.scene)
+        found, excluded = mode_checks(task, cols, job.row, job.mus, margin, job.v_rows, True, job.scene)
         if task.disturbance is not None:
             found += disturbance_checks(task, cols, job.row, job.mus, margin, True, job.scene)
         out[job.row] = (found, excluded)

@@ -206,7 +206,8 @@ def test_informational_labels_follow_the_schema():
 
 
 def test_the_shipped_schema_labels_only_bookkeeping():
-    """The plan schema's informational labels: names, labels, the run's bookkeeping and the search's figures."""
+    """The plan schema's informational labels: names, labels, the run's bookkeeping, the search's figures and a finger
+    replacement's formation (the next phases name it) and proof margin (the row checks prove the hold again)."""
     from qsplan.planner.export.schema import schedule_schema
 
     labelled = []
@@ -224,7 +225,7 @@ def test_the_shipped_schema_labels_only_bookkeeping():
     walk(schedule_schema(), "$")
     assert sorted(labelled) == sorted(["description_source", "task", "source", "planner", "name", "ompl_states",
                                        "binding", "grasp", "grasp_from", "grasp_to", "from", "to", "search",
-                                       "name", "phase"]), labelled  # fmt: skip
+                                       "name", "phase", "formation", "hold_margin_N"]), labelled  # fmt: skip
 
 
 # --- the issue's escapes, through the command line ----------------------------------------------------------------

@@ -80,7 +80,8 @@ def test_snapshot_labels_match_the_rows(name):
             pose, q = row_config(plan, s.phase, s.row)
             assert s.t == ph.t[s.row] and np.array_equal(s.pose, pose) and np.array_equal(s.q, q)
             assert s.state in STATES
-            touching = every_finger_touches(plan, pose, q)
+            # contacts drawn: every finger on the workpiece, or the one holding it while the other is replaced
+            touching = every_finger_touches(plan, pose, q) or ph.kind == "replace"
             assert s.touching == touching, (name, s.t)
             if isinstance(ph, ContactSegmentPlan) and ph.kind == "hold":  # nothing moves, the torque ramps
                 assert s.state == "holding" and np.ptp(ph.x) == 0 and s.effort == ph.command[s.row]
@@ -88,7 +89,7 @@ def test_snapshot_labels_match_the_rows(name):
                 assert s.state == "pivoting" and np.ptp(ph.pose[:, 2]) > 0 and s.effort == ph.command[s.row]
             elif isinstance(ph, ContactSegmentPlan):
                 assert s.state == "sliding" and np.ptp(ph.x) > 0 and s.effort == ph.command[s.row]
-            elif touching:
+            elif every_finger_touches(plan, pose, q):
                 assert s.state == "holding" and s.row in (0, ph.t.size - 1)  # released from, or closed onto, a grasp
             else:  # off the workpiece: closing when the next row touches again after an off row, else open
                 closing = every_finger_touches(plan, *row_config(plan, s.phase, s.row + 1)) and not every_finger_touches(
