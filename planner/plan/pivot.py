@@ -84,9 +84,9 @@ class PivotGeometry:
     cuts: tuple
 
 
-def pivot_thetas(theta0: float, theta1: float) -> np.ndarray:
-    """Rows' angles (rad) from ``theta0`` to ``theta1``, both included, at most :data:`PIVOT_STEP` apart."""
-    n = int(np.ceil(abs(theta1 - theta0) / PIVOT_STEP)) + 1
+def pivot_thetas(theta0: float, theta1: float, step: float = PIVOT_STEP) -> np.ndarray:
+    """Rows' angles (rad) from ``theta0`` to ``theta1``, both included, at most ``step`` apart."""
+    n = int(np.ceil(abs(theta1 - theta0) / step)) + 1
     return np.linspace(theta0, theta1, max(n, 2))
 
 
@@ -96,10 +96,11 @@ def _expected_contacts(i: int, flush: bool) -> int:
     return 5 if i == 0 and flush else 4
 
 
-def pivot_geometry(task, pivot, start, theta_goal: float) -> PivotGeometry:
+def pivot_geometry(task, pivot, start, theta_goal: float, step: float = PIVOT_STEP) -> PivotGeometry:
     """``pivot`` swept from configuration ``start`` (its flush instant, or a configuration on it mid-turn: a finger
     replaced there, :mod:`qsplan.planner.plan.replace`) to ``theta_goal`` (rad), its first event and the slip
-    reversals before it (module docstring)."""
+    reversals before it (module docstring); ``step``: the rows' spacing (rad; a coarser one screens a formation
+    cheaply: an event it finds is one, while one it misses between its rows the fine sweep finds)."""
     from qsplan.hands.contacts.found import made_contacts, ordered_contacts
     from qsplan.hands.formations.manifold import along_edges
     from qsplan.hands.formations.pivots import pivot_path
@@ -108,7 +109,7 @@ def pivot_geometry(task, pivot, start, theta_goal: float) -> PivotGeometry:
 
     hand = task.hand
     flush = float(start[2]) == 0.0  # the flush instant (theta 0 exactly); mid-turn otherwise
-    path = pivot_path(hand, pivot, start, pivot_thetas(float(start[2]), theta_goal))
+    path = pivot_path(hand, pivot, start, pivot_thetas(float(start[2]), theta_goal, step))
     cons = pivot.constraints(hand)
     n, end, contacts = path.theta.size, None, []
     for i in range(n):

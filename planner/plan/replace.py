@@ -30,16 +30,17 @@ import numpy as np
 
 from qsplan.planner.plan.results import PlanFailure, ReplacePhase
 
-__all__ = ["CLOSING_GUESSES", "FREE_GRID", "lifted_hold", "opening_direction", "reclosed", "reclosings", "replace_phase"]
+__all__ = ["CLOSING_GRID", "FREE_GRID", "lifted_hold", "opening_direction", "reclosed", "reclosings", "replace_phase"]
 
 #: Values of a chain finger's free joints tried for the new grasp, evenly over each joint's limits (the ends left out:
 #: a joint held at its limit has no room).  24 steps of a 3 rad range are 7 deg apart: a held knuckle moves its pad by
 #: 7 mm per step at 6 cm; finer grids found nothing more on the bundled hands.
 FREE_GRID = 24
 
-#: Starting values of the closing joint for Newton's method (fractions of its range): a finger can close on a feature
-#: from either side, and Newton's method finds the root nearest its start.
-CLOSING_GUESSES = np.linspace(0.05, 0.95, 10)
+#: Values of the closing joint over its limits at which the new feature's gap is evaluated: Newton's method starts in
+#: each interval where the gap changes sign (a finger can close on a feature from either side).  48 steps of a 5 rad
+#: range are 6 deg: two roots closer than that are a feature grazed, not closed on.
+CLOSING_GRID = 48
 
 
 def lifted_hold(task, pose, q, finger: str):
@@ -139,7 +140,7 @@ def reclosings(task, pivot, pose, q) -> list:
     from itertools import product
 
     from qsplan.hands.contacts.found import ordered_contacts
-    from qsplan.hands.formations.manifold import along_edges, project
+    from qsplan.hands.formations.manifold import along_edges, gaps, project
     from qsplan.hands.formations.pivots import FINGER_FEATURES, Pivot
     from qsplan.mechanics.errors import SceneError
     from qsplan.planner.states.contact import configuration_problem
@@ -152,7 +153,8 @@ def reclosings(task, pivot, pose, q) -> list:
     lim = np.asarray(task.joint_limits, dtype=float)
     grids = [np.linspace(lim[j, 0], lim[j, 1], FREE_GRID + 2)[1:-1] for j in free]
     base = np.concatenate([np.asarray(pose, dtype=float), np.asarray(q, dtype=float)])
-    out, seen = [], []
+    closings = np.linspace(lim[closing, 0], lim[closing, 1], CLOSING_GRID + 1)
+    out, seen = [], {tuple(np.round(base, 9))}  # the grasp it has, and each new one once
     for kind, candidates in FINGER_FEATURES.items():
         for feature in candidates(hand, finger):
             other = Pivot(pivot.vertex, pivot.flush, pivot.edge, feature)
@@ -161,14 +163,17 @@ def reclosings(task, pivot, pose, q) -> list:
                 c0 = base.copy()
                 for j, v in zip(free, values):
                     c0[3 + j] = v
-                for g in CLOSING_GUESSES:
-                    c0[3 + closing] = lim[closing, 0] + g * (lim[closing, 1] - lim[closing, 0])
+                g = []
+                for v in closings:  # the feature's gap along the closing joint: a root in each change of sign
+                    c0[3 + closing] = v
+                    g.append(gaps(hand, cons[3:], c0)[0])
+                g = np.asarray(g)
+                for k in np.flatnonzero(np.isfinite(g[:-1]) & np.isfinite(g[1:]) & (np.sign(g[:-1]) != np.sign(g[1:]))):
+                    c0[3 + closing] = 0.5 * (closings[k] + closings[k + 1])
                     c = project(hand, cons, c0, [3 + closing])
-                    if c is None or any(np.allclose(c, s, atol=1e-9) for s in seen):
+                    if c is None or tuple(np.round(c, 9)) in seen:
                         continue
-                    seen.append(c)
-                    if np.allclose(c, base, atol=1e-9):  # the grasp it has
-                        continue
+                    seen.add(tuple(np.round(c, 9)))
                     along = along_edges(hand, cons, c)
                     if not 0.0 <= along[3] <= 1.0 or configuration_problem(task, c[:3], c[3:]):
                         continue

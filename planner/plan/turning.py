@@ -27,7 +27,7 @@ import numpy as np
 from qsplan.planner.plan.results import Plan, PlanFailure
 from qsplan.planner.task.goal import Goal, GoalNotServedError
 
-__all__ = ["FLUSH_APPROACH", "FormationOutcome", "Leg", "REPLACE_ANGLES", "REPLACE_EVERY", "SEARCHED_FORMATIONS", "Surveyed", "TurnReport", "flush_free_joints",
+__all__ = ["FLUSH_APPROACH", "FormationOutcome", "Leg", "REPLACE_ANGLES", "REPLACE_EVERY", "SCREEN_STEP", "SEARCHED_FORMATIONS", "Surveyed", "TurnReport", "flush_free_joints",
            "goal_angle", "pivot_pieces", "plan_turn", "slide_task", "survey"]
 
 #: How far (m) short of the flush instant the slide's band tables end: five times the contact tolerance (1 um), so
@@ -38,6 +38,10 @@ FLUSH_APPROACH = 5e-6
 #: Rows of a pivot (0.25 deg apart) between the angles where its other finger may be replaced (one degree): the hold
 #: with the finger lifted is proved only in windows of a few degrees (docs/reorientation.md), finer gains nothing.
 REPLACE_EVERY = 4
+
+#: Rows' spacing (rad) of the coarse sweep that screens a new grasp's formation before its own (2 deg: eight times
+#: cheaper; an event it finds is one, and what it misses between its rows the fine sweep finds).
+SCREEN_STEP = np.radians(2.0)
 
 #: Angles with a proved lifted hold tried for a replacement, widest margin first: each costs the new grasps' geometry.
 REPLACE_ANGLES = 6
@@ -426,7 +430,7 @@ def _with_replacement(task, pivot, start, theta_goal, geometry, stop: int, ended
         progress(f"  the {finger} finger lifted at theta = {np.degrees(theta_k):.2f} deg: the hold is proved")
         pieces1 = None
         for other, c in reclosings(task, pivot, pose, q):
-            if pivot_geometry(task, other, c, theta_goal).end is not None:
+            if pivot_geometry(task, other, c, theta_goal, SCREEN_STEP).end is not None:  # screened coarsely first
                 continue
             try:
                 if pieces1 is None:  # this formation's pieces to theta_k: their last row is where the finger lifts
