@@ -27,8 +27,9 @@ import numpy as np
 from qsplan.planner.plan.results import Plan, PlanFailure
 from qsplan.planner.task.goal import Goal, GoalNotServedError
 
-__all__ = ["FLUSH_APPROACH", "FormationOutcome", "Leg", "REPLACE_ANGLES", "REPLACE_EVERY", "SCREEN_STEP", "SEARCHED_FORMATIONS", "Surveyed", "TurnReport", "flush_free_joints",
-           "goal_angle", "pivot_pieces", "plan_turn", "slide_task", "survey"]
+__all__ = ["FLUSH_APPROACH", "FormationOutcome", "Leg", "REPLACE_ANGLES", "REPLACE_EVERY", "SCREEN_STEP",
+           "SEARCHED_FORMATIONS", "Surveyed", "TurnReport", "flush_free_joints", "goal_angle", "pivot_pieces", "plan_turn",
+           "slide_task", "survey"]
 
 #: How far (m) short of the flush instant the slide's band tables end: five times the contact tolerance (1 um), so
 #: the polygons show the four contacts of the palm edge there; the slide then reaches the flush instant itself in
@@ -219,8 +220,9 @@ def pivot_pieces(task, pivot, start, theta_goal, geometry, progress):
     pieces = []
     for j, (a, b) in enumerate(zip(ends[:-1], ends[1:])):
         path = pivot_path(hand, pivot, c, pivot_thetas(a, b))
-        name = (f"pivot on vertex {int(hand.user_vertices[pivot.vertex])} from theta = {a:.4g} to {b:.4g} rad"
-                if len(ends) > 2 or not flush else f"pivot on vertex {int(hand.user_vertices[pivot.vertex])} to theta = {b:.4g} rad")
+        vertex = int(hand.user_vertices[pivot.vertex])
+        name = (f"pivot on vertex {vertex} from theta = {a:.4g} to {b:.4g} rad" if len(ends) > 2 or not flush
+                else f"pivot on vertex {vertex} to theta = {b:.4g} rad")
         pieces.append(widest_piece(task, name, pivot, path, np.arange(path.theta.size), flush and j == 0, progress))
         c = np.concatenate([path.pose[-1], path.q[-1]])
     return pieces
@@ -387,8 +389,8 @@ def survey(task, progress=None) -> tuple:
             e = geometry.end
             i = max(e.row - 1, 0)
             o = _outcome(pivot, hand, "ended", e.theta, e.words, geometry.path.pose[i], geometry.path.q[i])
-            found = _with_replacement(task, pivot, start, theta_goal, geometry, e.row, o, progress)
-            out.append(found or Surveyed(pivot, start, theta_goal, o, None))
+            found, why = _with_replacement(task, pivot, start, theta_goal, geometry, e.row, o, progress)
+            out.append(found or Surveyed(pivot, start, theta_goal, replace(o, why=f"{o.why}; {why}"), None))
             progress(f"  {o.line()}")
             continue
         try:
@@ -397,8 +399,8 @@ def survey(task, progress=None) -> tuple:
             r = exc.report
             o = _outcome(pivot, hand, "no band", r.pose[2], r.reason, r.pose, r.q)
             row = int(np.argmin(np.abs(geometry.path.theta - r.pose[2])))
-            found = _with_replacement(task, pivot, start, theta_goal, geometry, row, o, progress)
-            out.append(found or Surveyed(pivot, start, theta_goal, o, None, exc))
+            found, why = _with_replacement(task, pivot, start, theta_goal, geometry, row, o, progress)
+            out.append(found or Surveyed(pivot, start, theta_goal, replace(o, why=f"{o.why}; {why}"), None, exc))
             progress(f"  {o.line()}")
             continue
         band = min(float(np.min(p.width)) for p in pieces)
@@ -409,12 +411,13 @@ def survey(task, progress=None) -> tuple:
     return tuple(out)
 
 
-def _with_replacement(task, pivot, start, theta_goal, geometry, stop: int, ended, progress) -> Surveyed | None:
-    """``pivot``'s route with its other finger replaced (:mod:`qsplan.planner.plan.replace`) at one of its rows before
-    ``stop`` (where it ends or loses its band), or None.  Of the rows every :data:`REPLACE_EVERY` where the hold with
-    the finger lifted is proved, the one with the widest margin (the proof's certified rest margin: the least normal
-    force and cone slack) first, at most :data:`REPLACE_ANGLES` of them: the first where a new grasp's formation
-    reaches the goal with a band in every piece, and this formation's pieces reach that row with bands.  ``ended``: this formation's own outcome, said in the new one's."""
+def _with_replacement(task, pivot, start, theta_goal, geometry, stop: int, ended, progress) -> tuple:
+    """``(Surveyed or None, why not)``: ``pivot``'s route with its other finger replaced (:mod:`qsplan.planner.plan.
+    replace`) at one of its rows before ``stop`` (where it ends or loses its band).  Of the rows every
+    :data:`REPLACE_EVERY` where the hold with the finger lifted is proved, the one with the widest margin (the proof's
+    certified rest margin: the least normal force and cone slack) first, at most :data:`REPLACE_ANGLES` of them: the
+    first where a new grasp's formation reaches the goal with a band in every piece, and this formation's pieces reach
+    that row with bands.  ``ended``: this formation's own outcome, said in the new one's."""
     from qsplan.planner.plan.pivot import PivotGeometry, pivot_geometry
     from qsplan.planner.plan.replace import lifted_hold, reclosed, reclosings
 
@@ -451,8 +454,13 @@ def _with_replacement(task, pivot, start, theta_goal, geometry, stop: int, ended
                          f"finger replaced there, then {other.words(hand)}: {len(pieces2)} piece(s)",
                          band=band)  # fmt: skip
             return Surveyed(pivot, start, theta_goal, o, tuple(pieces1), None,
-                            (Leg(other, c, tuple(pieces2), finger),))  # fmt: skip
-    return None
+                            (Leg(other, c, tuple(pieces2), finger),)), ""  # fmt: skip
+    lo, hi = task.mu_range
+    if not proved:
+        return None, (f"the {finger} finger is replaced nowhere: the hold with it lifted is proved at no angle of this "
+                      f"formation for friction in [{lo:g}, {hi:g}]")
+    return None, (f"the {finger} finger is replaced nowhere: the hold with it lifted is proved at {len(proved)} "
+                  f"angle(s), and no new grasp there reaches the goal with a band")
 
 
 def _band_words(width: float) -> str:
