@@ -147,3 +147,21 @@ def test_a_box_with_zero_friction_refuses_the_replacement(replaced, tmp_path):
     assert rest == set(rows.tolist())
     assert all("while the right finger moves, and that hold is not proved" in v["message"]
                for v in doc["violations"] if v["kind"] == "rest")
+
+
+def test_a_turn_past_its_formation_says_why_no_finger_was_replaced(tmp_path):
+    """The demo's turn asked to -1.2 rad (its formation ends at -55 deg, the right finger meeting the workpiece) with
+    friction in [0, 0.2]: zero friction is in the box, so the hold with the right finger lifted is proved at no angle,
+    and the refusal says so beside the formation's own end."""
+    from qsplan.planner.plan.results import PlanFailure
+    from qsplan.planner.plan.turning import plan_turn
+    from qsplan.planner.task.task import load_task
+
+    path = tmp_path / "far.toml"
+    path.write_text(task_paths()["reorient_task"].read_text().replace("\ntheta = -0.5 ", "\ntheta = -1.2 ", 1))
+    with pytest.raises(PlanFailure) as exc:
+        plan_turn(load_task(path))
+    message = str(exc.value)
+    assert "ended at theta = -55.05 deg" in message
+    assert "the right finger is replaced nowhere: the hold with it lifted is proved at no angle of this formation for " \
+           "friction in [0, 0.2]" in message
