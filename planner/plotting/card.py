@@ -86,13 +86,12 @@ _LEGEND_LINE, _BODY_MARGIN = 0.16, 0.6
 #: Height (in) of a row of small snapshots, counted when deciding whether more than two velocity panels fit (a chain
 #: hand whose four joints each move at some time, as when a finger is replaced mid-turn: one panel, a line each).
 _SNAPSHOT_LEAST = 0.6
-#: A torque panel's least height (in) on a card far too full for its usual least: its ticks and band still read.
-_TORQUE_TIGHT = 1.0
-#: How far the snapshots and panels at their usual least may overfill the page before the card draws one row of
-#: snapshots and its torque panels at :data:`_TORQUE_TIGHT`: the layout otherwise squeezes every height alike and the
-#: snapshots, whose titles keep their size, shrink to icons (``scripted_regrasp_task`` 1.41 times, ``pentagon_task``
-#: 1.21, ``finger_replaced_task`` 1.38; ``two_link_regrasp_task``, 1.14, is left as it was).
-_OVERFULL = 1.15
+#: A torque panel drawn lower than this (in, after the layout squeezes an overfull page alike) is short
+#: (:func:`_torque_panel`): ``finger_replaced_task``'s nine phases leave its three panels 1.16 in, where the narrowest
+#: marks of a hold and a pivot sharing a panel met, and a log scale's ticks at 1, 2 and 5 per decade did.
+_SHORT_TORQUE = 1.3
+#: Most ticks of a short panel's log scale (:func:`qsplan.planner.plotting.plan_panels.log_ticks`): its powers of ten.
+_SHORT_LOG_TICKS = 5
 
 _OK, _BAD = "#1a7f37", "#b42318"
 #: Characters per line of the verdict in the header (bold, 9 pt: the page's width).
@@ -307,7 +306,7 @@ def _offset(sub, points, x_points=0.0):
     return offset_copy(sub.transSubfigure, fig=sub.get_figure(root=True), x=x_points, y=points, units="points")
 
 
-def _layout(plan, shots, n_torque, n_velocity, grid_in, torque_min=_TORQUE_MIN) -> tuple:
+def _layout(plan, shots, n_torque, n_velocity, grid_in) -> tuple:
     """``(snapshot rows, snapshot block height, torque panel height, velocity panel height)`` (inches of the body's
     grid, ``grid_in`` high; its ratios).
 
@@ -322,12 +321,12 @@ def _layout(plan, shots, n_torque, n_velocity, grid_in, torque_min=_TORQUE_MIN) 
     rows = 1 if _SNAPSHOT_ROW_WIDTH / len(shots) - 0.2 >= MIN_SNAPSHOT_WIDTH else 2
     cols = -(-len(shots) // rows)
     width = min(_SNAPSHOT_ROW_WIDTH / cols - 0.2, _SNAPSHOT_MAX_WIDTH)
-    least = n_torque * torque_min + n_velocity * _VELOCITY_MIN
+    least = n_torque * _TORQUE_MIN + n_velocity * _VELOCITY_MIN
     room = grid_in - _TIMELINE_HEIGHT - least  # for the snapshots, the panels at their least
     snap = min(rows * (width * aspect + _SNAPSHOT_TITLE), max(room, rows * (0.6 * width * aspect + _SNAPSHOT_TITLE)))
     want = n_torque * _TORQUE_HEIGHT + n_velocity * _VELOCITY_HEIGHT
     k = (grid_in - _TIMELINE_HEIGHT - snap) / want if want else 1.0
-    return rows, snap, max(_TORQUE_HEIGHT * k, torque_min), max(_VELOCITY_HEIGHT * k, _VELOCITY_MIN)
+    return rows, snap, max(_TORQUE_HEIGHT * k, _TORQUE_MIN), max(_VELOCITY_HEIGHT * k, _VELOCITY_MIN)
 
 
 def _snapshot_row(sub, plan, shots, letters, rows) -> set:
@@ -366,19 +365,22 @@ def _phases_text(numbers) -> str:
     return f"phases {numbers[0]}-{numbers[-1]}" if run else "phases " + ", ".join(str(n) for n in numbers)
 
 
-def _torque_panel(ax, plan, joint, segs, res, parts: int) -> set:
+def _torque_panel(ax, plan, joint, segs, res, parts: int, short: bool = False) -> set:
     """One joint's commands inside their bands on one scale (``segs``, one of :func:`scale_groups`' runs; ``parts``
-    runs in all), slack and narrowest marked; what was drawn."""
+    runs in all), slack and narrowest marked; what was drawn.  ``short``: the panel is squeezed (a page of many phases
+    and panels): the narrowest band marked once, at the panel's narrowest, and a log scale ticked at its powers of ten
+    only, so that labels stay apart."""
     hand = plan.task.hand
     ylim, log = torque_scale(segs, res)
     word, unit = effort_words(hand, joint)
     drawn = set()
     if log:
         ax.set_yscale("log")
+    narrowest = min(segs, key=lambda seg: float(np.min(seg.width)))
     for seg in segs:
         drawn |= draw_band(ax, seg.t, seg.lower, seg.upper, seg.command, joint_colour(hand, joint), ylim, label=False)
         k = int(np.argmin(seg.width))
-        if mark_narrowest(ax, seg, ylim, label=False, unit=unit):
+        if (seg is narrowest or not short) and mark_narrowest(ax, seg, ylim, label=False, unit=unit):
             drawn.add("narrowest")
         if mark_slack(ax, seg, ylim, unit=unit, avoid=float(seg.t[k])):
             drawn.add("slack")
@@ -391,7 +393,7 @@ def _torque_panel(ax, plan, joint, segs, res, parts: int) -> set:
                 _note(ax, float(ph.t[0]), float(ph.t[-1]), t0, t1, "in its own panel (another scale)")
     ax.set_ylim(*ylim)
     if log:
-        log_ticks(ax.yaxis, *ylim)
+        log_ticks(ax.yaxis, *ylim, most=_SHORT_LOG_TICKS if short else 10)
     else:
         ax.axhline(0.0, color="0.6", lw=0.5)
     symbol = "\\tau" if word == "torque" else "f"
@@ -497,13 +499,7 @@ def _card(plan, stated, snapshots) -> tuple:
                            for u in dict.fromkeys(units[j] for j in velocity_joints)]  # fmt: skip
     rows, snap_h, torque_h, velocity_h = _layout(plan, shots, len(panels), len(velocity_panels), grid_in)
     heights = [snap_h, _TIMELINE_HEIGHT] + [torque_h] * len(panels) + [velocity_h] * len(velocity_panels)
-    if rows == 2 and sum(heights) > _OVERFULL * grid_in:  # far too full (many phases and panels): one row of
-        # snapshots, the torque panels down to their tight least, rather than everything squeezed alike
-        shots = card_snapshots(plan, int(_SNAPSHOT_ROW_WIDTH // (MIN_SNAPSHOT_WIDTH + 0.2)))
-        letters = _letters(len(shots))
-        rows, snap_h, torque_h, velocity_h = _layout(plan, shots, len(panels), len(velocity_panels), grid_in,
-                                                     _TORQUE_TIGHT)  # fmt: skip
-        heights = [snap_h, _TIMELINE_HEIGHT] + [torque_h] * len(panels) + [velocity_h] * len(velocity_panels)
+    short = torque_h * min(1.0, grid_in / sum(heights)) < _SHORT_TORQUE  # the layout squeezes every height alike
     grid = body.add_gridspec(len(heights), 1, height_ratios=heights)
     drawn = _snapshot_row(body.add_subfigure(grid[0]), plan, shots, letters, rows)
     timeline = body.add_subplot(grid[1])
@@ -512,7 +508,7 @@ def _card(plan, stated, snapshots) -> tuple:
     axes = [timeline]
     for i, (joint, segs, parts) in enumerate(panels):
         ax = body.add_subplot(grid[2 + i], sharex=timeline)
-        drawn |= _torque_panel(ax, plan, joint, segs, res, parts)
+        drawn |= _torque_panel(ax, plan, joint, segs, res, parts, short)
         axes.append(ax)
     ticks = plan.sample(tick_times(plan.duration, min(VELOCITY_RATE, VELOCITY_TICKS / plan.duration)))
     for group in velocity_panels:
