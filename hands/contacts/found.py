@@ -28,8 +28,8 @@ import numpy as np
 from qsplan.mechanics.errors import QsplanError
 from qsplan.mechanics.model.geometry import CONTACT_TOL
 
-__all__ = ["TrackedContacts", "contact_names", "drawable_contacts", "polygon_contacts", "track_contacts", "hold_scene", "made_contacts", "ordered_contacts", "row_contact_scene",
-           "slot_of"]
+__all__ = ["TrackedContacts", "contact_names", "drawable_contacts", "polygon_contacts", "track_contacts", "hold_scene",
+           "lifted_contacts", "lifted_scene", "made_contacts", "ordered_contacts", "row_contact_scene", "slot_of"]
 
 
 def polygon_contacts(hand, pose, q, tol: float = CONTACT_TOL) -> list:
@@ -177,10 +177,23 @@ def lifted_scene(hand, pose, q, finger: str):
     SceneError
         As :func:`ordered_contacts`; QsplanError when only ``finger`` touches the workpiece.
     """
-    found = ordered_contacts(hand, pose, q)
-    drop = np.array([n.split(":")[0] == finger for n in contact_names(hand, pose, found)], dtype=bool)
+    found, _, lifted = lifted_contacts(hand, pose, q, finger)
     n_j = len(hand.joint_names)
-    return row_contact_scene(hand, pose, q, np.zeros(n_j, dtype=bool), np.zeros(n_j), drop=drop, found=found)
+    return row_contact_scene(hand, pose, q, np.zeros(n_j, dtype=bool), np.zeros(n_j), drop=lifted, found=found)
+
+
+def lifted_contacts(hand, pose, q, finger: str) -> tuple:
+    """``(found, names, lifted)``: every contact the polygons show at ``pose``, ``q`` (:func:`ordered_contacts`), their
+    names (:func:`contact_names`) and which are ``finger``'s (bool, shape (n_found,)): what lifting it leaves.
+
+    Raises
+    ------
+    SceneError
+        As :func:`ordered_contacts`.
+    """
+    found = ordered_contacts(hand, pose, q)
+    names = contact_names(hand, pose, found)
+    return found, names, np.array([n.split(":")[0] == finger for n in names], dtype=bool)
 
 
 def drawable_contacts(hand, pose, q) -> list:

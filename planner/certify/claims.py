@@ -159,19 +159,19 @@ def _replacement(task, cols, rows) -> dict:
     """A run of free rows where one finger's joints move and the other's do not (a finger replaced mid-turn): its
     ``phase_kind``, ``finger``, the workpiece's ``y_workpiece_m`` and ``theta_workpiece_rad`` and the ``contacts_kept``
     the polygons show at its first row without the moving finger's; ``{}`` for a regrasp (both fingers move)."""
-    from qsplan.hands.contacts.found import contact_names, ordered_contacts
+    from qsplan.hands.contacts.found import lifted_contacts
     from qsplan.mechanics.errors import SceneError
 
-    from qsplan.planner.certify.rows import row_pose, row_q
+    from qsplan.planner.certify.rows import moving_fingers, row_pose, row_q
 
-    hand = task.hand
-    q = np.array([row_q(cols, k, hand.joint_names) for k in rows])
-    moving = [f for f, joints in zip(("left", "right"), hand.finger_joints) if np.any(np.ptp(q[:, list(joints)], axis=0) > 0)]
+    moving = moving_fingers(task, cols, rows)
     if len(moving) != 1:
         return {}
-    pose = row_pose(cols, int(rows[0]))
+    k = int(rows[0])
+    pose = row_pose(cols, k)
     try:
-        kept = [n for n in contact_names(hand, pose, ordered_contacts(hand, pose, q[0])) if n.split(":")[0] != moving[0]]
+        _, names, lifted = lifted_contacts(task.hand, pose, row_q(cols, k, task.hand.joint_names), moving[0])
+        kept = [n for n, off in zip(names, lifted) if not off]
     except SceneError:
         kept = None  # the row checks name the overlap
     return {"phase_kind": "replace", "finger": moving[0], "y_workpiece_m": float(pose[1]),

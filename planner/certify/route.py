@@ -188,10 +188,11 @@ def rest_checks(task, cols, k, bodies, proved=None) -> list:
     it does not (a finger replaced mid-turn, :mod:`qsplan.planner.plan.replace`), held by what one finger that does
     not move in the phase and the palm touch while the other finger's joints move, that hold proved over the task's
     friction box and disturbance box (:func:`qsplan.planner.plan.replace.lifted_hold`, the planner's rule).
-    ``proved``: a dict the proofs are kept in, one per run of free rows (its first row's index)."""
+    ``proved``: a dict the moving fingers and the proof are kept in, one per run of free rows (its first row's index).
+    """
     from shapely.geometry import Point
 
-    from qsplan.planner.certify.rows import CONTACT_GAP_TOL, JUMP_TOL, row_pose, row_q
+    from qsplan.planner.certify.rows import CONTACT_GAP_TOL, JUMP_TOL, moving_fingers, row_pose, row_q
 
     out = []
     if k > 0:
@@ -203,23 +204,22 @@ def rest_checks(task, cols, k, bodies, proved=None) -> list:
     gaps = [Point(W[i]).distance(bodies["polys"]["palm"]) for i in (0, 1)]
     if max(gaps) <= CONTACT_GAP_TOL:
         return out
-    rows = _free_run(cols, k)
-    q = np.array([row_q(cols, i, task.hand.joint_names) for i in rows])
-    hand = task.hand
-    moving = [f for f, joints in zip(("left", "right"), hand.finger_joints) if np.any(np.ptp(q[:, list(joints)], axis=0) > 0)]
+    first = int(_free_run(cols, k)[0])
+    proved = {} if proved is None else proved
+    if first not in proved:  # once per run of free rows: the fingers that move, and the hold without the moving one
+        from qsplan.planner.plan.replace import lifted_hold
+
+        moving = moving_fingers(task, cols, _free_run(cols, k))
+        proof = None if len(moving) != 1 else lifted_hold(task, row_pose(cols, first),
+                                                          row_q(cols, first, task.hand.joint_names), moving[0])
+        proved[first] = moving, proof
+    moving, proof = proved[first]
     if len(moving) != 1:
         out.append(("rest", f"the workpiece does not rest on the palm on its bottom edge on a free row (its ends "
                             f"{gaps[0] * 1e3:.4g} mm and {gaps[1] * 1e3:.4g} mm above it), and "
                             f"{'both fingers move' if moving else 'no finger moves'} in this run of free rows: only "
                             f"a finger replaced while the other holds it is certified"))  # fmt: skip
-        return out
-    proved = {} if proved is None else proved
-    if int(rows[0]) not in proved:
-        from qsplan.planner.plan.replace import lifted_hold
-
-        proved[int(rows[0])] = lifted_hold(task, row_pose(cols, int(rows[0])), q[0], moving[0])
-    proof = proved[int(rows[0])]
-    if not proof.proved:
+    elif not proof.proved:
         out.append(("rest", f"the workpiece rests on the palm and the {'right' if moving[0] == 'left' else 'left'} "
                             f"finger while the {moving[0]} finger moves, and that hold is not proved over the "
                             f"friction box: {proof.reason}"))  # fmt: skip

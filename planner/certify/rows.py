@@ -24,6 +24,7 @@ __all__ = [
     "COMMAND_RTOL",
     "row_pose",
     "row_q",
+    "moving_fingers",
     "joint_speeds",
     "overlap_pairs",
     "joint_housings",
@@ -79,6 +80,13 @@ def row_pose(cols, k) -> np.ndarray:
 def row_q(cols, k, names=("left", "right")) -> np.ndarray:
     """Joint positions of row ``k`` over the joints ``names`` (the hand's, in its order) (rad or m), shape (n_j,)."""
     return np.array([cols[f"q_{n}"][k] for n in names], dtype=float)
+
+
+def moving_fingers(task, cols, rows) -> list:
+    """The fingers (``"left"``, ``"right"``) whose joints change over ``rows`` (a run of rows), in the hand's order."""
+    names = task.hand.joint_names
+    q = np.array([row_q(cols, k, names) for k in rows])
+    return [f for f, joints in zip(("left", "right"), task.hand.finger_joints) if np.any(np.ptp(q[:, list(joints)], axis=0) > 0)]
 
 
 def joint_speeds(task) -> np.ndarray:

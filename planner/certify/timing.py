@@ -32,7 +32,7 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["ACCEL_RTOL", "HOLD_PROOF", "RATE_TOL", "hold_checks", "interval_rates", "row_com_velocity", "row_velocity", "row_x_velocity",
+__all__ = ["ACCEL_RTOL", "HOLD_PROOF", "RATE_TOL", "hold_checks", "interval_rates", "row_com_velocity", "row_velocity",
            "timing_checks"]
 
 #: Relative excess tolerated on an acceleration limit and on the disturbance box: the planner times the rows to
@@ -106,13 +106,6 @@ def row_com_velocity(cols, k, names):
             v = 0.5 * (v + _rule_velocity(cols, k, *same[1], column))
         out.append(v)
     return np.array(out)
-
-
-def row_x_velocity(cols, k, names):
-    """The workpiece's x velocity (m/s) the rows give at moving in-contact row ``k`` (:func:`row_com_velocity`'s x);
-    ``None`` where :func:`row_velocity` gives none."""
-    v = row_com_velocity(cols, k, names)
-    return None if v is None else float(v[0])
 
 
 def _chords(cols, k) -> list:

@@ -30,7 +30,7 @@ from dataclasses import replace
 
 import numpy as np
 
-__all__ = ["release_holds", "release_joint", "release_torque"]
+__all__ = ["release_hold", "release_holds", "release_joint", "release_torque"]
 
 
 def release_torque(lo: float, hi: float, resolution: float) -> float:
@@ -73,33 +73,51 @@ def release_joint(task, slide) -> list:
     return [names[j] for j in np.argsort(-peak, kind="stable")]
 
 
+def release_hold(task, name, pose, q, joint, tau_from, t0, formation: str):
+    """``(hold phase, HoldStep)`` unloading ``joint`` at rest at ``pose``, ``q``: its torque ramps from ``tau_from``
+    (N m or N; None: taken over there) to :func:`release_torque` of the proved hold interval, every other joint held;
+    None where that interval is empty.
+
+    Raises
+    ------
+    PlanFailure, QsplanError
+        As :func:`qsplan.planner.plan.pivot.hold_phase` (no hold proved for the ramp, no scene).
+    """
+    from qsplan.planner.plan.pivot import held_interval, hold_phase
+    from qsplan.planner.plan.steps import HoldStep
+
+    held = held_interval(task, pose, q, np.array(task.hand.joint_names) == joint)
+    lo, hi = held[1]
+    target = release_torque(lo, hi, task.torque_resolution)
+    if not np.isfinite(target):
+        return None
+    start = target if tau_from is None else float(tau_from)
+    hold = hold_phase(task, name, pose, q, joint, start, target, t0, formation, held=held)
+    return hold, HoldStep(float(pose[0]), float(pose[2]), joint, start, target, float(lo), float(hi))
+
+
 def _release_hold(task, slide, t0):
     """The hold before ``slide``'s release, from ``t0`` (s): ``(phase, HoldStep)``, or None where no joint's hold is
     proved at the slide's end."""
     from qsplan.mechanics.errors import QsplanError
-    from qsplan.planner.plan.pivot import held_interval, hold_phase
     from qsplan.planner.plan.results import PlanFailure
-    from qsplan.planner.plan.steps import HoldStep
 
     pose = slide.poses(task.hand.rest_height)[-1]
     q = slide.q[-1]
     for joint in release_joint(task, slide):
-        effort = np.array(task.hand.joint_names) == joint
+        start = float(slide.command[-1]) if joint == slide.effort_joint else None
         try:  # no hold proved with this joint (or its scene not built): the next one
-            held = held_interval(task, pose, q, effort)
-            lo, hi = held[1]
-            target = release_torque(lo, hi, task.torque_resolution)
-            if not np.isfinite(target):
-                continue
-            start = float(slide.command[-1]) if joint == slide.effort_joint else target
-            hold = hold_phase(task, f"release hold at x = {pose[0]:.4g} m", pose, q, joint, start, target, t0,
-                              slide.formation, held=held)  # fmt: skip
+            found = release_hold(task, f"release hold at x = {pose[0]:.4g} m", pose, q, joint, start, t0,
+                                 slide.formation)  # fmt: skip
         except (PlanFailure, QsplanError):
             continue
+        if found is None:
+            continue
+        hold, step = found
         # on the palm edge: the formation's contacts, named as the slide's rows name them
         same = slide.contacts is None and len(hold.mode) == len(task.formation.contact_names)
         hold = replace(hold, pose=None if slide.pose is None else hold.pose, contacts=None if same else hold.contacts)
-        return hold, HoldStep(float(pose[0]), float(pose[2]), joint, start, target, float(lo), float(hi))
+        return hold, step
     return None
 
 

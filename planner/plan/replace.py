@@ -59,12 +59,6 @@ def lifted_hold(task, pose, q, finger: str):
     return prove_friction_hold(scene, task.mu_range, disturbance=task.disturbance)
 
 
-def _touches(hand, pose, q, finger: str) -> bool:
-    from qsplan.hands.contacts.found import contact_names, ordered_contacts
-
-    return any(n.split(":")[0] == finger for n in contact_names(hand, pose, ordered_contacts(hand, pose, q)))
-
-
 def opening_direction(task, pose, q, finger: str) -> np.ndarray:
     """Per joint -1, 0 or +1 (shape (n_j,)): ``finger``'s closing joint opened by its :data:`~qsplan.planner.plan.
     phases.OPENING` the way that leaves the workpiece at ``pose`` without overlap (tried both ways; the first that
@@ -75,6 +69,7 @@ def opening_direction(task, pose, q, finger: str) -> np.ndarray:
     PlanFailure
         Neither way leaves the workpiece free of the finger.
     """
+    from qsplan.hands.contacts.found import lifted_contacts
     from qsplan.planner.plan.failure import configuration_report
     from qsplan.planner.plan.phases import OPENING
     from qsplan.planner.states.contact import configuration_problem
@@ -86,7 +81,7 @@ def opening_direction(task, pose, q, finger: str) -> np.ndarray:
         d = np.zeros(q.size)
         d[j] = sign
         opened = q + d * OPENING[hand.joint_kinds[j]]
-        if configuration_problem(task, pose, opened) is None and not _touches(hand, pose, opened, finger):
+        if configuration_problem(task, pose, opened) is None and not lifted_contacts(hand, pose, opened, finger)[2].any():
             return d
     raise PlanFailure(configuration_report(task, f"the {finger} finger replaced", "its opening", float(pose[0]), q,
                                            f"the {finger} finger cannot open away from the workpiece either way",
@@ -103,7 +98,7 @@ def replace_phase(task, name, pose, q_from, q_to, finger: str, t0, options, prog
         The hold with the finger lifted is not proved (its reason), the finger cannot open away from the workpiece, or
         OMPL finds no collision-free motion (:func:`qsplan.planner.plan.phases.free_motion`).
     """
-    from qsplan.hands.contacts.found import contact_names, ordered_contacts
+    from qsplan.hands.contacts.found import lifted_contacts
     from qsplan.planner.plan.failure import configuration_report
     from qsplan.planner.plan.phases import OPENING, free_motion
 
@@ -125,8 +120,8 @@ def replace_phase(task, name, pose, q_from, q_to, finger: str, t0, options, prog
     q_to_open = q_to + amount * opening_direction(task, pose, q_to, finger)
     t, path, qd, results = free_motion(task, name, pose, q, q_open, q_to_open, q_to, t0, options, progress, counters,
                                        mine, f"the {finger} finger")  # fmt: skip
-    found = ordered_contacts(hand, pose, q)
-    kept = tuple(n for n in contact_names(hand, pose, found) if n.split(":")[0] != finger)
+    _, names, lifted = lifted_contacts(hand, pose, q, finger)
+    kept = tuple(n for n, off in zip(names, lifted) if not off)
     return ReplacePhase(name, float(pose[0]), t, path, qd, results, None, pose=pose, finger=finger, kept=kept,
                         hold_margin=float(proof.rest_margin))  # fmt: skip
 
@@ -139,11 +134,8 @@ def reclosings(task, pivot, pose, q) -> list:
     free joints' values, then the closing joint's."""
     from itertools import product
 
-    from qsplan.hands.contacts.found import ordered_contacts
-    from qsplan.hands.formations.manifold import along_edges, gaps, project
+    from qsplan.hands.formations.manifold import gaps, project
     from qsplan.hands.formations.pivots import FINGER_FEATURES, Pivot
-    from qsplan.mechanics.errors import SceneError
-    from qsplan.planner.states.contact import configuration_problem
 
     hand = task.hand
     finger = pivot.other_finger
@@ -174,37 +166,39 @@ def reclosings(task, pivot, pose, q) -> list:
                     if c is None or tuple(np.round(c, 9)) in seen:
                         continue
                     seen.add(tuple(np.round(c, 9)))
-                    along = along_edges(hand, cons, c)
-                    if not 0.0 <= along[3] <= 1.0 or configuration_problem(task, c[:3], c[3:]):
-                        continue
-                    try:
-                        if len(ordered_contacts(hand, c[:3], c[3:])) != 4:
-                            continue
-                    except SceneError:
-                        continue
-                    out.append((other, c))
+                    if _closes(task, cons, c):
+                        out.append((other, c))
     return out
+
+
+def _closes(task, constraints, c) -> bool:
+    """Whether configuration ``c`` (on a pivot's ``constraints``) is a grasp: the other finger's point on its edge, no
+    joint beyond its limit and no overlap, and exactly the pivot's four contacts in the polygons."""
+    from qsplan.hands.contacts.found import ordered_contacts
+    from qsplan.hands.formations.manifold import along_edges
+    from qsplan.mechanics.errors import SceneError
+    from qsplan.planner.states.contact import configuration_problem
+
+    if not 0.0 <= along_edges(task.hand, constraints, c)[3] <= 1.0 or configuration_problem(task, c[:3], c[3:]):
+        return False
+    try:
+        return len(ordered_contacts(task.hand, c[:3], c[3:])) == 4
+    except SceneError:
+        return False
 
 
 def reclosed(task, pivot, pose, q, grasp):
     """The new grasp ``grasp`` (a configuration :func:`reclosings` found, for ``pivot``) closed again from ``pose``, ``q``
     exactly: the other finger's joints and the pose as they are, the moving finger's free joints as ``grasp`` holds
     them, its closing joint by Newton's method from ``grasp``'s.  None when it does not close there (no
-    configuration, an overlap, or other than the pivot's four contacts)."""
-    from qsplan.hands.contacts.found import ordered_contacts
+    configuration, or not a grasp: :func:`_closes`)."""
     from qsplan.hands.formations.manifold import project
-    from qsplan.mechanics.errors import SceneError
-    from qsplan.planner.states.contact import configuration_problem
 
     hand = task.hand
     fi = 0 if pivot.other_finger == "left" else 1
     c = np.concatenate([np.asarray(pose, dtype=float), np.asarray(q, dtype=float)])
     for j in hand.finger_joints[fi]:
         c[3 + j] = grasp[3 + j]
-    c = project(hand, pivot.constraints(hand), c, [3 + hand.closing_joints[fi]])
-    if c is None or configuration_problem(task, c[:3], c[3:]):
-        return None
-    try:
-        return c if len(ordered_contacts(hand, c[:3], c[3:])) == 4 else None
-    except SceneError:
-        return None
+    cons = pivot.constraints(hand)
+    c = project(hand, cons, c, [3 + hand.closing_joints[fi]])
+    return c if c is not None and _closes(task, cons, c) else None

@@ -246,8 +246,8 @@ def _route(task, legs, options, progress, planner, started):
     from qsplan.planner.plan.autoplan import plan_automatic
     from qsplan.planner.plan.failure import StepReport, configuration_report
     from qsplan.planner.plan.phases import DEFAULT_OPTIONS
-    from qsplan.planner.plan.pivot import held_interval, hold_phase, shifted
-    from qsplan.planner.plan.release import release_torque
+    from qsplan.planner.plan.pivot import hold_phase, shifted
+    from qsplan.planner.plan.release import release_hold
     from qsplan.planner.plan.replace import replace_phase
     from qsplan.planner.plan.steps import (
         HoldStep,
@@ -291,16 +291,12 @@ def _route(task, legs, options, progress, planner, started):
             pose = before.pose[-1]
             # unloaded first, as before a regrasp (qsplan.planner.plan.release): the effort joint ramps at rest to the
             # least torque at which the hold is still proved, so that a compliant grasp stores little when it lets go
-            e = before.effort_joint
-            lo, hi = held_interval(task, pose, before.q[-1], np.array(hand.joint_names) == e)[1]
-            tau = release_torque(lo, hi, task.torque_resolution)
-            if np.isfinite(tau) and tau != prev_tau:
-                hold = hold_phase(task, f"release hold at theta = {pose[2]:.4g} rad", pose, before.q[-1], e, prev_tau,
-                                  tau, t0, before.formation)  # fmt: skip
-                turned.append(hold)
-                steps.append(HoldStep(float(pose[0]), float(pose[2]), e, float(hold.command[0]), float(tau),
-                                      float(hold.lower[0]), float(hold.upper[0])))  # fmt: skip
-                t0 = float(hold.t[-1])
+            found = release_hold(task, f"release hold at theta = {pose[2]:.4g} rad", pose, before.q[-1],
+                                 before.effort_joint, prev_tau, t0, before.formation)  # fmt: skip
+            if found is not None and found[1].torque_to != found[1].torque_from:  # already there: no ramp to hold
+                turned.append(found[0])
+                steps.append(found[1])
+                t0 = float(found[0].t[-1])
             moved = replace_phase(task, f"the {leg.finger} finger replaced at theta = {pose[2]:.4g} rad", pose,
                                   before.q[-1], leg.start[3:], leg.finger, t0, options or DEFAULT_OPTIONS, progress,
                                   counters)  # fmt: skip
